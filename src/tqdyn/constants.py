@@ -1,0 +1,33 @@
+"""Physical and astronomical constants used by tqdyn (SI units).
+
+Each constant states its value, unit and source.  Values whose decimal form
+is the defining form are kept as exact decimal strings so that extended
+precision code (mpmath, double-double) can convert them without a float64
+rounding step.
+"""
+
+__all__ = [
+    "GM_EARTH_EGM2008",
+    "R_EARTH_EGM2008",
+    "C_LIGHT",
+    "DAY_S",
+    "J2000_JD",
+]
+
+# Geocentric gravitational constant [m^3/s^2], exact decimal string as published
+# with the EGM2008 model (Pavlis et al. 2012, JGR 117, B04406; EGM2008 coefficient
+# file header: GM = 0.3986004415E+15).  TT-compatible value.
+GM_EARTH_EGM2008 = "3.986004415e14"
+
+# Reference radius of the EGM2008 spherical-harmonic expansion [m]
+# (EGM2008 coefficient file header: a = 6378136.3 m).
+R_EARTH_EGM2008 = 6378136.3
+
+# Speed of light in vacuum [m/s], exact by definition of the metre (SI, 1983).
+C_LIGHT = 299792458.0
+
+# Length of the (SI) day [s], exact: 1 d = 86400 s (IAU convention for Julian days).
+DAY_S = 86400
+
+# Julian date of the J2000.0 epoch, 2000-01-01T12:00:00 TT [d] (IAU 1976/2000).
+J2000_JD = 2451545.0

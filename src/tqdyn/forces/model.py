@@ -1,0 +1,104 @@
+"""Composition of the force model: which terms are on, their parameters and
+their time-only inputs, and the one compiled function that sums them.
+
+Each force term is a small object (one per module of :mod:`tqdyn.forces`)
+with the same interface:
+
+* ``name``, ``description``, ``source`` -- for ``tqdyn info`` and the docs;
+* ``params()`` -> float64 array of its constant parameters;
+* ``n_tdat`` and ``precompute(epoch, t_hi, t_lo)`` -> float64 array
+  (..., n_tdat) of its *time-only* inputs (ephemeris positions, rotation
+  matrices, tidal corrections ...) at propagation times t = t_hi + t_lo
+  [s of TDB since the epoch].  The propagator calls it once per chunk of
+  steps for all stage times (the DP87 nodes t_n + c_i h are known in
+  advance), so no Python runs inside the compiled loop.
+
+The compiled side is :func:`gravity`: a fixed list of slots, one per term
+kind, each switched on by the ``layout`` table built here.  Adding a term
+means adding its module, a slot constant and one branch in ``gravity``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..precision import add, const, mul
+from .central import EarthMonopole, monopole
+
+__all__ = ["ForceModel", "build_force_model", "gravity", "SLOTS"]
+
+#: Slot of each term kind in the compiled dispatcher (row of ``layout``).
+SLOT_EARTH_MONOPOLE = 0
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE}
+_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE}
+
+
+class ForceModel:
+    """The set of enabled force terms, flattened for the compiled loop.
+
+    Attributes
+    ----------
+    terms: tuple of term objects, in slot order.
+    params: (n_params,) float64, the terms' parameters concatenated.
+    layout: (n_slots, 3) int64; row s = (enabled, parameter offset, tdat
+        column offset) of slot s.
+    n_tdat: total number of time-only input columns.
+    """
+
+    def __init__(self, terms):
+        terms = tuple(sorted(terms, key=lambda t: _TERM_SLOT[type(t)]))
+        slots = [_TERM_SLOT[type(t)] for t in terms]
+        if len(set(slots)) != len(slots):
+            raise ValueError("forces: a force term is listed twice")
+        self.terms = terms
+        self.layout = np.zeros((len(SLOTS), 3), dtype=np.int64)
+        params, p_off, t_off = [], 0, 0
+        for term, slot in zip(terms, slots):
+            p = np.asarray(term.params(), dtype=np.float64)
+            self.layout[slot] = (1, p_off, t_off)
+            params.append(p)
+            p_off += p.size
+            t_off += term.n_tdat
+        self.params = np.concatenate(params) if params else np.zeros(0)
+        self.n_tdat = t_off
+
+    @property
+    def time_dependent(self) -> bool:
+        """True if any term needs time-only inputs."""
+        return self.n_tdat > 0
+
+    def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
+        """Time-only inputs of every enabled term at times t_hi + t_lo [s TDB
+        since epoch]; returns float64 (*shape(t_hi), n_tdat)."""
+        cols = [term.precompute(epoch, t_hi, t_lo) for term in self.terms]
+        return np.concatenate(cols, axis=-1) if cols else np.zeros(np.shape(t_hi) + (0,))
+
+    def describe(self) -> list[tuple[str, str, str]]:
+        """(name, description, source) of each enabled term."""
+        return [(t.name, t.description, t.source) for t in self.terms]
+
+
+def build_force_model(forces) -> ForceModel:
+    """ForceModel from a scenario's ``ForcesConfig``."""
+    terms = []
+    if forces.earth_monopole:
+        terms.append(EarthMonopole(gm=forces.gm_earth))
+    return ForceModel(terms)
+
+
+@njit(cache=False)
+def gravity(x, y, z, tdat, params, layout):
+    """Total gravitational acceleration [m/s^2] at the geocentric GCRS position
+    (x, y, z) [m] (generic dd / float64), from the enabled terms.
+
+    tdat: (n_tdat,) float64 time-only inputs at this instant; params, layout:
+    from :class:`ForceModel`.  Returns (ax, ay, az) in the number type of x.
+    """
+    zero = mul(x, 0.0)
+    ax, ay, az = zero, zero, zero
+    if layout[SLOT_EARTH_MONOPOLE, 0]:
+        o = layout[SLOT_EARTH_MONOPOLE, 1]
+        gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
+        ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
+    return ax, ay, az

@@ -1,0 +1,387 @@
+"""Propagation driver: initial states, chunked compiled DP87 loop, outputs.
+
+The fixed-step loop runs entirely in compiled code, one chunk of steps at a
+time.  Before each chunk the time-only inputs of the force model are
+computed for every stage time of the chunk (t_n + c_i h, known in advance)
+and handed to the loop as one array, so no Python runs per step.  The
+adaptive mode drives the same compiled step from Python (step-size control
+needs the stage times of the step being tried) and samples the solution on
+the output grid with the Hermite dense output of
+:mod:`tqdyn.integrators.hermite`.
+
+Time is kept as an integer step count times the exact step (a dd pair) --
+never as a large bare float64.  All states are GCRS, geocentric, SI.
+
+This module computes; it writes nothing.  Outputs go to a ``sink`` callable
+(the CLI connects it to the HDF5 writer), progress to a ``progress``
+callable.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from fractions import Fraction
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import mpmath
+import numpy as np
+from numba import njit
+
+from . import elements as _el
+from .dynamics import system_rhs
+from .forces.model import ForceModel, build_force_model
+from .integrators import dp87, hermite
+from .precision import add, dd_from_mp, ld, mul, mp_from_dd, st
+from .timescales import Epoch
+
+__all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs"]
+
+PRECISIONS = ("dd", "float64")
+_DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
+
+
+def initial_state(scenario) -> np.ndarray:
+    """Initial GCRS states of the scenario's satellites as a dd array
+    (n_sat, 6, 2): rows x, y, z [m], vx, vy, vz [m/s]; exact elements
+    converted in mpmath and rounded once to dd."""
+    gm = scenario.forces.gm_earth
+    rows = []
+    for sat in scenario.satellites:
+        r, v = _el.elements_to_state(sat.a_m, sat.e, _el.deg(sat.i_deg), _el.deg(sat.raan_deg),
+                                     _el.deg(sat.argp_deg), _el.deg(sat.nu_deg), gm)
+        rows.append(_el.state_to_dd(r, v))
+    return np.stack(rows)
+
+
+def _as_precision(y_dd: np.ndarray, precision: str) -> np.ndarray:
+    """dd array -> array of the working precision (float64 drops the dd axis, rounding hi+lo)."""
+    if precision == "dd":
+        return np.array(y_dd, dtype=np.float64, order="C", copy=True)
+    return np.ascontiguousarray(y_dd[..., 0] + y_dd[..., 1])
+
+
+def _to_dd(y: np.ndarray, ndim_value: int) -> np.ndarray:
+    """Working-precision array -> dd array (float64 gets lo = 0)."""
+    if y.ndim == ndim_value + 1:
+        return y
+    return np.stack([y, np.zeros_like(y)], axis=-1)
+
+
+# --------------------------------------------------------------------------
+# compiled loops
+
+
+@njit(cache=False)
+def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout):
+    """One DP87 step in place: the 13 stages (K[0] = f(y) first), then the
+    compensated update of y.  tdat_step: (13, n_tdat) time-only inputs at
+    the stage times."""
+    system_rhs(y, tdat_step[0], params, layout, K[0])
+    for i in range(1, 13):
+        dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
+        system_rhs(ystage, tdat_step[i], params, layout, K[i])
+    dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
+
+
+@njit(cache=False)
+def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+                 n_steps, out_y, out_a):
+    """n_steps fixed DP87 steps.  Before step n it records the state y_n in
+    out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s acceleration (stage 1) in
+    out_a[n] (n_body, 3[, 2]).  tdat: (n_steps, 13, n_tdat)."""
+    for n in range(n_steps):
+        out_y[n] = y
+        _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout)
+        out_a[n] = K[0][:, 3:6]
+
+
+@njit(cache=False)
+def _grid_times(n0, m, h, c, t_out, t_nodes):
+    """t_out[k] = (n0 + k) h (dd, exact for the usual decimal steps) and, if
+    t_nodes has rows, the stage times t_nodes[k, i] = t_out[k] + c_i h.
+    h: (2,) dd step [s]; c: (13,) nodes; t_out: (m, 2); t_nodes: (m or 0, 13, 2)."""
+    hd = (h[0], h[1])
+    for k in range(m):
+        t = mul(hd, float(n0 + k))
+        st(t_out, t, k)
+        if t_nodes.shape[0] > 0:
+            for i in range(c.shape[0]):
+                st(t_nodes, add(t, mul(hd, c[i])), k, i)
+
+
+@njit(cache=False)
+def _scale_tableau(a, b, h, ha, hb):
+    """ha = h * a, hb = h * b in the working precision (h: generic number)."""
+    for i in range(a.shape[0]):
+        st(hb, mul(ld(b, i), h), i)
+        for j in range(a.shape[1]):
+            st(ha, mul(ld(a, i, j), h), i, j)
+
+
+def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel) -> np.ndarray:
+    """dy/dt at one instant, same layout and precision as ``y``."""
+    k = np.zeros_like(y)
+    _rhs_at(y, tdat_row, model.params, model.layout, k)
+    return k
+
+
+@njit(cache=False)
+def _rhs_at(y, tdat_row, params, layout, k):
+    system_rhs(y, tdat_row, params, layout, k)
+
+
+# --------------------------------------------------------------------------
+# Python driver
+
+
+@dataclass
+class RunResult:
+    """Outcome of a propagation.
+
+    t_final: (2,) dd [s TDB since epoch]; y0, y_final: (n_sat, 6, 2) dd GCRS
+    states [m, m/s] (float64 runs have lo = 0); n_steps: accepted steps;
+    n_rejected: rejected steps (adaptive); n_rhs: right-hand-side
+    evaluations; wall_s: wall time of the propagation [s];
+    energy_rel_drift: (n_sat,) relative change of the two-body energy
+    v^2/2 - GM/r (only for a pure monopole model, else None).
+    """
+
+    precision: str
+    mode: str
+    t_final: np.ndarray
+    y0: np.ndarray
+    y_final: np.ndarray
+    n_steps: int
+    n_rejected: int
+    n_rhs: int
+    wall_s: float
+    energy_rel_drift: np.ndarray | None = None
+    extra: dict = field(default_factory=dict)
+
+
+def two_body_energy(y_dd: np.ndarray, gm) -> list:
+    """Specific two-body energy v^2/2 - gm/|r| [J/kg] of each body, in mpmath
+    (exact from the dd states).  y_dd: (n_body, 6, 2)."""
+    vals = mp_from_dd(y_dd)
+    out = []
+    with mpmath.workdps(60):
+        g = mpmath.mpf(str(gm))
+        for row in vals:
+            r = mpmath.sqrt(sum(x * x for x in row[:3]))
+            out.append(sum(x * x for x in row[3:]) / 2 - g / r)
+    return out
+
+
+def _rows(t, y, a, precision, every, n0):
+    """Output rows for global step indices n0.. whose index is a multiple of ``every``."""
+    sel = (np.arange(n0, n0 + t.shape[0]) % every) == 0
+    y_dd = _to_dd(y[sel], 2)
+    a_f = a[sel][..., 0] if precision == "dd" else a[sel]
+    return {
+        "t": (t[sel, 0], t[sel, 1]),
+        "sat/r": (y_dd[:, :, 0:3, 0], y_dd[:, :, 0:3, 1]),
+        "sat/v": (y_dd[:, :, 3:6, 0], y_dd[:, :, 3:6, 1]),
+        "sat/a_gravity": a_f,
+    }
+
+
+def _check_precision(precision):
+    if precision not in PRECISIONS:
+        raise ValueError(f"run.precision: {precision!r} is not allowed; allowed: {', '.join(PRECISIONS)}")
+
+
+def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping], None] | None = None,
+              progress: Callable[[int], None] | None = None, chunk: int = _DEFAULT_CHUNK,
+              y0: np.ndarray | None = None) -> RunResult:
+    """Propagate the scenario's satellites over ``scenario.run.duration_s``.
+
+    precision: "dd" | "float64" (default: the scenario's run.precision).
+    sink(rows): receives output rows every chunk -- a dict with "t" (hi, lo)
+    (m,) [s TDB since epoch], "sat/r" and "sat/v" (hi, lo) (m, n_sat, 3)
+    [m, m/s, GCRS], "sat/a_gravity" (m, n_sat, 3) float64 [m/s^2] -- on the
+    output grid (every run.output_every-th step; the adaptive mode samples
+    the fixed grid k * integrator.step_s by dense output).
+    progress(n): called with the number of steps just completed (fixed) or
+    the seconds of propagation time just covered (adaptive).
+    y0: optional initial dd states (n_sat, 6, 2) instead of the scenario's elements.
+    """
+    precision = precision or scenario.run.precision
+    _check_precision(precision)
+    model = build_force_model(scenario.forces)
+    epoch = Epoch.from_utc(scenario.epoch_utc)
+    tab = dp87.load_tableau(scenario.integrator.tableau)
+    y0_dd = initial_state(scenario) if y0 is None else np.asarray(y0, np.float64)
+    if scenario.integrator.mode == "adaptive":
+        result = _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress)
+    else:
+        result = _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk)
+    if model.describe() and [t[0] for t in model.describe()] == ["earth_monopole"]:
+        e0 = two_body_energy(result.y0, scenario.forces.gm_earth)
+        e1 = two_body_energy(result.y_final, scenario.forces.gm_earth)
+        with mpmath.workdps(60):
+            result.energy_rel_drift = np.array([float((b - a) / abs(a)) for a, b in zip(e0, e1)])
+    return result
+
+
+def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk):
+    coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
+    n_total = scenario.n_steps
+    every = scenario.run.output_every
+    y = _as_precision(y0_dd, precision)
+    comp = np.zeros_like(y)
+    K = np.zeros((13,) + y.shape)
+    ystage = np.zeros_like(y)
+    err = np.zeros(y.shape[:2])
+    h = np.array(coef.h)
+    nb = y.shape[0]
+    acc_shape = (nb, 3) + y.shape[2:]
+    t_start = _time.perf_counter()
+    n = 0
+    while n < n_total:
+        m = min(chunk, n_total - n)
+        t_out = np.empty((m, 2))
+        t_nodes = np.empty((m if model.time_dependent else 0, 13, 2))
+        _grid_times(n, m, h, coef.c, t_out, t_nodes)
+        tdat = (model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1]) if model.time_dependent
+                else np.zeros((m, 13, 0)))
+        out_y = np.empty((m,) + y.shape)
+        out_a = np.empty((m,) + acc_shape)
+        _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                     coef.he, tdat, model.params, model.layout, m, out_y, out_a)
+        if sink is not None:
+            sink(_rows(t_out, out_y, out_a, precision, every, n))
+        n += m
+        if progress is not None:
+            progress(m)
+    # the final state and its acceleration
+    t_end = np.empty((1, 2))
+    t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))
+    _grid_times(n_total, 1, h, coef.c, t_end, t_nodes)
+    tdat_end = (model.precompute(epoch, t_nodes[0, 0, 0], t_nodes[0, 0, 1]) if model.time_dependent
+                else np.zeros(0))
+    k_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model)
+    wall = _time.perf_counter() - t_start
+    if sink is not None:
+        sink(_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total))
+    return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,
+                     y_final=_to_dd(y, 2), n_steps=n_total, n_rejected=0,
+                     n_rhs=13 * n_total + 1, wall_s=wall)
+
+
+def _dd_of(x: Fraction) -> tuple[float, float]:
+    """Exact rational -> dd pair."""
+    hi = float(x)
+    return hi, float(x - Fraction(hi))
+
+
+def _node_tdat(model, epoch, times) -> np.ndarray:
+    """Time-only inputs at exact times (list of Fractions, s TDB since epoch): (len, n_tdat)."""
+    if not model.time_dependent:
+        return np.zeros((len(times), 0))
+    pairs = np.array([_dd_of(t) for t in times])
+    return model.precompute(epoch, pairs[:, 0], pairs[:, 1])
+
+
+#: max|r^(6)| (h/2)^6 / 6! bound of the quintic Hermite error, written as
+#: |r| (w h)^6 / _QUINTIC_ERROR_DIVISOR with w = sqrt(|a| / |r|).
+_QUINTIC_ERROR_DIVISOR = 46080.0
+
+
+def _dense_output_max_step(y, a, rtol) -> float:
+    """Largest step [s] whose quintic Hermite dense output stays within
+    rtol * |r|: h <= (46080 rtol)^(1/6) / w, with the orbital frequency
+    w = sqrt(|a| / |r|) [rad/s] of the fastest body (for a Keplerian orbit
+    w^2 = GM / r^3 exactly)."""
+    r = np.linalg.norm(_to_dd(y, 2)[:, 0:3, 0], axis=1)
+    acc = np.linalg.norm(np.asarray(a)[..., 0] if np.ndim(a) == 3 else a, axis=1)
+    w = float(np.max(np.sqrt(acc / r)))
+    return (_QUINTIC_ERROR_DIVISOR * rtol) ** (1.0 / 6.0) / w if w > 0 else np.inf
+
+
+def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress):
+    """Embedded-error step-size control (7th-order estimate, local error
+    per step <= rtol * |r| and rtol * |v| per body), output sampled on the
+    grid k * integrator.step_s by quintic Hermite dense output.  Time is
+    tracked as an exact rational (each step is an exact binary float)."""
+    rtol = float(scenario.integrator.rtol)
+    T = Fraction(scenario.run.duration_s)
+    dt_out = Fraction(scenario.integrator.step_s)
+    unit = dp87.step_coefficients(tab, 1, precision)  # h = 1: the bare tableau
+    c_nodes = [Fraction(x) for x in unit.c]
+    y = _as_precision(y0_dd, precision)
+    comp = np.zeros_like(y)
+    K = np.zeros((13,) + y.shape)
+    ystage = np.zeros_like(y)
+    err = np.zeros(y.shape[:2])
+    ha = np.zeros_like(unit.ha)
+    hb = np.zeros_like(unit.hb)
+    z = np.array([0.0, 1.0])
+    nb = y.shape[0]
+    rows: list = []
+
+    def flush(force=False):
+        if sink is not None and rows and (force or len(rows) >= _DEFAULT_CHUNK):
+            t_arr = np.array([r[0] for r in rows])
+            y_arr = np.stack([r[1] for r in rows])
+            a_arr = np.stack([r[2] for r in rows])
+            sink(_rows(t_arr, y_arr, a_arr, precision, 1, 0))
+            rows.clear()
+
+    def emit(t_exact, y_row):
+        k_row = evaluate_rhs(y_row, _node_tdat(model, epoch, [t_exact])[0], model)
+        rows.append((_dd_of(t_exact), y_row.copy(), k_row[:, 3:6].copy()))
+        flush()
+
+    t_start = _time.perf_counter()
+    t = Fraction(0)
+    k_out = 1
+    emit(t, y)
+    h_max = _dense_output_max_step(y, rows[0][2] if rows else evaluate_rhs(y, _node_tdat(model, epoch, [t])[0], model)[:, 3:6], rtol)
+    h = min(float(min(dt_out, T)), h_max)
+    n_acc = n_rej = n_rhs = 0
+    while t < T:
+        last = Fraction(h) >= T - t
+        h_exact = T - t if last else Fraction(h)
+        h_pair = np.array(_dd_of(h_exact))
+        _scale_tableau(unit.ha, unit.hb, (h_pair[0], h_pair[1]) if precision == "dd" else h_pair[0], ha, hb)
+        he = unit.he * float(h_exact)
+        tdat = _node_tdat(model, epoch, [t + ci * h_exact for ci in c_nodes])
+        y_try, comp_try = y.copy(), comp.copy()
+        _one_step(y_try, comp_try, K, ystage, err, ha, unit.nz, unit.nnz, hb, unit.nzb, unit.nnzb, he,
+                  tdat, model.params, model.layout)
+        n_rhs += 13
+        norm = dp87.error_norm(y_try, err, rtol)
+        if norm <= 1.0:
+            t_new = t + h_exact
+            a0 = K[0][:, 3:6].copy()
+            a1 = evaluate_rhs(y_try, _node_tdat(model, epoch, [t_new])[0], model)[:, 3:6]
+            n_rhs += 1
+            while k_out * dt_out <= t_new:
+                t_k = k_out * dt_out
+                if t_k == t_new:
+                    y_k = y_try
+                else:
+                    s_pair = _dd_of((t_k - t) / h_exact)
+                    y_k = np.empty_like(y)
+                    s = (s_pair[0], s_pair[1]) if precision == "dd" else s_pair[0]
+                    hh = (h_pair[0], h_pair[1]) if precision == "dd" else h_pair[0]
+                    for b in range(nb):
+                        nodes_r = np.stack([y[b, 0:3], y_try[b, 0:3]])
+                        nodes_v = np.stack([y[b, 3:6], y_try[b, 3:6]])
+                        nodes_a = np.stack([a0[b], a1[b]])
+                        hermite.hermite_eval(z, nodes_r, nodes_v, nodes_a, hh, s, y_k[b, 0:3], y_k[b, 3:6])
+                emit(t_k, y_k)
+                k_out += 1
+            if progress is not None:
+                progress(float(h_exact))
+            t, y, comp = t_new, y_try, comp_try
+            n_acc += 1
+            h_max = _dense_output_max_step(y, a1, rtol)
+        else:
+            n_rej += 1
+        h = min(h * dp87.next_step_factor(norm), h_max)
+    flush(force=True)
+    wall = _time.perf_counter() - t_start
+    return RunResult(precision=precision, mode="adaptive", t_final=np.array(_dd_of(t)), y0=y0_dd,
+                     y_final=_to_dd(y, 2), n_steps=n_acc, n_rejected=n_rej, n_rhs=n_rhs, wall_s=wall)

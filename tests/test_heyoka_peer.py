@@ -1,0 +1,180 @@
+"""Tests of the heyoka real128 Kepler reference peer (tqdyn._heyoka_peer)."""
+
+import numpy as np
+import pytest
+
+hy = pytest.importorskip("heyoka")
+mpmath = pytest.importorskip("mpmath")
+
+from tqdyn._heyoka_peer import (  # noqa: E402
+    propagate_kepler_grid,
+    real128_to_dd,
+    to_real128,
+)
+
+pytestmark = pytest.mark.heyoka
+
+R128 = hy.real128
+GM_STR = "3.986004415e14"
+STEP = 50.0
+N_DAY = 1728  # 1 day at 50 s
+DPS = 50
+
+
+def real128_to_mpf(x):
+    """Exact real128 -> mpf (113 bits fit in three float64 chunks)."""
+    x = R128(x)
+    parts = []
+    for _ in range(3):
+        f = float(x)
+        parts.append(f)
+        x = x - R128(f)  # exact: residual of round-to-nearest
+    assert float(x) == 0.0
+    with mpmath.workprec(400):
+        return mpmath.fsum(mpmath.mpf(p) for p in parts)
+
+
+def dd_to_mpf(hi, lo):
+    with mpmath.workprec(400):
+        return mpmath.mpf(float(hi)) + mpmath.mpf(float(lo))
+
+
+def _final_error(out, body, r_exact, v_exact):
+    dr = [dd_to_mpf(out["r_hi"][-1, body, i], out["r_lo"][-1, body, i]) - r_exact[i]
+          for i in range(3)]
+    dv = [dd_to_mpf(out["v_hi"][-1, body, i], out["v_lo"][-1, body, i]) - v_exact[i]
+          for i in range(3)]
+    return mpmath.sqrt(mpmath.fsum(d * d for d in dr)), mpmath.sqrt(
+        mpmath.fsum(d * d for d in dv))
+
+
+def test_circular_orbit_one_day():
+    with mpmath.workdps(DPS):
+        gm = mpmath.mpf(GM_STR)
+        rad = mpmath.mpf(10) ** 8
+        n = mpmath.sqrt(gm / rad**3)
+        r0 = np.array([[rad, mpmath.mpf(0), mpmath.mpf(0)]], dtype=object)
+        v0 = np.array([[mpmath.mpf(0), rad * n, mpmath.mpf(0)]], dtype=object)
+
+        out = propagate_kepler_grid(r0, v0, GM_STR, STEP, N_DAY)
+        assert out["fp_type"] == "real128"
+        assert out["r_hi"].shape == (N_DAY + 1, 1, 3)
+        assert out["v_lo"].shape == (N_DAY + 1, 1, 3)
+
+        t = N_DAY * mpmath.mpf(STEP)
+        r_ex = [rad * mpmath.cos(n * t), rad * mpmath.sin(n * t), mpmath.mpf(0)]
+        v_ex = [-rad * n * mpmath.sin(n * t), rad * n * mpmath.cos(n * t),
+                mpmath.mpf(0)]
+        err_r, err_v = _final_error(out, 0, r_ex, v_ex)
+    print(f"\ncircular 1 day: |dr| = {mpmath.nstr(err_r, 3)} m, "
+          f"|dv| = {mpmath.nstr(err_v, 3)} m/s, setup {out['setup_s']:.3f} s, "
+          f"propagate_grid {out['wall_s']:.3f} s")
+    assert err_r < 1e-20
+    assert err_v < 1e-24
+
+
+def _kepler_state(a, e, gm, t):
+    """Perifocal state at time t, periapsis at t = 0 (current mp precision)."""
+    n = mpmath.sqrt(gm / a**3)
+    m = n * t
+    ecc = mpmath.mpf(m)
+    for _ in range(100):
+        d = (ecc - e * mpmath.sin(ecc) - m) / (1 - e * mpmath.cos(ecc))
+        ecc -= d
+        if abs(d) < mpmath.mpf(10) ** (-mpmath.mp.dps + 3):
+            break
+    else:  # pragma: no cover
+        raise RuntimeError("Kepler solver did not converge")
+    b = a * mpmath.sqrt(1 - e * e)
+    edot = n / (1 - e * mpmath.cos(ecc))
+    r = [a * (mpmath.cos(ecc) - e), b * mpmath.sin(ecc), mpmath.mpf(0)]
+    v = [-a * mpmath.sin(ecc) * edot, b * mpmath.cos(ecc) * edot, mpmath.mpf(0)]
+    return r, v
+
+
+def test_eccentric_orbit_one_day():
+    with mpmath.workdps(DPS):
+        gm = mpmath.mpf(GM_STR)
+        a = mpmath.mpf(10) ** 8
+        e = mpmath.mpf("0.1")
+        r0, v0 = _kepler_state(a, e, gm, mpmath.mpf(0))
+        out = propagate_kepler_grid(np.array([r0], dtype=object),
+                                    np.array([v0], dtype=object),
+                                    GM_STR, STEP, N_DAY)
+        # also check an intermediate grid point (t = 12 h)
+        errs = []
+        for k in (N_DAY // 2, N_DAY):
+            r_ex, v_ex = _kepler_state(a, e, gm, k * mpmath.mpf(STEP))
+            sub = {key: out[key][: k + 1] for key in ("r_hi", "r_lo", "v_hi", "v_lo")}
+            errs.append(_final_error(sub, 0, r_ex, v_ex))
+    err_r, err_v = errs[-1]
+    print(f"\ne=0.1 1 day: |dr| = {mpmath.nstr(err_r, 3)} m, "
+          f"|dv| = {mpmath.nstr(err_v, 3)} m/s (12 h: |dr| = "
+          f"{mpmath.nstr(errs[0][0], 3)} m), Taylor steps {out['n_taylor_steps']}")
+    for er, ev in errs:
+        assert er < 1e-20
+        assert ev < 1e-24
+
+
+def test_hi_lo_conversion_exact():
+    rng = np.random.default_rng(12345)
+    # real128 values with full 113-bit significands: x = a + b*2^-53 + c*2^-106
+    a = rng.uniform(-2e8, 2e8, 200)
+    b = rng.uniform(-1, 1, 200) * np.abs(a)
+    c = rng.uniform(-1, 1, 200) * np.abs(a)
+    x = (a.astype(R128) + b.astype(R128) * R128(2.0**-53)
+         + c.astype(R128) * R128(2.0**-106))
+    x = np.concatenate([x, np.array([R128("0.1"), R128(GM_STR), R128(0),
+                                     R128("-1e-20"), R128("1e8")], dtype=R128)])
+    hi, lo = real128_to_dd(x)
+    assert hi.dtype == np.float64 and lo.dtype == np.float64
+    worst = mpmath.mpf(0)
+    with mpmath.workprec(400):
+        for xi, h, l in zip(x, hi, lo):
+            xm = real128_to_mpf(xi)
+            # hi is the nearest double, lo the nearest double to x - hi
+            assert h == float(xi)
+            assert abs(mpmath.mpf(h) - xm) <= abs(mpmath.mpf(np.spacing(h))) / 2
+            if xm == 0:
+                assert h == 0 and l == 0
+                continue
+            assert abs(l) <= abs(np.spacing(h)) / 2
+            rel = abs(dd_to_mpf(h, l) - xm) / abs(xm)
+            worst = max(worst, rel)
+            # a double-double holds ~107 bits, real128 113: the bound is
+            # |x - (hi+lo)| <= 2^-106 |x| (~1.2e-32), i.e. 1e-33
+            # cannot be guaranteed; observed worst case ~6e-33.
+            assert rel <= mpmath.mpf(2) ** -106
+    print(f"\nhi/lo worst relative error {mpmath.nstr(worst, 3)} "
+          f"(2^-106 = {2.0**-106:.3g})")
+    assert worst < 1e-32
+
+
+def test_input_conversions_exact():
+    with mpmath.workdps(DPS):
+        # double-double pair -> real128 exactly
+        hi = np.array([[1e8, -3.0, 7.5e7]])
+        lo = np.array([[1.1e-9, 2.0**-60, -3.3e-10]])
+        r = to_real128((hi, lo))
+        for i in range(3):
+            assert real128_to_mpf(r[0, i]) == mpmath.mpf(hi[0, i]) + mpmath.mpf(lo[0, i])
+        # mpf -> nearest real128
+        m = mpmath.mpf(1) / 3
+        r = to_real128(np.array([m], dtype=object))
+        err = abs(real128_to_mpf(r[0]) - m)
+        assert err <= mpmath.mpf(2) ** -114  # half an ulp at 1/3 (ulp = 2^-114)
+        # float64 exact
+        r = to_real128(np.array([0.1]))
+        assert real128_to_mpf(r[0]) == mpmath.mpf(0.1)
+
+
+def test_several_bodies_match_single():
+    # N bodies in one system give the same result as each alone (bitwise)
+    r0 = np.array([[1.0e8, 0.0, 0.0], [0.0, 1.000095e8, 0.0]])
+    v0 = np.array([[0.0, 1996.5, 0.0], [0.0, 0.0, 1996.4]])
+    both = propagate_kepler_grid(r0, v0, GM_STR, STEP, 100)
+    one = propagate_kepler_grid(r0[1:], v0[1:], GM_STR, STEP, 100)
+    diff = np.abs((both["r_hi"][:, 1] - one["r_hi"][:, 0])
+                  + (both["r_lo"][:, 1] - one["r_lo"][:, 0]))
+    # the adaptive step is shared by all bodies, so allow roundoff-level noise
+    assert diff.max() < 1e-22

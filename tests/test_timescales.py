@@ -1,0 +1,177 @@
+"""Tests for tqdyn.timescales (UTC -> TAI -> TT -> TDB at the geocenter).
+
+References used here, independent of the code under test:
+* JD of a calendar date from Python's proleptic Gregorian ``datetime.date``
+  ordinal: JD(2000-01-01 0h) = 2451544.5 (J2000.0 = 2451545.0 is 12h TT).
+* TAI-UTC = 32 s from 1999-01-01 to 2006-01-01 and 37 s since 2017-01-01
+  (IERS Bulletin C); TT-TAI = 32.184 s exactly (IAU 1991 Resolution A4).
+* TDB-TT approximation 0.001657 sin g + 0.000014 sin 2g s with
+  g = 357.53 deg + 0.98560028 deg * (JD - 2451545.0)
+  (USNO Circular 179, Kaplan 2005, eq. 2.6; accurate to about 10-30 us).
+* pyerfa's own routines called directly in the test (forward chain and the
+  inverse routines erfa.taiutc, erfa.tttai, erfa.tdbtt, erfa.d2dtf).
+All comparisons are differences of two-part JDs done in exact rational
+arithmetic (fractions.Fraction) and expressed in seconds.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import warnings
+from fractions import Fraction
+
+import erfa
+import numpy as np
+import pytest
+
+from tqdyn.timescales import Epoch, parse_utc, tdb_jd
+
+DAY = 86400
+EPOCH_ISO = "2004-06-06T00:00:00"
+
+
+def _jd(pair) -> Fraction:
+    return Fraction(float(pair[0])) + Fraction(float(pair[1]))
+
+
+def _dsec(p, q) -> float:
+    """(p - q) in seconds, exactly from the two float pairs, rounded once at the end."""
+    return float((_jd(p) - _jd(q)) * DAY)
+
+
+@pytest.fixture(scope="module")
+def ep() -> Epoch:
+    return Epoch.from_utc(EPOCH_ISO)
+
+
+def test_utc_jd_from_calendar(ep):
+    # JD at 0h of the date: days since 2000-01-01 (Python ordinal) + 2451544.5
+    jd0 = (dt.date(2004, 6, 6) - dt.date(2000, 1, 1)).days + 2451544.5
+    assert _jd(ep.utc) == Fraction(jd0)
+    assert ep.utc_iso == EPOCH_ISO
+    # jd1 is shared by all scales (ERFA convention: large part first)
+    assert ep.utc[0] == ep.tai[0] == ep.tt[0] == ep.tdb[0] == jd0
+
+
+def test_tai_minus_utc_is_32s(ep):
+    # IERS Bulletin C: TAI-UTC = 32 s on 2004-06-06; erfa's table agrees exactly
+    assert erfa.dat(2004, 6, 6, 0.0) == 32.0
+    # the float JD pair represents 32 s to its rounding: |err| < ulp(3.7e-4 d) * 86400 ~ 5e-15 s
+    assert abs(_dsec(ep.tai, ep.utc) - 32.0) < 1e-12
+
+
+def test_tt_minus_tai_is_32_184s(ep):
+    assert abs(_dsec(ep.tt, ep.tai) - 32.184) < 1e-12
+
+
+def test_tdb_minus_tt(ep):
+    dtdb = _dsec(ep.tdb, ep.tt)
+    assert abs(dtdb) < 2e-3  # the periodic TDB-TT terms are below 1.7 ms
+    # equal to erfa.dtdb at that instant (geocentric: elong = u = v = 0; ut then irrelevant)
+    ref = erfa.dtdb(ep.tt[0], ep.tt[1], 0.0, 0.0, 0.0, 0.0)
+    assert abs(dtdb - ref) < 1e-12
+    ref_ut_other = erfa.dtdb(ep.tt[0], ep.tt[1], 0.37, 0.0, 0.0, 0.0)
+    assert ref_ut_other == ref  # the UT argument only enters the topocentric terms
+    # USNO Circular 179 eq. 2.6 (first-principles approximation, ~10-30 us accuracy)
+    g = math.radians(357.53 + 0.98560028 * (float(_jd(ep.tt)) - 2451545.0))
+    approx = 0.001657 * math.sin(g) + 0.000014 * math.sin(2 * g)
+    assert abs(dtdb - approx) < 50e-6
+
+
+def test_chain_matches_erfa_forward_and_inverse(ep):
+    # forward chain evaluated independently here
+    u1, u2 = erfa.dtf2d("UTC", 2004, 6, 6, 0, 0, 0.0)
+    a1, a2 = erfa.utctai(u1, u2)
+    t1, t2 = erfa.taitt(a1, a2)
+    b1, b2 = erfa.tttdb(t1, t2, erfa.dtdb(t1, t2, 0.0, 0.0, 0.0, 0.0))
+    for mine, ref in ((ep.utc, (u1, u2)), (ep.tai, (a1, a2)), (ep.tt, (t1, t2)), (ep.tdb, (b1, b2))):
+        assert abs(_dsec(mine, ref)) < 1e-12
+    # inverse routines take us back to UTC
+    dtr = erfa.dtdb(ep.tt[0], ep.tt[1], 0.0, 0.0, 0.0, 0.0)
+    tt_back = erfa.tdbtt(ep.tdb[0], ep.tdb[1], dtr)
+    tai_back = erfa.tttai(*tt_back)
+    utc_back = erfa.taiutc(*tai_back)
+    assert abs(_dsec(tt_back, ep.tt)) < 1e-9
+    assert abs(_dsec(tai_back, ep.tai)) < 1e-9
+    assert abs(_dsec(utc_back, ep.utc)) < 1e-9
+    iy, im, id_, ihmsf = erfa.d2dtf("UTC", 3, *ep.utc)
+    assert (int(iy), int(im), int(id_)) == (2004, 6, 6)
+    assert tuple(int(x) for x in ihmsf.tolist()) == (0, 0, 0, 0)
+
+
+def test_after_last_leap_second_and_leap_second_day():
+    # 37 s since 2017-01-01 (IERS Bulletin C)
+    e = Epoch.from_utc("2017-01-01T00:00:00")
+    assert abs(_dsec(e.tai, e.utc) - 37.0) < 1e-12
+    # 2016-12-31 had a leap second: 23:59:60.5 exists
+    e = Epoch.from_utc("2016-12-31T23:59:60.5")
+    assert e.utc_iso == "2016-12-31T23:59:60.5"
+    with pytest.raises(ValueError, match="2016-12-30T23:59:60"):
+        Epoch.from_utc("2016-12-30T23:59:60")
+
+
+def test_no_erfa_warning_leaks():
+    # 2004 (inside the table) and 2035 (TianQin era, after the last leap second:
+    # erfa flags it "dubious" and keeps TAI-UTC = 37 s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Epoch.from_utc(EPOCH_ISO)
+        e = Epoch.from_utc("2035-01-01T00:00:00")
+    assert abs(_dsec(e.tai, e.utc) - 37.0) < 1e-12
+
+
+def test_normalisation():
+    assert Epoch.from_utc("2004-06-06 00:00Z").utc_iso == "2004-06-06T00:00:00"
+    assert Epoch.from_utc("2004-06-06").utc_iso == "2004-06-06T00:00:00"
+    e = Epoch.from_utc("2004-06-06T12:34:56.789")
+    assert e.utc_iso == "2004-06-06T12:34:56.789"
+    assert abs(float(_jd(e.utc) - _jd(Epoch.from_utc("2004-06-06").utc)) * DAY - (12 * 3600 + 34 * 60 + 56.789)) < 1e-9
+    f = parse_utc("2004-06-06T01:02:03")
+    assert (f.year, f.month, f.day, f.hour, f.minute, f.second) == (2004, 6, 6, 1, 2, 3.0)
+
+
+@pytest.mark.parametrize(
+    "bad",
+    ["06/06/2004", "2004-6-6T00:00:00", "2004-13-01T00:00:00", "2004-02-30T00:00:00",
+     "2004-06-06T24:00:00", "2004-06-06T00:61:00", "1950-01-01T00:00:00", "", "yesterday"],
+)
+def test_bad_strings(bad):
+    with pytest.raises(ValueError) as info:
+        Epoch.from_utc(bad)
+    msg = str(info.value)
+    assert repr(bad) in msg
+    assert "YYYY-MM-DDTHH:MM:SS" in msg
+
+
+def test_non_string_rejected():
+    with pytest.raises(ValueError, match="must be a string"):
+        Epoch.from_utc(20040606)
+
+
+def test_tdb_jd_zero_and_shapes(ep):
+    jd1, jd2 = tdb_jd(ep, 0.0)
+    assert jd1 == ep.tdb[0] and jd2 == ep.tdb[1]
+    jd1, jd2 = tdb_jd(ep, np.arange(5.0) * 50.0)
+    assert jd1.shape == jd2.shape == (5,)
+    assert np.all(jd1 == ep.tdb[0])
+    jd1, jd2 = tdb_jd(ep, np.arange(3.0), np.zeros((2, 1)))
+    assert jd1.shape == jd2.shape == (2, 3)
+
+
+@pytest.mark.parametrize("t_hi, t_lo", [(7.776e6, 0.0), (7.776e6, 3.1e-10), (12345.678901234, -1.7e-13), (1.5778e8, 0.0)])
+def test_tdb_jd_round_trip(ep, t_hi, t_lo):
+    # Float64 two-part JD resolution: the error is the rounding of jd2, at most
+    # half an ulp: near 90 d jd2 is in [64, 128) d, ulp = 2**-46 d = 1.23 ns, so
+    # |error| <= 0.61 ns; at 5 yr (1.58e8 s, jd2 in [1024, 2048) d) ulp = 19.6 ns.
+    jd1, jd2 = tdb_jd(ep, t_hi, t_lo)
+    assert jd1 == ep.tdb[0]  # exactly
+    exact = Fraction(ep.tdb[1]) + (Fraction(t_hi) + Fraction(t_lo)) / DAY
+    err_days = Fraction(float(jd2)) - exact
+    half_ulp = Fraction(float(np.spacing(jd2))) / 2
+    assert abs(err_days) <= half_ulp * Fraction(1000001, 1000000)
+    t_back = (Fraction(float(jd2)) - Fraction(ep.tdb[1])) * DAY
+    err_s = abs(float(t_back - Fraction(t_hi) - Fraction(t_lo)))
+    if t_hi <= 7.776e6:
+        assert err_s <= 1e-9
+    assert err_s <= float(half_ulp) * DAY * 1.000001
