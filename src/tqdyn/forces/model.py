@@ -26,7 +26,7 @@ from numba import njit
 from ..precision import add, const, mul
 from .central import EarthMonopole, monopole
 
-__all__ = ["ForceModel", "build_force_model", "gravity", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -77,6 +77,11 @@ class ForceModel:
     def describe(self) -> list[tuple[str, str, str]]:
         """(name, description, source) of each enabled term."""
         return [(t.name, t.description, t.source) for t in self.terms]
+
+
+def describe_terms() -> list[tuple[str, str, str]]:
+    """(name, description, source) of every force term tqdyn can evaluate."""
+    return [(cls.name, cls.description, cls.source) for cls in _TERM_SLOT]
 
 
 def build_force_model(forces) -> ForceModel:

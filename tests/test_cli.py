@@ -1,0 +1,169 @@
+"""The command line: `tqdyn run` end to end, bad input, interruption, info, bench.
+
+Reference values: the analytic two-body solution (mpmath, 50 digits) of the
+tianqin-kepler elements (Table I of the TianQin paper) -- independent of the
+integrator -- and the trajectory-file contract of DESIGN.md section 7.
+"""
+
+from __future__ import annotations
+
+import os
+
+import mpmath
+import numpy as np
+import pytest
+
+from tqdyn import cli, elements, io, propagator
+from tqdyn.precision import mp_from_dd
+from tqdyn.scenario import load_scenario, loads_scenario
+
+
+def _run(argv, capsys):
+    """Run the CLI in-process; returns (exit status, stdout, stderr)."""
+    try:
+        status = cli.main(argv)
+    except SystemExit as exc:
+        status = exc.code
+    out = capsys.readouterr()
+    return status, out.out, out.err
+
+
+def _no_files(directory) -> list[str]:
+    return sorted(os.listdir(directory))
+
+
+def test_run_default_scenario_writes_valid_file(tmp_path, capsys, monkeypatch):
+    """`tqdyn run` with no scenario argument: the built-in tianqin scenario,
+    10 days at 50 s, written to the default file name in the working dir."""
+    monkeypatch.chdir(tmp_path)
+    status, out, err = _run(["run", "-q"], capsys)
+    assert status == 0, err
+    path = tmp_path / "tqdyn-run.h5"
+    assert path.exists()
+    assert "wall time" in out and "energy drift" in out and "Sat3" in out
+    tr = io.read_trajectory(path)
+    scen = load_scenario("tianqin")
+    assert tr.attrs["format"] == "tqdyn-trajectory" and tr.attrs["format_version"] == 1
+    assert tr.attrs["time_scale"] == "TDB" and tr.attrs["frame"] == "GCRS"
+    assert tr.attrs["precision"] == "dd" and tr.attrs["epoch_utc"] == "2004-06-06T00:00:00"
+    assert tr.attrs["step_s"] == 50.0
+    assert loads_scenario(tr.scenario_toml) == scen  # the resolved scenario is in the file
+    t_hi, t_lo = tr.dd("t")
+    n = scen.n_steps
+    assert t_hi.shape == (n + 1,) and t_hi[-1] + t_lo[-1] == float(scen.run.duration_s)
+    np.testing.assert_array_equal(np.diff(t_hi), 50.0)
+    r_hi, r_lo = tr.dd("sat/r")
+    assert r_hi.shape == (n + 1, 3, 3) and tr["sat/a_gravity"].shape == (n + 1, 3, 3)
+    # final positions vs the analytic two-body solution (the tianqin scenario
+    # has only the Earth monopole in this version)
+    got = mp_from_dd(np.stack([r_hi[-1], r_lo[-1]], axis=-1))
+    with mpmath.workdps(50):
+        for sat, row in zip(scen.satellites, got):
+            ref, _ = elements.kepler_state_at(sat.a_m, sat.e, elements.deg(sat.i_deg), elements.deg(sat.raan_deg),
+                                              elements.deg(sat.argp_deg), elements.deg(sat.nu_deg),
+                                              scen.forces.gm_earth, scen.run.duration_s)
+            err = float(mpmath.sqrt(sum((a - b) ** 2 for a, b in zip(row, ref))))
+            assert err < 1e-12, (sat.name, err)
+    # a_gravity: the monopole, |a| = GM / r^2 to float64 accuracy
+    a = tr["sat/a_gravity"][-1]
+    r = r_hi[-1] + r_lo[-1]
+    gm = float(scen.forces.gm_earth)
+    np.testing.assert_allclose(np.linalg.norm(a, axis=1), gm / np.linalg.norm(r, axis=1) ** 2, rtol=1e-14)
+
+
+def test_run_options_and_overrides(tmp_path, capsys):
+    out_file = tmp_path / "short.h5"
+    status, out, err = _run(["run", "tianqin-kepler", "--duration", "2h", "--step", "25", "--precision", "float64",
+                             "--set", "run.output_every=4", "-o", str(out_file), "-q"], capsys)
+    assert status == 0, err
+    tr = io.read_trajectory(out_file)
+    assert tr.attrs["precision"] == "float64" and tr.attrs["step_s"] == 25.0
+    t = tr["t"]
+    assert t[0] == 0.0 and t[-1] == 7200.0 and np.all(np.diff(t) == 100.0)
+    assert np.all(tr.dd("sat/r")[1] == 0.0)  # float64 run: lo parts are zero
+
+
+def test_adaptive_run(tmp_path, capsys):
+    out_file = tmp_path / "adaptive.h5"
+    status, out, err = _run(["run", "tianqin-kepler", "--duration", "1d", "--set", "integrator.mode=adaptive",
+                             "--set", "integrator.rtol=1e-16", "-o", str(out_file), "-q"], capsys)
+    assert status == 0, err
+    assert "rejected" in out
+    tr = io.read_trajectory(out_file)
+    np.testing.assert_array_equal(np.diff(tr["t"]), 50.0)  # sampled on the output grid
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["run", "no-such-scenario"], "no-such-scenario"),
+    (["run", "--set", "integrator.bogus=1"], "integrator.bogus"),
+    (["run", "--set", "nonsense"], "nonsense"),
+    (["run", "--step", "-50"], "-50"),
+    (["run", "--step", "0"], "step"),
+    (["run", "--duration", "1000", "--step", "300"], "1000"),
+    (["run", "--duration", "ten days"], "ten days"),
+    (["run", "--precision", "quad"], "quad"),
+    (["run", "--set", "satellites.7.e=0.1"], "satellites.7"),
+    (["run", "--set", "satellites.1.e=1.5"], "1.5"),
+    (["frobnicate"], "frobnicate"),
+])
+def test_bad_input_one_line_exit_2(tmp_path, capsys, monkeypatch, argv, needle):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = _run(argv, capsys)
+    assert status == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("tqdyn: error:"), err
+    assert needle in lines[0]
+    assert "Traceback" not in err
+    assert _no_files(tmp_path) == []
+
+
+def test_malformed_toml_and_missing_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[run\nduration = 5\n")
+    status, _, err = _run(["run", str(bad)], capsys)
+    assert status == 2 and "bad.toml" in err and len(err.strip().splitlines()) == 1
+    status, _, err = _run(["run", str(tmp_path / "missing.toml")], capsys)
+    assert status == 2 and "missing.toml" in err
+    assert _no_files(tmp_path) == ["bad.toml"]
+
+
+def test_unwritable_output(tmp_path, capsys):
+    target = tmp_path / "no" / "such" / "dir" / "x.h5"
+    status, _, err = _run(["run", "-o", str(target)], capsys)
+    assert status == 2 and str(target.parent) in err
+    status, _, err = _run(["run", "-o", str(tmp_path)], capsys)  # a directory
+    assert status == 2 and len(err.strip().splitlines()) == 1
+
+
+def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch):
+    """Ctrl-C during the propagation: exit 130, no output, no temporary file,
+    an existing output file untouched."""
+    out_file = tmp_path / "run.h5"
+    out_file.write_bytes(b"previous")
+    real = propagator.propagate
+
+    def interrupted(scen, sink=None, progress=None, **kw):
+        def sink_then_stop(rows):
+            sink(rows)
+            raise KeyboardInterrupt
+        return real(scen, sink=sink_then_stop, progress=progress, chunk=64, **kw)
+
+    monkeypatch.setattr(propagator, "propagate", interrupted)
+    status, _, err = _run(["run", "tianqin-kepler", "--duration", "1d", "-o", str(out_file), "-q"], capsys)
+    assert status == 130 and "interrupted" in err
+    assert _no_files(tmp_path) == ["run.h5"] and out_file.read_bytes() == b"previous"
+
+
+def test_info(capsys):
+    status, out, _ = _run(["info"], capsys)
+    assert status == 0
+    for needle in ("tqdyn", "numba", "tianqin-kepler", "earth_monopole", "RK8(7)13M", "corrected"):
+        assert needle in out
+
+
+def test_bench_short(capsys):
+    """The benchmark command runs (short span; the 90-day numbers are in the README)."""
+    status, out, err = _run(["bench", "--duration", "1h", "--no-heyoka"], capsys)
+    assert status == 0, err
+    assert "tqdyn dd" in out and "tqdyn float64" in out and "dd / float64" in out

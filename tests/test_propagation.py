@@ -1,0 +1,435 @@
+"""Accuracy of whole propagations (compiled DP87 in dd and float64 modes).
+
+References, per test:
+
+* the analytic two-body (Kepler) solution, :func:`tqdyn.elements.kepler_state_at`
+  evaluated in mpmath at 50 significant digits (Kepler's equation solved by
+  Newton to full working precision) -- for a point-mass Earth it is the exact
+  solution, so the difference is the total numerical error (method + rounding);
+* an independent, slow Prince-Dormand RK8(7)13M written below in mpmath at 50
+  digits (tableau strings read from ``_dp87_tableau``, no code from tqdyn's
+  integrator) with exactly the dd-rounded coefficients of the compiled run --
+  the difference is the arithmetic rounding of the compiled dd code alone;
+* first principles: the specific two-body energy v^2/2 - GM/|r| recomputed
+  in mpmath from the dd states.
+
+All errors are asserted in physical units (m) or as relative energy.  The
+measured values are printed (run with ``-s``).  GM = 3.986004415e14 m^3/s^2
+(EGM2008) throughout; the force model is the Earth monopole only.
+"""
+
+from __future__ import annotations
+
+from decimal import Decimal
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+from mpmath import mpf
+
+from tqdyn import elements as el
+from tqdyn import precision as P
+from tqdyn import propagator as prop
+from tqdyn import scenario as sc
+from tqdyn.integrators import _dp87_tableau as tab
+from tqdyn.integrators import dp87, hermite
+
+GM = "3.986004415e14"  # m^3/s^2
+DPS = 50  # mpmath digits of every reference computation
+DAY = 86400
+
+#: circular orbit, r = 1e8 m, non-trivial inclination and node
+CIRC = dict(name="Circ", a_km="100000", e="0", i_deg="37.3", raan_deg="123.4", argp_deg="0", nu_deg="17.5")
+#: e = 0.1, a = 1e8 m, all angles non-trivial
+ECC = dict(name="Ecc", a_km="100000", e="0.1", i_deg="62.1", raan_deg="301.7", argp_deg="48.2", nu_deg="133.9")
+
+
+# --------------------------------------------------------------------------
+# helpers
+
+
+def make_scenario(sat: dict, *, duration="10d", step="50", mode="fixed", rtol="1e-22", tableau="corrected",
+                  precision="dd") -> sc.Scenario:
+    sat_lines = "\n".join(f'{k} = "{v}"' if k == "name" else f"{k} = {v}" for k, v in sat.items())
+    text = f"""
+[scenario]
+name = "test-{sat['name']}"
+epoch_utc = "2004-06-06T00:00:00"
+
+[run]
+duration = "{duration}"
+precision = "{precision}"
+
+[integrator]
+method = "dp87"
+mode = "{mode}"
+step = {step}
+tableau = "{tableau}"
+rtol = {rtol}
+
+[forces]
+earth_monopole = true
+gm_earth = {GM}
+
+[[satellites]]
+{sat_lines}
+"""
+    scen = sc.loads_scenario(text)
+    assert scen.forces.gm_earth == Decimal(GM)
+    return scen
+
+
+def analytic(sat: sc.SatelliteConfig, t):
+    """Exact two-body state (mpf lists r [m], v [m/s]) of ``sat`` at t [s] (str/Decimal/mpf/int)."""
+    return el.kepler_state_at(sat.a_m, sat.e, el.deg(sat.i_deg), el.deg(sat.raan_deg), el.deg(sat.argp_deg),
+                              el.deg(sat.nu_deg), GM, t)
+
+
+def dist(x, y) -> mpf:
+    """Euclidean distance of two 3-vectors of mpf (exact inputs, DPS digits)."""
+    with mpmath.workdps(DPS):
+        return mpmath.sqrt(sum((mpf(a) - mpf(b)) ** 2 for a, b in zip(x, y)))
+
+
+def final_pos_error(result: prop.RunResult, scen: sc.Scenario, b: int = 0) -> float:
+    """|r_final - r_analytic| [m] of body b at result.t_final."""
+    t = el.from_dd(*result.t_final)
+    r_ref, _ = analytic(scen.satellites[b], t)
+    return float(dist(P.mp_from_dd(result.y_final[b, 0:3]), r_ref))
+
+
+class RowCollector:
+    """Sink that keeps the output rows and concatenates them (documented layout)."""
+
+    def __init__(self):
+        self.chunks = []
+
+    def __call__(self, rows):
+        m = rows["t"][0].shape[0]
+        n_sat = rows["sat/r"][0].shape[1]
+        for key in ("sat/r", "sat/v"):
+            for part in rows[key]:
+                assert part.shape == (m, n_sat, 3), (key, part.shape)
+        assert rows["sat/a_gravity"].shape == (m, n_sat, 3)
+        self.chunks.append(rows)
+
+    def arrays(self):
+        """t (N, 2) dd [s]; r, v (N, n_sat, 3, 2) dd [m, m/s]; a (N, n_sat, 3) float64 [m/s^2]."""
+        cat = lambda key, part: np.concatenate([c[key][part] for c in self.chunks])  # noqa: E731
+        t = P.join_dd(cat("t", 0), cat("t", 1))
+        r = P.join_dd(cat("sat/r", 0), cat("sat/r", 1))
+        v = P.join_dd(cat("sat/v", 0), cat("sat/v", 1))
+        a = np.concatenate([c["sat/a_gravity"] for c in self.chunks])
+        return t, r, v, a
+
+
+def rows_max_error(t, r, sat, b: int = 0) -> tuple[float, float]:
+    """Max over output rows of |r_row - r_analytic(t_row)| [m]; returns (max, t at max)."""
+    worst, t_worst = mpf(0), None
+    r_mp = P.mp_from_dd(r[:, b])
+    for k in range(t.shape[0]):
+        tk = el.from_dd(t[k, 0], t[k, 1])
+        ref, _ = analytic(sat, tk)
+        d = dist(r_mp[k], ref)
+        if d > worst:
+            worst, t_worst = d, tk
+    return float(worst), float(t_worst) if t_worst is not None else 0.0
+
+
+def energy(y_dd: np.ndarray) -> list:
+    """Specific energy v^2/2 - GM/|r| [J/kg] per body from dd states (n, 6, 2), in mpmath."""
+    vals = P.mp_from_dd(y_dd)
+    out = []
+    with mpmath.workdps(DPS):
+        for row in vals:
+            out.append(sum(x * x for x in row[3:6]) / 2 - mpf(GM) / mpmath.sqrt(sum(x * x for x in row[0:3])))
+    return out
+
+
+# --------------------------------------------------------------------------
+# runs shared by several tests (module scope: each is computed once)
+
+
+@pytest.fixture(scope="module")
+def circ10():
+    """Circular 1e8 m orbit, 10 days at 50 s, dd, with every output row."""
+    scen = make_scenario(CIRC)
+    sink = RowCollector()
+    res = prop.propagate(scen, precision="dd", sink=sink)
+    return scen, res, sink.arrays()
+
+
+@pytest.fixture(scope="module")
+def ecc10():
+    """e = 0.1, a = 1e8 m orbit, 10 days at 50 s, dd, with every output row."""
+    scen = make_scenario(ECC)
+    sink = RowCollector()
+    res = prop.propagate(scen, precision="dd", sink=sink)
+    return scen, res, sink.arrays()
+
+
+# --------------------------------------------------------------------------
+# 1. Kepler orbits in dd mode vs the analytic solution
+
+
+@pytest.mark.parametrize("which", ["circ", "ecc"])
+def test_kepler_10_days_dd_final_error(which, circ10, ecc10):
+    scen, res, _ = circ10 if which == "circ" else ecc10
+    assert res.n_steps == 17280 and res.precision == "dd"
+    assert el.from_dd(*res.t_final) == 10 * DAY
+    err = final_pos_error(res, scen)
+    print(f"\n[{which}] 10 d, h = 50 s, dd: |r - r_kepler| = {err:.3e} m  (wall {res.wall_s:.2f} s)")
+    assert err < 1e-12
+
+
+def test_kepler_circular_every_row_dd(circ10):
+    scen, res, (t, r, v, a) = circ10
+    assert t.shape[0] == 17281  # rows at n = 0..17280
+    assert np.array_equal(t[:, 0], 50.0 * np.arange(17281)) and not t[:, 1].any()
+    # the last row is the final state
+    assert np.array_equal(r[-1, 0], res.y_final[0, 0:3])
+    worst, t_worst = rows_max_error(t, r, scen.satellites[0])
+    print(f"\n[circ] max over all 17281 rows of |r - r_kepler| = {worst:.3e} m (at t = {t_worst:.0f} s)")
+    assert worst < 1e-12
+
+
+# --------------------------------------------------------------------------
+# 2. float64 mode of the same circular run
+
+
+def test_kepler_circular_float64_is_worse(circ10):
+    scen, res_dd, _ = circ10
+    res = prop.propagate(scen, precision="float64")
+    assert res.precision == "float64"
+    assert not res.y_final[..., 1].any()  # float64 states carry lo = 0
+    err64 = final_pos_error(res, scen)
+    err_dd = final_pos_error(res_dd, scen)
+    print(f"\n[circ] 10 d float64: |r - r_kepler| = {err64:.3e} m; dd: {err_dd:.3e} m; ratio {err64 / err_dd:.2e}"
+          f"  (float64 wall {res.wall_s:.2f} s)")
+    assert 1e-10 < err64 < 1e-3
+    assert err64 >= 1e6 * err_dd
+
+
+# --------------------------------------------------------------------------
+# 3. Rounding of the dd mode vs an independent mpmath DP87 with the same coefficients
+
+
+def _tableau_entry(text: str) -> mpf:
+    """Exact tableau string ("p/q", "0", "1" or a decimal) -> mpf at the working precision."""
+    if "/" in text:
+        f = Fraction(text)
+        return mpf(f.numerator) / f.denominator
+    return mpf(text)
+
+
+def _round_dd(x: mpf) -> tuple[float, float]:
+    """Nearest double-double of x: hi = nearest float64, lo = nearest float64 of x - hi."""
+    hi = float(x)  # mpmath rounds to nearest (context rounding 'n')
+    with mpmath.workdps(80):
+        lo = float(x - mpf(hi))
+    return hi, lo
+
+
+def mp_dp87(y0: list, h: str, n_steps: int, *, a_rows=tab.A_CORRECTED, b_row=tab.B_CORRECTED, coef=None):
+    """Independent RK8(7)13M in mpmath (DPS digits) for y' = (v, -GM r/|r|^3).
+
+    The stage matrix and weights enter as h*a_ij and h*b_j, each formed at 60
+    digits and rounded to dd exactly as the compiled code's coefficients (and,
+    if ``coef`` is given, checked to be bit-identical to them); the stages
+    are y + sum_j (h a_ij) k_j, the update y + sum_j (h b_j) k_j, all at DPS digits.
+    """
+    with mpmath.workdps(60):
+        hm = mpf(h)
+        ha = [[(j, _round_dd(_tableau_entry(x) * hm)) for j, x in enumerate(row) if x != "0"] for row in a_rows]
+        hb = [(j, _round_dd(_tableau_entry(x) * hm)) for j, x in enumerate(b_row) if x != "0"]
+    if coef is not None:  # the compiled run uses exactly these numbers
+        for i, row in enumerate(ha):
+            assert coef.nnz[i] == len(row)
+            for j, pair in row:
+                assert tuple(coef.ha[i, j]) == pair, (i, j)
+        assert [int(j) for j in coef.nzb] == [j for j, _ in hb]
+        for j, pair in hb:
+            assert tuple(coef.hb[j]) == pair, j
+    with mpmath.workdps(DPS):
+        ha = [[(j, mpf(p[0]) + mpf(p[1])) for j, p in row] for row in ha]
+        hb = [(j, mpf(p[0]) + mpf(p[1])) for j, p in hb]
+        gm = mpf(GM)
+
+        def f(y):
+            r2 = y[0] * y[0] + y[1] * y[1] + y[2] * y[2]
+            k = -gm / (r2 * mpmath.sqrt(r2))
+            return [y[3], y[4], y[5], k * y[0], k * y[1], k * y[2]]
+
+        y = [mpf(x) for x in y0]
+        for _ in range(n_steps):
+            K = [f(y)]
+            for i in range(1, 13):
+                K.append(f([y[q] + mpmath.fsum(c * K[j][q] for j, c in ha[i]) for q in range(6)]))
+            y = [y[q] + mpmath.fsum(c * K[j][q] for j, c in hb) for q in range(6)]
+        return y
+
+
+@pytest.fixture(scope="module")
+def circ1_both_tableaux():
+    out = {}
+    for name in ("corrected", "published"):
+        scen = make_scenario(CIRC, duration="1d", tableau=name)
+        out[name] = (scen, prop.propagate(scen, precision="dd"))
+    return out
+
+
+def test_dd_rounding_vs_mpmath_dp87(circ1_both_tableaux):
+    scen, res = circ1_both_tableaux["corrected"]
+    assert res.n_steps == 1728
+    coef = dp87.step_coefficients(dp87.load_tableau("corrected"), scen.integrator.step_s, "dd")
+    y0 = P.mp_from_dd(res.y0[0])  # the same dd-rounded initial state
+    y_mp = mp_dp87(list(y0), "50", 1728, coef=coef)
+    y_dd = P.mp_from_dd(res.y_final[0])
+    dr = float(dist(y_dd[0:3], y_mp[0:3]))
+    dv = float(dist(y_dd[3:6], y_mp[3:6]))
+    err_kepler = final_pos_error(res, scen)
+    print(f"\n[circ] 1 d, 1728 steps: |r_dd - r_mpDP87| = {dr:.3e} m, |v_dd - v_mpDP87| = {dv:.3e} m/s; "
+          f"|r_dd - r_kepler| = {err_kepler:.3e} m")
+    assert dr < 1e-21
+
+
+def test_published_tableau_method_error(circ1_both_tableaux):
+    scen_c, res_c = circ1_both_tableaux["corrected"]
+    scen_p, res_p = circ1_both_tableaux["published"]
+    diff = float(dist(P.mp_from_dd(res_c.y_final[0, 0:3]), P.mp_from_dd(res_p.y_final[0, 0:3])))
+    err_c = final_pos_error(res_c, scen_c)
+    err_p = final_pos_error(res_p, scen_p)
+    print(f"\n[circ] 1 d: |r_corrected - r_published| = {diff:.3e} m; vs Kepler: corrected {err_c:.3e} m, "
+          f"published {err_p:.3e} m")
+    assert diff > 1e-12
+    assert err_p > 1e-12 and err_c < 1e-12
+
+
+# --------------------------------------------------------------------------
+# 4. Energy conservation
+
+
+@pytest.mark.parametrize("which", ["circ", "ecc"])
+def test_energy_conserved_10_days(which, circ10, ecc10):
+    scen, res, _ = circ10 if which == "circ" else ecc10
+    e0, e1 = energy(res.y0)[0], energy(res.y_final)[0]
+    with mpmath.workdps(DPS):
+        drift = float((e1 - e0) / abs(e0))
+        # the initial state is the dd rounding of the exact elements: E = -GM / (2a)
+        e_exact = -mpf(GM) / (2 * mpf(scen.satellites[0].a_m))
+        init = float((e0 - e_exact) / abs(e_exact))
+    print(f"\n[{which}] 10 d energy: relative drift (mpmath) {drift:.3e}, RunResult {res.energy_rel_drift[0]:.3e}; "
+          f"initial-state rounding {init:.3e}")
+    assert res.energy_rel_drift is not None and res.energy_rel_drift.shape == (1,)
+    assert abs(drift) < 1e-28
+    assert abs(res.energy_rel_drift[0]) < 1e-28
+    assert abs(res.energy_rel_drift[0] - drift) <= 1e-6 * abs(drift) + 1e-40
+    assert abs(init) < 1e-30
+
+
+# --------------------------------------------------------------------------
+# 5. Adaptive mode
+
+
+def _adaptive_check(rtol: str, out_step: str = "600"):
+    scen = make_scenario(ECC, mode="adaptive", rtol=rtol, step=out_step)
+    sink = RowCollector()
+    res = prop.propagate(scen, precision="dd", sink=sink)
+    sat = scen.satellites[0]
+    t, r, v, a = sink.arrays()
+    err = final_pos_error(res, scen)
+    bound = res.n_steps * float(rtol) * float(sat.a_m * (1 + sat.e))
+    rows_err, t_worst = rows_max_error(t, r, sat)
+    print(f"\n[ecc adaptive rtol={rtol}] steps {res.n_steps}, rejected {res.n_rejected}, rhs {res.n_rhs}, "
+          f"wall {res.wall_s:.2f} s: final |r - r_kepler| = {err:.3e} m, rows max {rows_err:.3e} m "
+          f"(t = {t_worst:.0f} s), bound n_steps*rtol*a(1+e) = {bound:.3e} m, energy drift {res.energy_rel_drift[0]:.2e}")
+    assert res.mode == "adaptive"
+    assert el.from_dd(*res.t_final) == 10 * DAY
+    assert res.n_steps > 1
+    assert res.n_rejected >= 0
+    # every tried step costs 13 evaluations, every accepted one one more (a at its end)
+    assert res.n_rhs == 13 * (res.n_steps + res.n_rejected) + res.n_steps
+    n_out = 10 * DAY // int(out_step)
+    assert t.shape[0] == n_out + 1
+    assert np.array_equal(t[:, 0], float(out_step) * np.arange(n_out + 1)) and not t[:, 1].any()
+    assert np.array_equal(r[-1, 0], res.y_final[0, 0:3])
+    assert err <= bound
+    assert rows_err <= bound
+    return res, err
+
+
+def test_adaptive_meets_tolerance():
+    res14, err14 = _adaptive_check("1e-14")
+    res18, err18 = _adaptive_check("1e-18")
+    assert err18 < err14
+    assert res18.n_steps > res14.n_steps
+
+
+@pytest.mark.slow
+def test_adaptive_tight_tolerance_slow():
+    res, err = _adaptive_check("1e-22")
+    assert res.n_rejected > 0
+    assert err < 1e-12
+
+
+# --------------------------------------------------------------------------
+# 6. Dense output (Hermite) vs direct propagation and vs Kepler
+
+#: node indices (50 s grid) and offsets [s] after the node of the query instants
+QUERY_NODES = (1, 347, 864, 1291, 1726)
+QUERY_OFFSETS = ("17.3", "25", "41.9")
+
+
+@pytest.mark.parametrize("which", ["circ", "ecc"])
+def test_dense_output_vs_direct_and_kepler(which, circ10, ecc10):
+    scen, _, (t, r, v, a) = circ10 if which == "circ" else ecc10
+    sat = scen.satellites[0]
+    n_day = 1729  # the first day of the run: nodes 0..1728
+    t, r, v, a = t[:n_day], r[:n_day], v[:n_day], a[:n_day]
+    queries = [(k, off) for k in QUERY_NODES for off in QUERY_OFFSETS]
+    t_exact = [Decimal(50 * k) + Decimal(off) for k, off in queries]
+    t_query = np.array([P.dd_from_mp(x) for x in t_exact])
+    interp = {m: hermite.interpolate_states(t, r, v, a, t_query, n_nodes=m) for m in (2, 4)}
+    worst = {(m, ref): 0.0 for m in (2, 4) for ref in ("direct", "kepler")}
+    worst_v = {m: 0.0 for m in (2, 4)}
+    worst_direct_kepler = 0.0
+    for q, ((k, off), tq) in enumerate(zip(queries, t_exact)):
+        # direct: one compiled DP87 step of length `off` from the stored node state
+        direct_scen = make_scenario(CIRC if which == "circ" else ECC, duration=off, step=off)
+        y0 = np.concatenate([r[k], v[k]], axis=1)  # (1, 6, 2)
+        res = prop.propagate(direct_scen, precision="dd", y0=y0)
+        assert res.n_steps == 1
+        r_dir = P.mp_from_dd(res.y_final[0, 0:3])
+        v_dir = P.mp_from_dd(res.y_final[0, 3:6])
+        r_kep, _ = analytic(sat, tq)
+        worst_direct_kepler = max(worst_direct_kepler, float(dist(r_dir, r_kep)))
+        for m in (2, 4):
+            r_i = P.mp_from_dd(interp[m][0][q, 0])
+            v_i = P.mp_from_dd(interp[m][1][q, 0])
+            worst[m, "direct"] = max(worst[m, "direct"], float(dist(r_i, r_dir)))
+            worst[m, "kepler"] = max(worst[m, "kepler"], float(dist(r_i, r_kep)))
+            worst_v[m] = max(worst_v[m], float(dist(v_i, v_dir)))
+    print(f"\n[{which}] dense output, {len(queries)} instants in day 1: "
+          f"quintic (2 nodes): max |r - r_direct| = {worst[2, 'direct']:.3e} m, vs Kepler {worst[2, 'kepler']:.3e} m, "
+          f"|v - v_direct| = {worst_v[2]:.3e} m/s; "
+          f"4 nodes: max |r - r_direct| = {worst[4, 'direct']:.3e} m, vs Kepler {worst[4, 'kepler']:.3e} m, "
+          f"|v - v_direct| = {worst_v[4]:.3e} m/s; direct vs Kepler {worst_direct_kepler:.3e} m")
+    for key, val in worst.items():
+        assert val < 1e-13, key
+    assert worst[4, "direct"] < worst[2, "direct"]
+
+
+# --------------------------------------------------------------------------
+# 7. The three TianQin satellites
+
+
+def test_tianqin_kepler_three_satellites_1_day():
+    scen = sc.load_scenario("tianqin-kepler", ["run.duration=1d"])
+    assert scen.forces.gm_earth == Decimal(GM) and len(scen.satellites) == 3
+    res = prop.propagate(scen, precision="dd")
+    assert res.y_final.shape == (3, 6, 2) and res.n_steps == 1728
+    errs = [final_pos_error(res, scen, b) for b in range(3)]
+    print("\n[tianqin-kepler] 1 d, dd: |r - r_kepler| = " + ", ".join(
+        f"{s.name} {e:.3e} m" for s, e in zip(scen.satellites, errs)) + f"; energy drift {res.energy_rel_drift}")
+    assert max(errs) < 1e-12
