@@ -32,6 +32,7 @@ from tqdyn import elements as el
 from tqdyn import precision as P
 from tqdyn import propagator as prop
 from tqdyn import scenario as sc
+from tqdyn.forces.model import build_force_model
 from tqdyn.integrators import _dp87_tableau as tab
 from tqdyn.integrators import dp87, hermite
 
@@ -174,8 +175,8 @@ def ecc10():
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_kepler_10_days_dd_final_error(which, circ10, ecc10):
-    scen, res, _ = circ10 if which == "circ" else ecc10
+def test_kepler_10_days_dd_final_error(which, request):
+    scen, res, _ = request.getfixturevalue(which + "10")
     assert res.n_steps == 17280 and res.precision == "dd"
     assert el.from_dd(*res.t_final) == 10 * DAY
     err = final_pos_error(res, scen)
@@ -200,9 +201,13 @@ def test_kepler_circular_every_row_dd(circ10):
 
 def test_kepler_circular_float64_is_worse(circ10):
     scen, res_dd, _ = circ10
-    res = prop.propagate(scen, precision="float64")
+    sink = RowCollector()
+    res = prop.propagate(scen, precision="float64", sink=sink)
     assert res.precision == "float64"
     assert not res.y_final[..., 1].any()  # float64 states carry lo = 0
+    t, r, v, a = sink.arrays()
+    assert t.shape[0] == 17281 and not r[..., 1].any() and not v[..., 1].any()
+    assert np.array_equal(r[-1, 0], res.y_final[0, 0:3])
     err64 = final_pos_error(res, scen)
     err_dd = final_pos_error(res_dd, scen)
     print(f"\n[circ] 10 d float64: |r - r_kepler| = {err64:.3e} m; dd: {err_dd:.3e} m; ratio {err64 / err_dd:.2e}"
@@ -311,8 +316,8 @@ def test_published_tableau_method_error(circ1_both_tableaux):
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_energy_conserved_10_days(which, circ10, ecc10):
-    scen, res, _ = circ10 if which == "circ" else ecc10
+def test_energy_conserved_10_days(which, request):
+    scen, res, _ = request.getfixturevalue(which + "10")
     e0, e1 = energy(res.y0)[0], energy(res.y_final)[0]
     with mpmath.workdps(DPS):
         drift = float((e1 - e0) / abs(e0))
@@ -382,17 +387,30 @@ QUERY_OFFSETS = ("17.3", "25", "41.9")
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_dense_output_vs_direct_and_kepler(which, circ10, ecc10):
-    scen, _, (t, r, v, a) = circ10 if which == "circ" else ecc10
+def test_dense_output_vs_direct_and_kepler(which, request):
+    """Hermite dense output from the stored rows (t, r, v in dd; a_gravity in
+    float64) at instants between the 50 s nodes, vs a direct compiled DP87
+    step of the same length from the stored node state and vs Kepler.
+
+    The stored acceleration is float64: h^2 a / 2 ~ 50 m carries ~4e-15 m of
+    float64 rounding, which floors the degree-11 (4-node) interpolant at
+    ~1e-16 m.  With dd accelerations (recomputed here from the stored dd
+    states) the 4-node interpolant reaches the dd propagation's own error."""
+    scen, _, (t, r, v, a) = request.getfixturevalue(which + "10")
     sat = scen.satellites[0]
     n_day = 1729  # the first day of the run: nodes 0..1728
     t, r, v, a = t[:n_day], r[:n_day], v[:n_day], a[:n_day]
+    model = build_force_model(scen.forces)
+    a_dd = np.stack([prop.evaluate_rhs(np.concatenate([r[k], v[k]], axis=1), np.zeros(0), model)[:, 3:6]
+                     for k in range(n_day)])
+    assert np.array_equal(a_dd[..., 0], a)  # the stored float64 acceleration is its hi part
     queries = [(k, off) for k in QUERY_NODES for off in QUERY_OFFSETS]
     t_exact = [Decimal(50 * k) + Decimal(off) for k, off in queries]
     t_query = np.array([P.dd_from_mp(x) for x in t_exact])
-    interp = {m: hermite.interpolate_states(t, r, v, a, t_query, n_nodes=m) for m in (2, 4)}
-    worst = {(m, ref): 0.0 for m in (2, 4) for ref in ("direct", "kepler")}
-    worst_v = {m: 0.0 for m in (2, 4)}
+    variants = {(m, acc): hermite.interpolate_states(t, r, v, aa, t_query, n_nodes=m)
+                for m in (2, 4) for acc, aa in (("a64", a), ("add", a_dd))}
+    worst = {(key, ref): 0.0 for key in variants for ref in ("direct", "kepler")}
+    worst_v = {key: 0.0 for key in variants}
     worst_direct_kepler = 0.0
     for q, ((k, off), tq) in enumerate(zip(queries, t_exact)):
         # direct: one compiled DP87 step of length `off` from the stored node state
@@ -404,20 +422,23 @@ def test_dense_output_vs_direct_and_kepler(which, circ10, ecc10):
         v_dir = P.mp_from_dd(res.y_final[0, 3:6])
         r_kep, _ = analytic(sat, tq)
         worst_direct_kepler = max(worst_direct_kepler, float(dist(r_dir, r_kep)))
-        for m in (2, 4):
-            r_i = P.mp_from_dd(interp[m][0][q, 0])
-            v_i = P.mp_from_dd(interp[m][1][q, 0])
-            worst[m, "direct"] = max(worst[m, "direct"], float(dist(r_i, r_dir)))
-            worst[m, "kepler"] = max(worst[m, "kepler"], float(dist(r_i, r_kep)))
-            worst_v[m] = max(worst_v[m], float(dist(v_i, v_dir)))
-    print(f"\n[{which}] dense output, {len(queries)} instants in day 1: "
-          f"quintic (2 nodes): max |r - r_direct| = {worst[2, 'direct']:.3e} m, vs Kepler {worst[2, 'kepler']:.3e} m, "
-          f"|v - v_direct| = {worst_v[2]:.3e} m/s; "
-          f"4 nodes: max |r - r_direct| = {worst[4, 'direct']:.3e} m, vs Kepler {worst[4, 'kepler']:.3e} m, "
-          f"|v - v_direct| = {worst_v[4]:.3e} m/s; direct vs Kepler {worst_direct_kepler:.3e} m")
+        for key, (r_q, v_q) in variants.items():
+            r_i = P.mp_from_dd(r_q[q, 0])
+            worst[key, "direct"] = max(worst[key, "direct"], float(dist(r_i, r_dir)))
+            worst[key, "kepler"] = max(worst[key, "kepler"], float(dist(r_i, r_kep)))
+            worst_v[key] = max(worst_v[key], float(dist(P.mp_from_dd(v_q[q, 0]), v_dir)))
+    print(f"\n[{which}] dense output, {len(queries)} instants in day 1; direct step vs Kepler "
+          f"{worst_direct_kepler:.3e} m")
+    for key in variants:
+        print(f"   {key[0]} nodes, {'float64' if key[1] == 'a64' else 'dd'} a: max |r - r_direct| = "
+              f"{worst[key, 'direct']:.3e} m, |r - r_kepler| = {worst[key, 'kepler']:.3e} m, "
+              f"|v - v_direct| = {worst_v[key]:.3e} m/s")
+    assert worst_direct_kepler < 1e-20
     for key, val in worst.items():
         assert val < 1e-13, key
-    assert worst[4, "direct"] < worst[2, "direct"]
+    # the 4-node interpolant is the more accurate one; with dd accelerations by far
+    assert worst[(4, "a64"), "direct"] < worst[(2, "a64"), "direct"] / 5
+    assert worst[(4, "add"), "direct"] < 1e-20 and worst[(4, "add"), "kepler"] < 1e-20
 
 
 # --------------------------------------------------------------------------

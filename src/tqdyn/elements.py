@@ -25,7 +25,9 @@ from numbers import Integral
 import mpmath
 import numpy as np
 from mpmath import mp, mpf
-from mpmath.libmp import round_nearest, to_float
+
+from .precision import dd_from_mp as to_dd
+from .precision import mp_from_pair as from_dd
 
 __all__ = [
     "deg",
@@ -261,32 +263,6 @@ def kepler_state_at(a, e, i, raan, argp, nu0, gm, t) -> tuple[list[mpf], list[mp
         ecc = _solve_kepler(m, e)
         nu = 2 * mp.atan2(mp.sqrt(1 + e) * mp.sin(ecc / 2), mp.sqrt(1 - e) * mp.cos(ecc / 2))
         return _state(a, e, i, raan, argp, nu, gm)
-
-
-def _round53(x: mpf) -> float:
-    """Nearest float64 of an mpf (round half to even)."""
-    return to_float(x._mpf_, rnd=round_nearest)
-
-
-def to_dd(x) -> tuple[float, float]:
-    """mpf (or int/str/Decimal) -> double-double ``(hi, lo)`` of float64.
-
-    ``hi`` is the nearest double to ``x``; ``lo`` is the nearest double to
-    the exact difference ``x - hi``; hence ``|hi + lo - x| <= 2**-106 |x|``
-    (normal range) and ``|lo| <= ulp(hi) / 2``.
-    """
-    with mp.workdps(_dps()):
-        x = _mp(x, "x")
-        hi = _round53(x)
-        # exact difference x - hi (no rounding)
-        diff = mpmath.fsub(x, mpf(hi), exact=True)
-        lo = _round53(diff)
-        return hi, lo
-
-
-def from_dd(hi, lo) -> mpf:
-    """Double-double ``(hi, lo)`` -> mpf ``hi + lo``, exactly (no rounding)."""
-    return mpmath.fadd(mpf(float(hi)), mpf(float(lo)), exact=True)
 
 
 def state_to_dd(r, v) -> np.ndarray:

@@ -39,6 +39,7 @@ import h5py
 import numpy as np
 
 from . import __version__ as _TQDYN_VERSION
+from .precision import np_two_sum
 
 __all__ = [
     "FORMAT",
@@ -689,13 +690,6 @@ def _native_attr(value):
     return value
 
 
-def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    s = a + b
-    bb = s - a
-    err = (a - (s - bb)) + (b - bb)
-    return s, err
-
-
 class Trajectory:
     """A trajectory file read fully into memory (numpy arrays, file closed).
 
@@ -795,7 +789,7 @@ class Trajectory:
         coords: dict[str, Any] = {}
         variables: dict[str, Any] = {}
         if "t" in self._data:
-            t, t_lo = _two_sum(*self._data["t"])
+            t, t_lo = np_two_sum(*self._data["t"])
             spec = FIELDS["t"]
             coords["time"] = ("time", t, {"units": "s", "frame": spec.frame,
                                           "description": spec.description + " (float64 hi + lo)"})
@@ -812,7 +806,7 @@ class Trajectory:
             attrs = {"units": spec.unit, "frame": spec.frame, "description": spec.description}
             arrays = self._data[f]
             if len(arrays) == 2:
-                val, res = _two_sum(*arrays)
+                val, res = np_two_sum(*arrays)
                 variables[name] = (dims, val, dict(attrs, description=attrs["description"] + " (float64 hi + lo)"))
                 variables[name + "_lo"] = (dims, res, dict(
                     attrs, description=f"residual of {name}: exact value = {name} + {name}_lo"))

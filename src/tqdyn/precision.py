@@ -50,7 +50,8 @@ __all__ = [
     "add", "add_acc", "sub", "mul", "div", "sqrt", "neg", "fma_", "to_f64",
     "ld", "st", "const",
     "two_sum", "two_prod", "fast_two_sum",
-    "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "split_dd", "join_dd",
+    "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "mp_from_pair", "split_dd", "join_dd",
+    "np_two_sum", "np_two_prod", "mp_exact",
     "is_dd_array",
 ]
 
@@ -364,20 +365,63 @@ def is_dd_array(arr: np.ndarray, ndim_value: int) -> bool:
     return arr.ndim == ndim_value + 1 and arr.shape[-1] == 2
 
 
-def dd_from_mp(x) -> tuple[float, float]:
-    """Round an exact number (mpmath mpf, Fraction, int, str, Decimal) to dd.
-
-    Returns (hi, lo): hi = nearest float64 of x, lo = nearest float64 of
-    x - hi; |x - (hi + lo)| <= 2**-106 |x| (relative).
-    """
+def mp_exact(x):
+    """An exact number (mpf, Fraction, int, float, str, Decimal) as mpf at
+    the current working precision (decimal strings converted by mpmath)."""
     import mpmath
 
+    if isinstance(x, Fraction):
+        return mpmath.mpf(x.numerator) / x.denominator
+    if isinstance(x, (mpmath.mpf, int, float)):
+        return mpmath.mpf(x)
+    return mpmath.mpf(str(x))
+
+
+def dd_from_mp(x) -> tuple[float, float]:
+    """Round an exact number (mpmath mpf, Fraction, int, float, str, Decimal) to dd.
+
+    Returns (hi, lo): hi = nearest float64 of x (ties to even), lo = nearest
+    float64 of the exact difference x - hi; so |x - (hi + lo)| <= 2**-106 |x|
+    (normal range) and |lo| <= ulp(hi)/2.  Decimal strings are converted at
+    60 digits first (exact enough for any dd).
+    """
+    import mpmath
+    from mpmath.libmp import round_nearest, to_float
+
     with mpmath.workdps(60):
-        v = mpmath.mpf(str(x)) if not isinstance(x, (mpmath.mpf, int, Fraction)) else (
-            mpmath.mpf(x.numerator) / x.denominator if isinstance(x, Fraction) else mpmath.mpf(x))
-        hi = float(v)
-        lo = float(v - hi)
+        v = mp_exact(x)
+        hi = to_float(v._mpf_, rnd=round_nearest)
+        lo = to_float(mpmath.fsub(v, mpmath.mpf(hi), exact=True)._mpf_, rnd=round_nearest)
     return hi, lo
+
+
+def mp_from_pair(hi: float, lo: float):
+    """dd pair -> mpmath mpf hi + lo, exactly (no rounding)."""
+    import mpmath
+
+    return mpmath.fadd(mpmath.mpf(float(hi)), mpmath.mpf(float(lo)), exact=True)
+
+
+def np_two_sum(a, b):
+    """Vectorised error-free sum (numpy): a + b = s + e exactly, elementwise."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+def np_two_prod(a, b):
+    """Vectorised error-free product (numpy, Veltkamp-Dekker splitting, no
+    FMA needed): a * b = p + e exactly, elementwise, barring overflow."""
+
+    def split(x):
+        c = 134217729.0 * x  # 2**27 + 1
+        hi = c - (c - x)
+        return hi, x - hi
+
+    p = a * b
+    ah, al = split(a)
+    bh, bl = split(b)
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
 def dd_array_from_mp(values, shape=None) -> np.ndarray:
@@ -390,13 +434,10 @@ def dd_array_from_mp(values, shape=None) -> np.ndarray:
 
 def mp_from_dd(arr: np.ndarray):
     """dd array (trailing axis 2) -> numpy object array of exact mpmath values hi + lo."""
-    import mpmath
-
     arr = np.asarray(arr, dtype=np.float64)
     out = np.empty(arr.shape[:-1], dtype=object)
-    with mpmath.workdps(60):
-        for idx in np.ndindex(out.shape):
-            out[idx] = mpmath.mpf(arr[idx + (0,)]) + mpmath.mpf(arr[idx + (1,)])
+    for idx in np.ndindex(out.shape):
+        out[idx] = mp_from_pair(arr[idx + (0,)], arr[idx + (1,)])
     return out
 
 

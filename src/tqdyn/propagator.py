@@ -213,7 +213,7 @@ def _check_precision(precision):
 
 def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping], None] | None = None,
               progress: Callable[[int], None] | None = None, chunk: int = _DEFAULT_CHUNK,
-              y0: np.ndarray | None = None) -> RunResult:
+              y0: np.ndarray | None = None, model: ForceModel | None = None) -> RunResult:
     """Propagate the scenario's satellites over ``scenario.run.duration_s``.
 
     precision: "dd" | "float64" (default: the scenario's run.precision).
@@ -225,10 +225,11 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
     progress(n): called with the number of steps just completed (fixed) or
     the seconds of propagation time just covered (adaptive).
     y0: optional initial dd states (n_sat, 6, 2) instead of the scenario's elements.
+    model: optional force model instead of the one built from scenario.forces.
     """
     precision = precision or scenario.run.precision
     _check_precision(precision)
-    model = build_force_model(scenario.forces)
+    model = build_force_model(scenario.forces) if model is None else model
     epoch = Epoch.from_utc(scenario.epoch_utc)
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario) if y0 is None else np.asarray(y0, np.float64)
@@ -236,23 +237,26 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
         result = _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress)
     else:
         result = _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk)
-    if model.describe() and [t[0] for t in model.describe()] == ["earth_monopole"]:
-        e0 = two_body_energy(result.y0, scenario.forces.gm_earth)
-        e1 = two_body_energy(result.y_final, scenario.forces.gm_earth)
+    if [t.name for t in model.terms] == ["earth_monopole"]:
+        e0 = two_body_energy(result.y0, model.terms[0].gm)
+        e1 = two_body_energy(result.y_final, model.terms[0].gm)
         with mpmath.workdps(60):
             result.energy_rel_drift = np.array([float((b - a) / abs(a)) for a, b in zip(e0, e1)])
     return result
+
+
+def _workspace(y0_dd, precision):
+    """State y (a copy of y0 in the working precision), its compensation,
+    the 13 stage derivatives, a stage state and the error estimate."""
+    y = _as_precision(y0_dd, precision)
+    return y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros(y.shape[:2])
 
 
 def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
     n_total = scenario.n_steps
     every = scenario.run.output_every
-    y = _as_precision(y0_dd, precision)
-    comp = np.zeros_like(y)
-    K = np.zeros((13,) + y.shape)
-    ystage = np.zeros_like(y)
-    err = np.zeros(y.shape[:2])
+    y, comp, K, ystage, err = _workspace(y0_dd, precision)
     h = np.array(coef.h)
     nb = y.shape[0]
     acc_shape = (nb, 3) + y.shape[2:]
@@ -329,11 +333,7 @@ def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, pro
     dt_out = Fraction(scenario.integrator.step_s)
     unit = dp87.step_coefficients(tab, 1, precision)  # h = 1: the bare tableau
     c_nodes = [Fraction(x) for x in unit.c]
-    y = _as_precision(y0_dd, precision)
-    comp = np.zeros_like(y)
-    K = np.zeros((13,) + y.shape)
-    ystage = np.zeros_like(y)
-    err = np.zeros(y.shape[:2])
+    y, comp, K, ystage, err = _workspace(y0_dd, precision)
     ha = np.zeros_like(unit.ha)
     hb = np.zeros_like(unit.hb)
     z = np.array([0.0, 1.0])

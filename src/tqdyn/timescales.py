@@ -35,6 +35,7 @@ import erfa
 import numpy as np
 
 from .constants import DAY_S
+from .precision import np_two_prod, np_two_sum
 
 __all__ = ["Epoch", "UTCFields", "parse_utc", "tdb_jd"]
 
@@ -174,25 +175,6 @@ class Epoch:
         return cls(f.iso, as_pair(utc), as_pair(tai), as_pair(tt), as_pair(tdb))
 
 
-def _two_sum(a, b):
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
-
-
-def _split(a):
-    c = 134217729.0 * a  # 2**27 + 1 (Veltkamp)
-    hi = c - (c - a)
-    return hi, a - hi
-
-
-def _two_prod(a, b):
-    p = a * b
-    ah, al = _split(a)
-    bh, bl = _split(b)
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
-
-
 def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
     """Two-part TDB Julian date of ``t = t_hi + t_lo`` seconds of TDB after ``epoch``.
 
@@ -222,10 +204,10 @@ def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
     t_hi, t_lo = np.broadcast_arrays(t_hi, t_lo)
     day = float(DAY_S)
     q_hi = t_hi / day
-    p, pe = _two_prod(q_hi, day)  # p + pe == q_hi * 86400 exactly
+    p, pe = np_two_prod(q_hi, day)  # p + pe == q_hi * 86400 exactly
     rem = ((t_hi - p) - pe) + t_lo  # t_hi - p is exact (Sterbenz)
     q_lo = rem / day
-    s, se = _two_sum(np.float64(epoch.tdb[1]), q_hi)
+    s, se = np_two_sum(np.float64(epoch.tdb[1]), q_hi)
     jd2 = s + (se + q_lo)
     jd1 = np.full(jd2.shape, epoch.tdb[0], dtype=np.float64)
     return jd1, np.asarray(jd2, dtype=np.float64)

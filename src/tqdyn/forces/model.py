@@ -23,15 +23,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..precision import add, const, mul
+from ..precision import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
+from .third_body import ThirdBodies, third_body_accel
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
-SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE}
-_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE}
+SLOT_THIRD_BODY = 1
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY}
+_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY}
 
 
 class ForceModel:
@@ -106,4 +108,14 @@ def gravity(x, y, z, tdat, params, layout):
         o = layout[SLOT_EARTH_MONOPOLE, 1]
         gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
         ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    return ax, ay, az
+    # perturbations: float64 at the float64-rounded position (error ~1e-16 relative)
+    rx, ry, rz = to_f64(x), to_f64(y), to_f64(z)
+    px, py, pz = 0.0, 0.0, 0.0
+    if layout[SLOT_THIRD_BODY, 0]:
+        o = layout[SLOT_THIRD_BODY, 1]
+        c = layout[SLOT_THIRD_BODY, 2]
+        for k in range(int(params[o])):
+            gx, gy, gz = third_body_accel(rx, ry, rz, tdat[c + 3 * k], tdat[c + 3 * k + 1], tdat[c + 3 * k + 2],
+                                          params[o + 1 + k])
+            px, py, pz = px + gx, py + gy, pz + gz
+    return add(ax, px), add(ay, py), add(az, pz)

@@ -33,7 +33,7 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
-from ..precision import add, add_acc, dd_from_mp, ld, mul, st, sub, to_f64
+from ..precision import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
 
 __all__ = [
@@ -56,15 +56,6 @@ def _exact(text: str):
 
     with mpmath.workdps(60):
         return mpmath.mpf(text)
-
-
-def _mp(x):
-    """Exact tableau entry (Fraction or mpf) -> mpf at the working precision."""
-    import mpmath
-
-    if isinstance(x, Fraction):
-        return mpmath.mpf(x.numerator) / x.denominator
-    return mpmath.mpf(x)
 
 
 @dataclass(frozen=True)
@@ -132,20 +123,20 @@ def step_coefficients(tab: Tableau, h, precision: str) -> StepCoefficients:
     import mpmath
 
     with mpmath.workdps(60):
-        hm = mpmath.mpf(h) if isinstance(h, float) else mpmath.mpf(str(h))
+        hm = mp_exact(h)
         ha = np.zeros((_N, _N, 2))
         nz = np.zeros((_N, _N), dtype=np.int64)
         nnz = np.zeros(_N, dtype=np.int64)
         for i in range(_N):
             for j in range(i):
                 if tab.a[i][j] != 0:
-                    ha[i, j] = dd_from_mp(_mp(tab.a[i][j]) * hm)
+                    ha[i, j] = dd_from_mp(mp_exact(tab.a[i][j]) * hm)
                     nz[i, nnz[i]] = j
                     nnz[i] += 1
-        hb = np.array([dd_from_mp(_mp(x) * hm) for x in tab.b])
-        he = np.array([float((_mp(x) - _mp(y)) * hm) for x, y in zip(tab.b, tab.bhat)])
+        hb = np.array([dd_from_mp(mp_exact(x) * hm) for x in tab.b])
+        he = np.array([float((mp_exact(x) - mp_exact(y)) * hm) for x, y in zip(tab.b, tab.bhat)])
         nzb = np.array([j for j in range(_N) if tab.b[j] != 0], dtype=np.int64)
-        c = np.array([float(_mp(x)) for x in tab.c])
+        c = np.array([float(mp_exact(x)) for x in tab.c])
         h_pair = dd_from_mp(hm)
     if precision != "dd":
         ha, hb = ha[..., 0] + ha[..., 1], hb[..., 0] + hb[..., 1]
