@@ -259,10 +259,9 @@ def _nearest_fraction(x: mpf) -> Fraction:
 
 def test_dd_array_round_trip_exact_and_split_join():
     rng = np.random.default_rng(9)
-    # |lo| / |hi| from 2**-53 down to 2**-140.  (dd_from_mp first rounds its
-    # input to 60 digits = 203 bits, so a valid dd whose lo lies more than
-    # ~150 bits below hi does not survive dd -> mp -> dd bit for bit.)
-    d = random_dd(rng, 300, -20, 20, 53, 140).reshape(100, 3, 2)
+    # |lo| / |hi| from 2**-53 down to 2**-500: mpf inputs are converted at
+    # their own precision, so every valid dd survives dd -> mp -> dd bit for bit.
+    d = random_dd(rng, 300, -20, 20, 53, 500).reshape(100, 3, 2)
     assert is_normalized(d).all()
     vals = P.mp_from_dd(d)
     assert vals.shape == (100, 3) and vals.dtype == object

@@ -15,7 +15,7 @@ from .precision import ld, st
 __all__ = ["system_rhs"]
 
 
-@njit(cache=False)
+@njit(cache=True)
 def system_rhs(y, tdat, params, layout, k):
     """dy/dt for every body: k[b, 0:3] = v_b, k[b, 3:6] = a(r_b).
 

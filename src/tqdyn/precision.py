@@ -44,6 +44,8 @@ from fractions import Fraction
 
 import numpy as np
 from numba import njit, types
+
+from . import _jit  # noqa: F401  (registers the package-wide kernel cache before any @njit)
 from numba.extending import intrinsic, overload
 
 __all__ = [
@@ -370,9 +372,11 @@ def mp_exact(x):
     the current working precision (decimal strings converted by mpmath)."""
     import mpmath
 
+    if isinstance(x, mpmath.mpf):
+        return x  # as is: no rounding to the working precision
     if isinstance(x, Fraction):
         return mpmath.mpf(x.numerator) / x.denominator
-    if isinstance(x, (mpmath.mpf, int, float)):
+    if isinstance(x, (int, float)):
         return mpmath.mpf(x)
     return mpmath.mpf(str(x))
 
@@ -382,8 +386,9 @@ def dd_from_mp(x) -> tuple[float, float]:
 
     Returns (hi, lo): hi = nearest float64 of x (ties to even), lo = nearest
     float64 of the exact difference x - hi; so |x - (hi + lo)| <= 2**-106 |x|
-    (normal range) and |lo| <= ulp(hi)/2.  Decimal strings are converted at
-    60 digits first (exact enough for any dd).
+    (normal range) and |lo| <= ulp(hi)/2.  mpf inputs are used exactly at
+    their own precision; Fractions, decimal strings and Decimals are
+    converted at 60 digits first (exact enough for any dd).
     """
     import mpmath
     from mpmath.libmp import round_nearest, to_float

@@ -73,7 +73,7 @@ def _to_dd(y: np.ndarray, ndim_value: int) -> np.ndarray:
 # compiled loops
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout):
     """One DP87 step in place: the 13 stages (K[0] = f(y) first), then the
     compensated update of y.  tdat_step: (13, n_tdat) time-only inputs at
@@ -85,7 +85,7 @@ def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step
     dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                  n_steps, out_y, out_a):
     """n_steps fixed DP87 steps.  Before step n it records the state y_n in
@@ -97,7 +97,7 @@ def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, 
         out_a[n] = K[0][:, 3:6]
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _grid_times(n0, m, h, c, t_out, t_nodes):
     """t_out[k] = (n0 + k) h (dd, exact for the usual decimal steps) and, if
     t_nodes has rows, the stage times t_nodes[k, i] = t_out[k] + c_i h.
@@ -111,7 +111,7 @@ def _grid_times(n0, m, h, c, t_out, t_nodes):
                 st(t_nodes, add(t, mul(hd, c[i])), k, i)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _scale_tableau(a, b, h, ha, hb):
     """ha = h * a, hb = h * b in the working precision (h: generic number)."""
     for i in range(a.shape[0]):
@@ -127,7 +127,7 @@ def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel) -> np.n
     return k
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _rhs_at(y, tdat_row, params, layout, k):
     system_rhs(y, tdat_row, params, layout, k)
 
@@ -308,19 +308,25 @@ def _node_tdat(model, epoch, times) -> np.ndarray:
 
 
 #: max|r^(6)| (h/2)^6 / 6! bound of the quintic Hermite error, written as
-#: |r| (w h)^6 / _QUINTIC_ERROR_DIVISOR with w = sqrt(|a| / |r|).
+#: |r| (w h)^6 / _QUINTIC_ERROR_DIVISOR for a motion of angular rate w.
 _QUINTIC_ERROR_DIVISOR = 46080.0
+#: Margin on that step (error ~ h^6: 0.75 -> 0.18 of the bound) for the
+#: higher harmonics of eccentric motion near perigee, which the rate w does
+#: not capture (measured: 3.9x the bound on e = 0.1 without it).
+_DENSE_OUTPUT_SAFETY = 0.75
 
 
 def _dense_output_max_step(y, a, rtol) -> float:
     """Largest step [s] whose quintic Hermite dense output stays within
-    rtol * |r|: h <= (46080 rtol)^(1/6) / w, with the orbital frequency
-    w = sqrt(|a| / |r|) [rad/s] of the fastest body (for a Keplerian orbit
-    w^2 = GM / r^3 exactly)."""
-    r = np.linalg.norm(_to_dd(y, 2)[:, 0:3, 0], axis=1)
+    rtol * |r|: h <= safety * (46080 rtol)^(1/6) / w, with the angular rate
+    w = max(sqrt(|a| / |r|), |v| / |r|) [rad/s] of the fastest body (for a
+    Keplerian orbit sqrt(GM / r^3) and the rate of the radius vector)."""
+    y_dd = _to_dd(y, 2)
+    r = np.linalg.norm(y_dd[:, 0:3, 0], axis=1)
+    v = np.linalg.norm(y_dd[:, 3:6, 0], axis=1)
     acc = np.linalg.norm(np.asarray(a)[..., 0] if np.ndim(a) == 3 else a, axis=1)
-    w = float(np.max(np.sqrt(acc / r)))
-    return (_QUINTIC_ERROR_DIVISOR * rtol) ** (1.0 / 6.0) / w if w > 0 else np.inf
+    w = float(np.max(np.maximum(np.sqrt(acc / r), v / r)))
+    return _DENSE_OUTPUT_SAFETY * (_QUINTIC_ERROR_DIVISOR * rtol) ** (1.0 / 6.0) / w if w > 0 else np.inf
 
 
 def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress):

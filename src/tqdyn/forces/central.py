@@ -19,7 +19,7 @@ from ..precision import add, dd_from_mp, div, mul, neg, sqrt
 __all__ = ["monopole", "EarthMonopole"]
 
 
-@njit(cache=False)
+@njit(cache=True)
 def monopole(x, y, z, gm):
     """Acceleration -gm r / |r|^3 [m/s^2] at r = (x, y, z) [m] relative to the
     body's center, in the frame of r.  Generic: dd tuples or float64 scalars.

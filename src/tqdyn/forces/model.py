@@ -94,7 +94,7 @@ def build_force_model(forces) -> ForceModel:
     return ForceModel(terms)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def gravity(x, y, z, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the geocentric GCRS position
     (x, y, z) [m] (generic dd / float64), from the enabled terms.

@@ -36,7 +36,7 @@ from numba import njit
 __all__ = ["ThirdBodies", "third_body_accel"]
 
 
-@njit(cache=False)
+@njit(cache=True)
 def third_body_accel(rx, ry, rz, sx, sy, sz, gm):
     """Geocentric acceleration [m/s^2] of a satellite at r [m] due to a point
     mass gm [m^3/s^2] at s [m] (direct minus indirect term, Battin's

@@ -148,7 +148,7 @@ def step_coefficients(tab: Tableau, h, precision: str) -> StepCoefficients:
 # compiled building blocks (generic over dd / float64)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def stage_state(y, K, ha, nz, nnz, i, out):
     """out = y + sum_j ha[i, j] K[j] over the nonzero a[i][j] (j < i).
 
@@ -164,7 +164,7 @@ def stage_state(y, K, ha, nz, nnz, i, out):
             st(out, acc, b, q)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def combine(y, comp, K, hb, nzb, nnzb, he, err):
     """Advance y in place by the 8th-order increment sum_j hb[j] K[j], with a
     compensated (Kahan) update: ``comp`` carries the rounding error of the
@@ -195,7 +195,7 @@ def combine(y, comp, K, hb, nzb, nnzb, he, err):
             err[b, q] = e
 
 
-@njit(cache=False)
+@njit(cache=True)
 def error_norm(y, err, rtol):
     """Scaled local-error norm: max over bodies of |err_r| / (rtol |r|) and
     |err_v| / (rtol |v|) (Euclidean norms per body).  <= 1 accepts a step."""
