@@ -361,9 +361,9 @@ def _adaptive_check(rtol: str, out_step: str = "600"):
     assert np.array_equal(r[-1, 0], res.y_final[0, 0:3])
     assert err <= bound
     assert rows_err <= bound
-    # the dense output itself keeps within rtol * |r| (plus the global error
-    # already accumulated at that row, <= the final error bound)
-    assert rows_err <= float(rtol) * float(sat.a_m * (1 + sat.e)) + bound
+    # the dense output itself keeps within rtol * |r|, plus the global error
+    # already accumulated at that row (which grows about linearly to err)
+    assert rows_err <= float(rtol) * float(sat.a_m * (1 + sat.e)) + 2 * err
     return res, err
 
 
