@@ -123,9 +123,9 @@ def test_composition_sums_terms():
     tdat = model.precompute(None, np.array(1234.0), np.array(0.0))
     np.testing.assert_array_equal(tdat, s)
     dd = [(x, 0.0) for x in r]  # dd inputs: the monopole is evaluated in dd
-    total = gravity(*dd, tdat, model.params, model.layout)
+    total = gravity(*dd, *dd, tdat, model.params, model.layout)
     mono_only = ForceModel([EarthMonopole()])
-    mono = gravity(*dd, np.zeros(0), mono_only.params, mono_only.layout)
+    mono = gravity(*dd, *dd, np.zeros(0), mono_only.params, mono_only.layout)
     tb = third_body_accel(*r, *s, GM_MOON)
     for q in range(3):
         diff = (Fraction(total[q][0]) + Fraction(total[q][1])) - (Fraction(mono[q][0]) + Fraction(mono[q][1]))

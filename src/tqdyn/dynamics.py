@@ -23,7 +23,8 @@ def system_rhs(y, tdat, params, layout, k):
     instant of y; params, layout: the force model's.  Units m/s and m/s^2.
     """
     for b in range(y.shape[0]):
-        ax, ay, az = gravity(ld(y, b, 0), ld(y, b, 1), ld(y, b, 2), tdat, params, layout)
+        ax, ay, az = gravity(ld(y, b, 0), ld(y, b, 1), ld(y, b, 2), ld(y, b, 3), ld(y, b, 4), ld(y, b, 5),
+                             tdat, params, layout)
         for q in range(3):
             st(k, ld(y, b, q + 3), b, q)
         st(k, ax, b, 3)

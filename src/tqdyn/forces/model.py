@@ -6,6 +6,10 @@ with the same interface:
 
 * ``name``, ``description``, ``source`` -- for ``tqdyn info`` and the docs;
 * ``params()`` -> float64 array of its constant parameters;
+* a compiled kernel ``(rx, ry, rz, vx, vy, vz, tdat, params) -> (ax, ay, az)``
+  (float64, m and m/s in, m/s^2 out, GCRS) reading its own slices of the
+  time-only inputs and parameters -- only the central monopole, large enough
+  to need it, is evaluated in the propagation's extended precision;
 * ``n_tdat`` and ``precompute(epoch, t_hi, t_lo)`` -> float64 array
   (..., n_tdat) of its *time-only* inputs (ephemeris positions, rotation
   matrices, tidal corrections ...) at propagation times t = t_hi + t_lo
@@ -25,7 +29,7 @@ from numba import njit
 
 from ..precision import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
-from .third_body import ThirdBodies, third_body_accel
+from .third_body import ThirdBodies, third_bodies_accel
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
 
@@ -95,9 +99,10 @@ def build_force_model(forces) -> ForceModel:
 
 
 @njit(cache=True)
-def gravity(x, y, z, tdat, params, layout):
+def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the geocentric GCRS position
-    (x, y, z) [m] (generic dd / float64), from the enabled terms.
+    (x, y, z) [m] and velocity (vx, vy, vz) [m/s] (generic dd / float64; the
+    velocity enters the relativistic terms only), from the enabled terms.
 
     tdat: (n_tdat,) float64 time-only inputs at this instant; params, layout:
     from :class:`ForceModel`.  Returns (ax, ay, az) in the number type of x.
@@ -108,14 +113,14 @@ def gravity(x, y, z, tdat, params, layout):
         o = layout[SLOT_EARTH_MONOPOLE, 1]
         gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
         ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    # perturbations: float64 at the float64-rounded position (error ~1e-16 relative)
+    # perturbations: float64 kernels at the float64-rounded state (~1e-16
+    # relative); each has the signature (rx, ry, rz, vx, vy, vz, tdat, params)
+    # -> (ax, ay, az) on its own slices of tdat and params
     rx, ry, rz = to_f64(x), to_f64(y), to_f64(z)
+    ux, uy, uz = to_f64(vx), to_f64(vy), to_f64(vz)
     px, py, pz = 0.0, 0.0, 0.0
     if layout[SLOT_THIRD_BODY, 0]:
-        o = layout[SLOT_THIRD_BODY, 1]
-        c = layout[SLOT_THIRD_BODY, 2]
-        for k in range(int(params[o])):
-            gx, gy, gz = third_body_accel(rx, ry, rz, tdat[c + 3 * k], tdat[c + 3 * k + 1], tdat[c + 3 * k + 2],
-                                          params[o + 1 + k])
-            px, py, pz = px + gx, py + gy, pz + gz
+        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+        gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
     return add(ax, px), add(ay, py), add(az, pz)

@@ -33,7 +33,7 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-__all__ = ["ThirdBodies", "third_body_accel"]
+__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel"]
 
 
 @njit(cache=True)
@@ -49,6 +49,18 @@ def third_body_accel(rx, ry, rz, sx, sy, sz, gm):
     d2 = dx * dx + dy * dy + dz * dz
     k = -gm / (d2 * math.sqrt(d2))
     return k * (rx + f * sx), k * (ry + f * sy), k * (rz + f * sz)
+
+
+@njit(cache=True)
+def third_bodies_accel(rx, ry, rz, vx, vy, vz, tdat, params):
+    """Sum of the point-mass terms of all bodies (the perturbation-kernel
+    signature of :mod:`tqdyn.forces.model`): tdat = body positions (3 n,) [m]
+    at this instant, params = [n, gm_1, ..., gm_n].  float64, m/s^2."""
+    ax, ay, az = 0.0, 0.0, 0.0
+    for k in range(int(params[0])):
+        gx, gy, gz = third_body_accel(rx, ry, rz, tdat[3 * k], tdat[3 * k + 1], tdat[3 * k + 2], params[1 + k])
+        ax, ay, az = ax + gx, ay + gy, az + gz
+    return ax, ay, az
 
 
 @dataclass(frozen=True)
