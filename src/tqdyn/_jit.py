@@ -62,7 +62,11 @@ def install_cache_locator() -> bool:
 
         def __init__(self, py_func, py_file):
             self._lineno = py_func.__code__.co_firstlineno
-            self._cache_path = str(cache_dir() / self.get_suitable_cache_subpath(py_file))
+            # one folder per package version (stamp) and source folder: every
+            # install of the same sources shares it, old versions' folders are
+            # simply never read again
+            sub = pathlib.Path(py_file).resolve().parent.relative_to(_PACKAGE)
+            self._cache_path = str(cache_dir() / _package_stamp()[:16] / sub)
 
         def get_cache_path(self):
             return self._cache_path

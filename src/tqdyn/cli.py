@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import sys
 import time
-from decimal import Decimal
 
 import click
 
@@ -20,10 +19,6 @@ __all__ = ["main"]
 
 _EXIT_BAD_INPUT = 2
 _EXIT_INTERRUPTED = 130
-
-
-class _BadInput(Exception):
-    """Raised inside commands for a one-line user error (exit status 2)."""
 
 
 def _fail(message: str, status: int = _EXIT_BAD_INPUT):

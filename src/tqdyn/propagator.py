@@ -20,8 +20,8 @@ callable.
 from __future__ import annotations
 
 import time as _time
-from fractions import Fraction
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Callable, Mapping
 
 import mpmath
@@ -32,7 +32,7 @@ from . import elements as _el
 from .dynamics import system_rhs
 from .forces.model import ForceModel, build_force_model
 from .integrators import dp87, hermite
-from .precision import add, dd_from_mp, ld, mul, mp_from_dd, st
+from .precision import add, ld, mul, mp_from_dd, st
 from .timescales import Epoch
 
 __all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs", "warm_up",
