@@ -12,6 +12,8 @@ __all__ = [
     "C_LIGHT",
     "DAY_S",
     "J2000_JD",
+    "J_EARTH_IERS2010",
+    "AU_M",
 ]
 
 # Geocentric gravitational constant [m^3/s^2], exact decimal string as published
@@ -31,3 +33,11 @@ DAY_S = 86400
 
 # Julian date of the J2000.0 epoch, 2000-01-01T12:00:00 TT [d] (IAU 1976/2000).
 J2000_JD = 2451545.0
+
+# Earth's angular momentum per unit mass |J| [m^2/s], the value quoted with the
+# Lense-Thirring term of the IERS Conventions 2010 (TN36, sec. 10.3, eq. 10.12):
+# |J| ~ 9.8e8 m^2/s (C Omega / M with C/(M a^2) = 0.3307, Omega = 7.292e-5 rad/s).
+J_EARTH_IERS2010 = 9.8e8
+
+# Astronomical unit [m], exact by definition (IAU 2012 Resolution B2).
+AU_M = 149597870700.0
