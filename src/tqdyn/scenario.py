@@ -272,21 +272,69 @@ class RunConfig:
         _require(isinstance(oe, int) and not isinstance(oe, bool) and oe >= 1, "run.output_every", oe, "is not an integer >= 1", "an integer >= 1")
 
 
+#: Bodies available as point-mass third bodies (JPL DE ephemerides).
+THIRD_BODIES = ("sun", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+#: Largest degrees the shipped coefficient files hold.
+MAX_EARTH_DEGREE = 90  # EGM2008_90.gfc
+MAX_MOON_DEGREE = 20  # jggrx_0660b_sha_deg20.tab
+MAX_OCEAN_TIDE_DEGREE = 100  # fes2004_Cnm-Snm.dat
+LIBRATION_MODELS = ("de421", "iau")
+
+
 @dataclass(frozen=True)
 class ForcesConfig:
-    """Force-model switches (more are added with the full force model).
+    """Force-model switches.  Every perturbation is off unless switched on
+    (the built-in ``tianqin`` scenario switches on the paper's full model).
 
-    ``earth_monopole``: Earth point-mass attraction on/off;
-    ``gm_earth`` [m^3/s^2] (> 0), default EGM2008 3.986004415e14.
+    ``earth_monopole``: Earth point mass; ``gm_earth`` [m^3/s^2] (> 0),
+    default EGM2008 3.986004415e14.
+    ``earth_degree``: degree and order of the Earth's static field EGM2008
+    (0 = off, 2..90).
+    ``ephemeris``: "de421" (shipped) or the path of a JPL DE .bsp file.
+    ``third_bodies``: point-mass bodies, a subset of THIRD_BODIES.
+    ``solid_tides``: IERS 2010 solid Earth tides (steps 1 and 2).
+    ``ocean_tides_degree``: FES2004 ocean tides to this degree (0 = off).
+    ``pole_tides``: solid Earth and ocean pole tides.
+    ``moon_degree``: GL0660B lunar field degree (0 = off, 2..20);
+    ``moon_libration``: lunar orientation "de421" (PA kernel) | "iau".
+    ``sun_j2``: the Sun's J2 with its IAU pole.
+    ``relativity``: IERS 2010 eq. 10.12 (Schwarzschild, Lense-Thirring, de Sitter).
+    ``eop``: polar motion, UT1-UTC and celestial-pole offsets from EOP 14 C04
+    (false: zero -- for tests and comparisons only).
     """
 
     earth_monopole: bool = True
     gm_earth: Decimal = Decimal(GM_EARTH_EGM2008)
+    earth_degree: int = 0
+    ephemeris: str = "de421"
+    third_bodies: tuple[str, ...] = ()
+    solid_tides: bool = False
+    ocean_tides_degree: int = 0
+    pole_tides: bool = False
+    moon_degree: int = 0
+    moon_libration: str = "de421"
+    sun_j2: bool = False
+    relativity: bool = False
+    eop: bool = True
 
     def __post_init__(self) -> None:
-        _require(isinstance(self.earth_monopole, bool), "forces.earth_monopole", self.earth_monopole, "is not a boolean", "true or false")
+        for key in ("earth_monopole", "solid_tides", "pole_tides", "sun_j2", "relativity", "eop"):
+            _require(isinstance(getattr(self, key), bool), f"forces.{key}", getattr(self, key), "is not a boolean", "true or false")
         _set(self, "gm_earth", _to_decimal(self.gm_earth, "forces.gm_earth"))
         _require(self.gm_earth > 0, "forces.gm_earth", self.gm_earth, "is not positive", "gm_earth > 0 m^3/s^2")
+        for key, top in (("earth_degree", MAX_EARTH_DEGREE), ("moon_degree", MAX_MOON_DEGREE),
+                         ("ocean_tides_degree", MAX_OCEAN_TIDE_DEGREE)):
+            v = getattr(self, key)
+            ok = isinstance(v, int) and not isinstance(v, bool) and (v == 0 or 2 <= v <= top)
+            _require(ok, f"forces.{key}", v, "is not an allowed degree", f"0 (off) or 2..{top} (the data file's limit)")
+        _require(isinstance(self.ephemeris, str) and self.ephemeris.strip() != "", "forces.ephemeris", self.ephemeris,
+                 "is not a name or path", '"de421" or the path of a JPL .bsp file')
+        bodies = tuple(self.third_bodies)
+        _set(self, "third_bodies", bodies)
+        for body in bodies:
+            _require(body in THIRD_BODIES, "forces.third_bodies", body, "is not a known body", _one_of(THIRD_BODIES))
+        _require(len(set(bodies)) == len(bodies), "forces.third_bodies", list(bodies), "lists a body twice", "each body once")
+        _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
 
 
 @dataclass(frozen=True)
@@ -393,8 +441,15 @@ class Scenario:
         out += ["[integrator]", f"method = {_toml_str(g.method)}", f"mode = {_toml_str(g.mode)}",
                 f"step = {_toml_dec(g.step_s)}  # s", f"tableau = {_toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]
         f = self.forces
-        out += ["[forces]", f"earth_monopole = {'true' if f.earth_monopole else 'false'}",
-                f"gm_earth = {_toml_dec(f.gm_earth)}  # m^3/s^2", ""]
+        b = lambda x: "true" if x else "false"  # noqa: E731
+        out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}",
+                f"gm_earth = {_toml_dec(f.gm_earth)}  # m^3/s^2", f"earth_degree = {f.earth_degree}",
+                f"ephemeris = {_toml_str(f.ephemeris)}",
+                "third_bodies = [" + ", ".join(_toml_str(x) for x in f.third_bodies) + "]",
+                f"solid_tides = {b(f.solid_tides)}", f"ocean_tides_degree = {f.ocean_tides_degree}",
+                f"pole_tides = {b(f.pole_tides)}", f"moon_degree = {f.moon_degree}",
+                f"moon_libration = {_toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
+                f"relativity = {b(f.relativity)}", f"eop = {b(f.eop)}", ""]
         s = self.spacecraft
         out += ["[spacecraft]", f"d_tm = {_toml_dec(s.d_tm_m)}  # m", f"d_p = {_toml_dec(s.d_p_m)}  # m", ""]
         for sat in self.satellites:
@@ -431,12 +486,15 @@ def _toml_str(s: str) -> str:
 # --------------------------------------------------------------------------- raw table -> Scenario
 
 _STR, _NUM, _INT, _BOOL, _DUR, _EPOCH = "string", "number", "integer", "boolean", "duration", "epoch"
+_STRLIST = "list of strings"
 
 _SCHEMA: dict[str, dict[str, str]] = {
     "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH},
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
-    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM},
+    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "ephemeris": _STR,
+               "third_bodies": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
+               "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL, "eop": _BOOL},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM},
 }
 _SAT_SCHEMA: dict[str, str] = {
@@ -463,6 +521,10 @@ def _typed(value: Any, kind: str, name: str) -> Any:
         _require(ok, name, value, f"is {_a(_toml_type(value))}", "a number")
         _require(Decimal(value).is_finite(), name, value, "is not finite", "a finite number")
         return Decimal(value)
+    if kind == _STRLIST:
+        ok = isinstance(value, list) and all(isinstance(x, str) for x in value)
+        _require(ok, name, value, f"is {_a(_toml_type(value))}", "a list of strings")
+        return tuple(value)
     if kind == _DUR:
         d = _parse_duration(value, name)
         return d
@@ -573,6 +635,8 @@ def _parse_override_value(text: str, kind: str) -> Any:
     try:
         value = tomllib.loads("v = " + text, parse_float=Decimal)["v"]
     except tomllib.TOMLDecodeError:
+        if kind == _STRLIST:  # --set forces.third_bodies=sun,moon
+            return [x.strip() for x in text.split(",") if x.strip()]
         return text.strip()
     if kind in (_STR, _EPOCH) and not isinstance(value, str) and not (kind == _EPOCH and isinstance(value, _dt.date)):
         return text.strip()  # e.g. --set scenario.name=123 means the string "123"

@@ -29,6 +29,7 @@ from numba import njit
 
 from ..precision import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
+from .relativity import Relativity, relativity_accel
 from .third_body import ThirdBodies, third_bodies_accel
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
@@ -36,8 +37,9 @@ __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOT
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
 SLOT_THIRD_BODY = 1
-SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY}
-_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY}
+SLOT_RELATIVITY = 2
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY}
+_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY, Relativity: SLOT_RELATIVITY}
 
 
 class ForceModel:
@@ -90,11 +92,26 @@ def describe_terms() -> list[tuple[str, str, str]]:
     return [(cls.name, cls.description, cls.source) for cls in _TERM_SLOT]
 
 
+def _ephemeris(name_or_path: str):
+    """The JPL ephemeris of a scenario: "de421" (shipped) or a .bsp path."""
+    from ..ephemeris import Ephemeris, default_ephemeris
+
+    return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
+
+
 def build_force_model(forces) -> ForceModel:
-    """ForceModel from a scenario's ``ForcesConfig``."""
+    """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)."""
     terms = []
     if forces.earth_monopole:
         terms.append(EarthMonopole(gm=forces.gm_earth))
+    needs_ephemeris = forces.third_bodies or forces.relativity
+    eph = _ephemeris(forces.ephemeris) if needs_ephemeris else None
+    if forces.third_bodies:
+        from .third_body_ephemeris import third_bodies
+
+        terms.append(third_bodies(eph, forces.third_bodies))
+    if forces.relativity:
+        terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth)))
     return ForceModel(terms)
 
 
@@ -122,5 +139,9 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     if layout[SLOT_THIRD_BODY, 0]:
         o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
         gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_RELATIVITY, 0]:
+        o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
+        gx, gy, gz = relativity_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     return add(ax, px), add(ay, py), add(az, pz)

@@ -1,0 +1,542 @@
+"""Earth orientation parameters (EOP): the IERS 14 C04 series and its interpolation.
+
+What this module provides
+-------------------------
+* :func:`load_eop` -- reader of the IERS EOP 14 C04 daily series
+  (``data/eopc04_14_IAU2000.62-now.txt``, shipped; see ``data/SOURCES.md``)
+  into an :class:`EOP` table: polar motion x_p, y_p and celestial pole
+  offsets dX, dY in **rad**, UT1-UTC and LOD in **s**, one row per day at
+  0 h UTC (MJD in UTC).
+* :meth:`EOP.at` -- interpolation to any instants (arrays of any shape).
+* :func:`load_tidal_eop_terms` / :func:`tidal_eop_corrections` -- the IERS
+  2010 diurnal and semidiurnal corrections to polar motion and UT1 that the
+  C04 series does not contain (ocean tides: TN36 Tables 8.2 and 8.3, as in
+  the IERS routine ``interp.f``/PMUT1_OCEANS; libration in polar motion:
+  TN36 Table 5.1a, as in PMSDNUT2).  They are optional
+  (:func:`tqdyn.frames.earth_orientation` ``tidal_eop=``).
+
+Interpolation
+-------------
+Four-point (cubic) Lagrange interpolation in MJD(UTC) between the daily
+nodes, the scheme of the IERS routine ``interp.f`` (IERS Gazette No. 13,
+"Interpolating IERS Earth orientation data", McCarthy, Gambis & Bizouard)
+recommended for the C04 series: for x in [MJD_i, MJD_i+1) the nodes
+i-1, i, i+1, i+2 are used (the first / last four nodes at the two ends of the
+table), so the interpolant reproduces every tabulated value exactly at its
+node and is continuous.
+
+UT1-UTC jumps by +1 s at every leap second.  It is therefore interpolated as
+UT1-TAI, which is smooth: the node values enter as
+``UT1-UTC_j + (TAI-UTC(x) - TAI-UTC_j)`` with TAI-UTC from ERFA's leap-second
+table (``erfa.dat``, which also carries the pre-1972 linear drifts), i.e. the
+interpolated quantity is UT1-TAI and TAI-UTC of the requested instant is
+added back.  For a query at a node the correction is zero and the tabulated
+UT1-UTC is returned exactly.  :meth:`EOP.ut1_minus_tai` gives UT1-TAI
+directly (what :mod:`tqdyn.frames` uses: UT1 = TAI + (UT1-TAI), no UTC
+needed).
+
+How much the interpolation scheme matters (measured in ``tests/test_eop.py``,
+2004-2006): 4-point Lagrange and 8-point Lagrange interpolants of the same
+C04 nodes differ by up to ~7 us (rms ~2 us) in UT1 (5e-10 rad of Earth
+rotation angle) and ~2e-10 rad (45 uas) in polar motion at mid-day -- the
+day-to-day scatter of the series itself, below the C04's own stated errors
+(e.g. 2004-06-06: 14 us in UT1-UTC, 68 uas in x).  The IERS also recommends
+removing the zonal tides from UT1 (TN36 Table 8.1, routine RG_ZONT2) before
+interpolating; that table is not shipped and this is not done (the cubic
+interpolation error of the largest zonal term, 13.66 d, ~0.4 ms, is < 0.4 us).
+For tqdyn's use (rotating the Earth's gravity field seen from 1e8 m) any of
+these is far below what matters: 1e-9 rad of orientation changes the
+acceleration of the Earth's non-central field at 1e8 m by < 1e-15 m/s^2.
+
+Units: angles in rad (the file's arcsec times pi/648000), times in s, MJD in
+days of UTC (ERFA quasi-JD convention on leap-second days).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+import math
+import os
+import re
+import warnings
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import erfa
+import numpy as np
+from numba import njit
+
+from . import _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+
+__all__ = [
+    "ARCSEC",
+    "EOP",
+    "EOPValues",
+    "TidalEOPTerms",
+    "load_eop",
+    "load_tidal_eop_terms",
+    "parse_eop_c04",
+    "tidal_arguments",
+    "tidal_eop_corrections",
+]
+
+#: One arcsecond in radians (pi / 648000).
+ARCSEC = math.pi / 648000.0
+_MICROARCSEC = ARCSEC * 1e-6
+
+_EOP_FILE = "eopc04_14_IAU2000.62-now.txt"
+_MJD_JD0 = 2400000.5
+_DAY = 86400.0
+
+
+class EOPValues(NamedTuple):
+    """Interpolated Earth orientation parameters (arrays of the query's shape).
+
+    xp, yp : rad -- polar motion (CIP in the ITRS), IERS C04.
+    dut1 : s -- UT1-UTC.
+    lod : s -- excess length of day.
+    dx, dy : rad -- celestial pole offsets dX, dY w.r.t. IAU 2006/2000A.
+    """
+
+    xp: np.ndarray
+    yp: np.ndarray
+    dut1: np.ndarray
+    lod: np.ndarray
+    dx: np.ndarray
+    dy: np.ndarray
+
+
+def _quiet_dat(y, m, d, fd):
+    """erfa.dat without the 'dubious year' warning (years past ERFA's table)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=erfa.ErfaWarning, message=".*dubious year.*")
+        return np.asarray(erfa.dat(y, m, d, fd), dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class EOP:
+    """IERS C04 Earth orientation parameters at daily nodes (0 h UTC).
+
+    Attributes (1-D float64 arrays, one element per day, equally spaced)
+    ----------
+    mjd : MJD of the node [d, UTC].
+    xp, yp : polar motion [rad].
+    dut1 : UT1-UTC [s].
+    lod : excess length of day [s].
+    dx, dy : celestial pole offsets dX, dY w.r.t. IAU 2006/2000A [rad].
+    source : where the table came from (file path, the shipped file, or "arrays").
+
+    TAI-UTC at the nodes (from ``erfa.dat``) is computed on construction and
+    kept privately (it is what removes the leap-second jumps of UT1-UTC).
+    Construct with :func:`load_eop` (or directly from arrays, e.g. in tests).
+    """
+
+    mjd: np.ndarray
+    xp: np.ndarray
+    yp: np.ndarray
+    dut1: np.ndarray
+    lod: np.ndarray
+    dx: np.ndarray
+    dy: np.ndarray
+    source: str = "arrays"
+    _dat0: np.ndarray = field(init=False, repr=False)
+    _dlod: np.ndarray = field(init=False, repr=False)
+    _daylen: np.ndarray = field(init=False, repr=False)
+    _table: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self):
+        cols = {}
+        for name in ("mjd", "xp", "yp", "dut1", "lod", "dx", "dy"):
+            a = np.array(getattr(self, name), dtype=np.float64)  # own copy
+            if a.ndim != 1:
+                raise ValueError(f"EOP.{name}: expected a 1-D array, got shape {a.shape}")
+            a.setflags(write=False)
+            cols[name] = a
+            object.__setattr__(self, name, a)
+        n = cols["mjd"].size
+        if n < 4:
+            raise ValueError(f"EOP: need at least 4 daily nodes for 4-point interpolation, got {n}")
+        for name, a in cols.items():
+            if a.size != n:
+                raise ValueError(f"EOP.{name}: {a.size} values, expected {n} (one per node)")
+            if not np.all(np.isfinite(a)):
+                raise ValueError(f"EOP.{name}: non-finite values")
+        mjd = cols["mjd"]
+        if np.any(mjd != np.round(mjd)) or np.any(np.diff(mjd) != 1.0):
+            raise ValueError("EOP.mjd: nodes must be consecutive integer MJDs (one per day at 0 h UTC)")
+        # TAI-UTC from ERFA's table, as erfa.utctai splits it: dat0 at 0 h of
+        # each node day, the drift over the day dlod (pre-1972 UTC only) and
+        # the step at its end dleap (leap second); the UTC day then lasts
+        # daylen = (86400 + dleap)(86400 + dlod)/86400 s of TAI.
+        days = np.append(mjd, mjd[-1] + 1.0)
+        y, m, d, _ = erfa.jd2cal(_MJD_JD0, days)
+        dat0 = _quiet_dat(y, m, d, 0.0)
+        dlod = 2.0 * (_quiet_dat(y, m, d, 0.5) - dat0)
+        dleap = dat0[1:] - (dat0[:-1] + dlod[:-1])
+        daylen = (_DAY + dleap) * (_DAY + dlod[:-1]) / _DAY
+        for name, a in (("_dat0", dat0[:-1]), ("_dlod", dlod[:-1]), ("_daylen", daylen)):
+            a = np.ascontiguousarray(a)
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+        # columns interpolated together: xp, yp, UT1-TAI, lod, dx, dy
+        tab = np.stack([cols["xp"], cols["yp"], cols["dut1"] - dat0[:-1], cols["lod"], cols["dx"], cols["dy"]],
+                       axis=1)
+        tab.setflags(write=False)
+        object.__setattr__(self, "_table", tab)
+
+    # ------------------------------------------------------------------
+    @property
+    def span_mjd(self) -> tuple[float, float]:
+        """(first, last) node MJD [d, UTC]; :meth:`at` accepts first <= mjd <= last."""
+        return float(self.mjd[0]), float(self.mjd[-1])
+
+    def _check_span(self, mjd: np.ndarray) -> None:
+        lo, hi = self.span_mjd
+        if mjd.size == 0:
+            return
+        ok = (mjd >= lo) & (mjd <= hi)
+        if not np.all(ok):
+            v = float(mjd[~ok].flat[0])
+            raise ValueError(
+                f"EOP: date MJD {v:.6f} (UTC, {_mjd_iso(v)}) is outside the EOP table span "
+                f"MJD {lo:.0f}..{hi:.0f} ({_mjd_iso(lo)} .. {_mjd_iso(hi)}) of {self.source}")
+
+    def _day_index(self, mjd: np.ndarray) -> np.ndarray:
+        return np.clip(np.floor(mjd - self.mjd[0]).astype(np.int64), 0, self.mjd.size - 1)
+
+    def _tai_utc(self, mjd: np.ndarray, day: np.ndarray) -> np.ndarray:
+        """TAI-UTC [s] at mjd (UTC quasi-MJD) in the node day of index ``day``."""
+        return self._dat0[day] + (mjd - self.mjd[day]) * self._dlod[day]
+
+    def at(self, mjd_utc) -> EOPValues:
+        """Interpolated EOP at ``mjd_utc`` [d, MJD in UTC], any shape.
+
+        4-point Lagrange interpolation (see the module docstring); UT1-UTC
+        is interpolated as UT1-TAI (leap-second jumps removed) and TAI-UTC of
+        the query instant is added back.  At a node the tabulated values are
+        returned exactly.  Returns an :class:`EOPValues` of float64 arrays of
+        the shape of ``mjd_utc`` (xp, yp, dx, dy in rad; dut1, lod in s).
+        Raises ``ValueError`` outside :attr:`span_mjd`.
+        """
+        mjd = np.asarray(mjd_utc, dtype=np.float64)
+        shape = mjd.shape
+        mjd = mjd.ravel()
+        cols = self._interp_columns(mjd)
+        # UT1-UTC = sum_j w_j (UT1-UTC_j + (TAI-UTC(q) - TAI-UTC_j)): exact at nodes
+        day = self._day_index(mjd)
+        dat_q = self._tai_utc(mjd, day)
+        vals = np.stack([self.dut1, self._dat0], axis=1)
+        adj = np.empty((mjd.size, 4))
+        k = np.empty(mjd.size, dtype=np.int64)
+        _lagrange4_window(mjd - self.mjd[0], self.mjd.size, k, adj)
+        dut1 = np.zeros(mjd.size)
+        for j in range(4):
+            dut1 += adj[:, j] * (vals[k + j, 0] + (dat_q - vals[k + j, 1]))
+        c = [cols[:, 0], cols[:, 1], dut1, cols[:, 3], cols[:, 4], cols[:, 5]]
+        return EOPValues(*(a.reshape(shape) for a in c))
+
+    def tai_minus_utc(self, mjd_utc) -> np.ndarray:
+        """TAI-UTC [s] at ``mjd_utc`` [d, UTC quasi-MJD] (ERFA's table, within the EOP span)."""
+        mjd = np.asarray(mjd_utc, dtype=np.float64)
+        self._check_span(mjd)
+        return self._tai_utc(mjd, self._day_index(mjd))
+
+    def ut1_minus_tai(self, mjd_utc) -> np.ndarray:
+        """UT1-TAI [s] at ``mjd_utc`` [d, UTC], 4-point Lagrange (smooth across leap seconds)."""
+        mjd = np.asarray(mjd_utc, dtype=np.float64)
+        return self._interp_columns(mjd.ravel())[:, 2].reshape(mjd.shape)
+
+    def _interp_columns(self, mjd: np.ndarray, check: bool = True) -> np.ndarray:
+        """(n, 6) interpolated [xp, yp, UT1-TAI, lod, dx, dy] (rad, s) at 1-D mjd (UTC)."""
+        if check:
+            self._check_span(mjd)
+        out = np.empty((mjd.size, 6))
+        _lagrange4_table(np.ascontiguousarray(mjd - self.mjd[0]), self._table, out)
+        return out
+
+    def mjd_utc_from_tai(self, mjd_tai) -> np.ndarray:
+        """MJD(UTC) [d] of instants given as MJD(TAI) [d] (float64 arrays of any shape).
+
+        Uses ERFA's leap-second table as ``erfa.taiutc`` does, including
+        ERFA's UTC quasi-JD convention on leap-second days (the fraction of a
+        day with a leap second is seconds/86401).  Instants outside the table
+        span are mapped with the first / last day's TAI-UTC (the span is
+        checked where EOP values are interpolated).
+        """
+        tai = np.asarray(mjd_tai, dtype=np.float64)
+        out = np.empty(tai.size)
+        _utc_from_tai(np.ascontiguousarray(tai.ravel() - self.mjd[0]), self._dat0, self._daylen, out)
+        return (out + self.mjd[0]).reshape(tai.shape)
+
+
+@njit(cache=True)
+def _lagrange4_window(x, n_nodes, k_out, w_out):
+    """Window start (nodes k..k+3) and 4-point Lagrange weights at abscissae x
+    [d] relative to the first of n_nodes unit-spaced nodes."""
+    for i in range(x.size):
+        xi = x[i]
+        k = int(math.floor(xi)) - 1
+        if k < 0:
+            k = 0
+        if k > n_nodes - 4:
+            k = n_nodes - 4
+        s = xi - k
+        s1, s2, s3 = s - 1.0, s - 2.0, s - 3.0
+        k_out[i] = k
+        w_out[i, 0] = -(s1 * s2 * s3) / 6.0
+        w_out[i, 1] = (s * s2 * s3) * 0.5
+        w_out[i, 2] = -(s * s1 * s3) * 0.5
+        w_out[i, 3] = (s * s1 * s2) / 6.0
+
+
+@njit(cache=True)
+def _lagrange4_table(x, table, out):
+    """out[i, c] = 4-point Lagrange interpolant of table[:, c] (unit-spaced
+    nodes 0, 1, ...) at x[i]; window i-1..i+2, clamped at the ends."""
+    n_nodes, m = table.shape
+    for i in range(x.size):
+        xi = x[i]
+        k = int(math.floor(xi)) - 1
+        if k < 0:
+            k = 0
+        if k > n_nodes - 4:
+            k = n_nodes - 4
+        s = xi - k
+        s1, s2, s3 = s - 1.0, s - 2.0, s - 3.0
+        w0 = -(s1 * s2 * s3) / 6.0
+        w1 = (s * s2 * s3) * 0.5
+        w2 = -(s * s1 * s3) * 0.5
+        w3 = (s * s1 * s2) / 6.0
+        for c in range(m):
+            out[i, c] = w0 * table[k, c] + w1 * table[k + 1, c] + w2 * table[k + 2, c] + w3 * table[k + 3, c]
+
+
+@njit(cache=True)
+def _utc_from_tai(tai, dat0, daylen, out):
+    """UTC quasi-MJD (relative to the first node) of TAI MJDs (same origin):
+    day i starts at TAI i + dat0[i]/86400 and lasts daylen[i] s of TAI."""
+    n = dat0.size
+    for q in range(tai.size):
+        t = tai[q]
+        i = int(math.floor(t))
+        if i < 0:
+            i = 0
+        if i > n - 1:
+            i = n - 1
+        sec = (t - i) * 86400.0 - dat0[i]
+        if sec < 0.0 and i > 0:
+            i -= 1
+            sec = (t - i) * 86400.0 - dat0[i]
+        elif sec >= daylen[i] and i < n - 1:
+            i += 1
+            sec = (t - i) * 86400.0 - dat0[i]
+        out[q] = i + sec / daylen[i]
+
+
+def _mjd_iso(mjd: float) -> str:
+    """Calendar date YYYY-MM-DD of an MJD (for error messages)."""
+    try:
+        y, m, d, _ = erfa.jd2cal(_MJD_JD0, float(mjd))
+        return f"{int(y):04d}-{int(m):02d}-{int(d):02d}"
+    except Exception:
+        return "?"
+
+
+# ----------------------------------------------------------------------
+# reader
+
+_C04_ROW = re.compile(r"^\s*(\d{4})\s+(\d{1,2})\s+(\d{1,2})\s+(\d{5})\s")
+
+
+def parse_eop_c04(text: str, source: str = "text") -> EOP:
+    """Parse the text of an IERS EOP (14 or 20) C04 file into an :class:`EOP`.
+
+    Data rows are ``Y M D MJD x y UT1-UTC LOD dX dY`` followed by their
+    errors (x, y, dX, dY in arcsec; UT1-UTC, LOD in s); header lines are
+    skipped.  Each row's MJD is checked against its calendar date.
+    Angles are converted to rad.  Raises ``ValueError`` for a file without
+    data rows, a malformed row, or non-consecutive days.
+    """
+    rows = []
+    for lineno, line in enumerate(text.splitlines(), 1):
+        m = _C04_ROW.match(line)
+        if m is None:
+            continue
+        tok = line.split()
+        if len(tok) < 10:
+            raise ValueError(f"{source}:{lineno}: EOP C04 row has {len(tok)} fields, expected >= 10")
+        try:
+            y, mo, d, mjd = (int(t) for t in tok[:4])
+            vals = [float(t) for t in tok[4:10]]
+        except ValueError:
+            raise ValueError(f"{source}:{lineno}: cannot parse EOP C04 row {line.strip()!r}") from None
+        rows.append((y, mo, d, mjd, *vals))
+    if not rows:
+        raise ValueError(f"{source}: no EOP C04 data rows found")
+    a = np.array(rows, dtype=np.float64)
+    jd1, jd2 = erfa.cal2jd(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2].astype(int))
+    bad = np.nonzero(jd1 + jd2 - _MJD_JD0 != a[:, 3])[0]
+    if bad.size:
+        r = rows[bad[0]]
+        raise ValueError(f"{source}: row {r[:4]}: MJD does not match the calendar date")
+    return EOP(mjd=a[:, 3], xp=a[:, 4] * ARCSEC, yp=a[:, 5] * ARCSEC, dut1=a[:, 6], lod=a[:, 7],
+               dx=a[:, 8] * ARCSEC, dy=a[:, 9] * ARCSEC, source=source)
+
+
+@functools.lru_cache(maxsize=1)
+def _default_eop() -> EOP:
+    res = importlib.resources.files("tqdyn") / "data" / _EOP_FILE
+    return parse_eop_c04(res.read_text(encoding="ascii"), source=f"tqdyn/data/{_EOP_FILE} (IERS EOP 14 C04)")
+
+
+def load_eop(path=None) -> EOP:
+    """Read an IERS C04 EOP file into an :class:`EOP` (x, y, dX, dY in rad; s).
+
+    ``path=None``: the shipped IERS EOP 14 C04 series
+    (``tqdyn/data/eopc04_14_IAU2000.62-now.txt``, 1962-01-01 .. 2024-09-03),
+    parsed once and cached.  Otherwise a path to a file of the same format.
+    Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for a
+    malformed one.
+    """
+    if path is None:
+        return _default_eop()
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise FileNotFoundError(f"EOP file not found: {p}")
+    with open(p, encoding="ascii", errors="replace") as fh:
+        return parse_eop_c04(fh.read(), source=p)
+
+
+# ----------------------------------------------------------------------
+# diurnal / semidiurnal corrections (ocean tides, libration)
+
+
+@dataclass(frozen=True, eq=False)
+class TidalEOPTerms:
+    """Trigonometric terms of the sub-daily EOP corrections (IERS 2010).
+
+    Each term j has integer multipliers ``mult[j]`` of the six arguments
+    (gamma = GMST + pi, l, l', F, D, Omega) and coefficients of
+    sin(arg) and cos(arg):
+
+    pm_mult (n_pm, 6) int64, pm_coef (n_pm, 4) float64 [rad]:
+        x_p sin, x_p cos, y_p sin, y_p cos (ocean tides, TN36 Table 8.2, plus,
+        if included, the libration terms of Table 5.1a);
+    ut1_mult (n_ut, 6) int64, ut1_coef (n_ut, 2) float64 [s]:
+        UT1 sin, UT1 cos (ocean tides, TN36 Table 8.3).
+    periods_pm, periods_ut1 : the tables' period column [d] (for checks only).
+    """
+
+    pm_mult: np.ndarray
+    pm_coef: np.ndarray
+    ut1_mult: np.ndarray
+    ut1_coef: np.ndarray
+    periods_pm: np.ndarray
+    periods_ut1: np.ndarray
+    source: str = ""
+
+
+def _parse_tidal_table(text: str, n_coef: int, source: str):
+    """Rows '... m1..m6 doodson period c1..c_ncoef' of an IERS table (Orekit
+    transcription); lines starting with '#' and non-numeric lines skipped.
+    Returns (mult (n,6) int64, period (n,), coef (n, n_coef))."""
+    mult, per, coef = [], [], []
+    need = 8 + n_coef
+    for line in text.splitlines():
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        tok = s.split()
+        if len(tok) < need:
+            continue
+        tail = tok[-need:]
+        try:
+            m = [int(t) for t in tail[:6]]
+            doodson = float(tail[6])
+            p = float(tail[7])
+            c = [float(t) for t in tail[8:]]
+        except ValueError:
+            continue
+        if "." not in tail[6] or doodson <= 0:
+            continue
+        mult.append(m)
+        per.append(p)
+        coef.append(c)
+    if not mult:
+        raise ValueError(f"{source}: no tidal terms found")
+    return np.array(mult, dtype=np.int64), np.array(per), np.array(coef)
+
+
+def _read_iers_table(name: str) -> str:
+    res = importlib.resources.files("tqdyn") / "data" / "iers2010" / name
+    if not res.is_file():
+        raise FileNotFoundError(f"IERS table not found: tqdyn/data/iers2010/{name}")
+    return res.read_text(encoding="utf-8")
+
+
+@functools.lru_cache(maxsize=4)
+def load_tidal_eop_terms(ocean: bool = True, libration: bool = True) -> TidalEOPTerms:
+    """Sub-daily EOP correction terms from the shipped IERS 2010 tables.
+
+    ocean: diurnal and semidiurnal ocean-tide terms in x_p, y_p (TN36 Table
+    8.2, 71 terms, ``iers2010/tab8.2ab.txt``) and UT1 (Table 8.3,
+    ``iers2010/tab8.3ab.txt``), the coefficients of the IERS routine
+    ``interp.f`` (PMUT1_OCEANS); libration: the 10 quasi-diurnal libration
+    terms in polar motion (Table 5.1a, ``iers2010/tab5.1a.txt``, long-period
+    terms removed as in PMSDNUT2).  The UT1 libration (Table 5.1b) is not
+    shipped and not included (amplitude a few us).  Coefficients are
+    converted to rad (from uas) and s (from us).  Cached.
+    """
+    pm_m, pm_c, pm_p = [np.zeros((0, 6), np.int64)], [np.zeros((0, 4))], [np.zeros(0)]
+    ut_m, ut_c, ut_p = np.zeros((0, 6), np.int64), np.zeros((0, 2)), np.zeros(0)
+    src = []
+    if ocean:
+        m, p, c = _parse_tidal_table(_read_iers_table("tab8.2ab.txt"), 4, "tab8.2ab.txt")
+        pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
+        ut_m, ut_p, c = _parse_tidal_table(_read_iers_table("tab8.3ab.txt"), 2, "tab8.3ab.txt")
+        ut_c = c * 1e-6
+        src.append("ocean tides: IERS 2010 Tables 8.2, 8.3 (interp.f)")
+    if libration:
+        m, p, c = _parse_tidal_table(_read_iers_table("tab5.1a.txt"), 4, "tab5.1a.txt")
+        pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
+        src.append("polar-motion libration: IERS 2010 Table 5.1a (PMSDNUT2)")
+    return TidalEOPTerms(np.concatenate(pm_m), np.concatenate(pm_c), ut_m, ut_c,
+                         np.concatenate(pm_p), ut_p, "; ".join(src))
+
+
+def tidal_arguments(ut1, tt) -> np.ndarray:
+    """The six arguments (gamma, l, l', F, D, Omega) [rad] of the sub-daily EOP terms.
+
+    ut1, tt : two-part Julian dates (jd1, jd2) of UT1 and TT (arrays, same shape).
+    gamma = GMST + pi with the IAU 2006 GMST (``erfa.gmst06``); the Delaunay
+    arguments are the IERS 2003 expressions (TN36 eq. 5.43, ``erfa.fal03``,
+    ``falp03``, ``faf03``, ``fad03``, ``faom03``) of TT Julian centuries since
+    J2000.  (``interp.f`` and PMSDNUT2 use the 1982 GMST of an MJD taken as
+    both UT1 and TT; the difference, < 0.01 rad in gamma, changes the
+    corrections by < 1e-11 rad.)  Returns float64 (..., 6).
+    """
+    t = ((np.asarray(tt[0]) - 2451545.0) + np.asarray(tt[1])) / 36525.0
+    gmst = erfa.gmst06(ut1[0], ut1[1], tt[0], tt[1])
+    return np.stack([gmst + math.pi, erfa.fal03(t), erfa.falp03(t), erfa.faf03(t),
+                     erfa.fad03(t), erfa.faom03(t)], axis=-1)
+
+
+def tidal_eop_corrections(args, terms: TidalEOPTerms):
+    """Sub-daily corrections (dx_p, dy_p [rad], dUT1 [s]) to add to interpolated C04 EOP.
+
+    args : (..., 6) float64 [rad], the arguments (gamma = GMST + pi, l, l', F,
+        D, Omega), e.g. from :func:`tidal_arguments`.
+    terms : :class:`TidalEOPTerms`.
+    Each term contributes s * sin(a) + c * cos(a) with a = mult . args
+    (the convention of interp.f and PMSDNUT2).  Returns three float64 arrays
+    of shape args.shape[:-1].
+    """
+    args = np.asarray(args, dtype=np.float64)
+    a_pm = args @ terms.pm_mult.T.astype(np.float64)
+    s_pm, c_pm = np.sin(a_pm), np.cos(a_pm)
+    dxp = s_pm @ terms.pm_coef[:, 0] + c_pm @ terms.pm_coef[:, 1]
+    dyp = s_pm @ terms.pm_coef[:, 2] + c_pm @ terms.pm_coef[:, 3]
+    a_ut = args @ terms.ut1_mult.T.astype(np.float64)
+    dut = np.sin(a_ut) @ terms.ut1_coef[:, 0] + np.cos(a_ut) @ terms.ut1_coef[:, 1]
+    return dxp, dyp, dut
