@@ -299,6 +299,9 @@ class ForcesConfig:
     ``moon_libration``: lunar orientation "de421" (PA kernel) | "iau".
     ``sun_j2``: the Sun's J2 with its IAU pole.
     ``relativity``: IERS 2010 eq. 10.12 (Schwarzschild, Lense-Thirring, de Sitter).
+    ``earth_field_indirect``: the geocentre's acceleration by the Moon and
+    Sun (those listed in third_bodies) acting on the Earth's non-central
+    field (needs earth_degree >= 2).
     ``eop``: polar motion, UT1-UTC and celestial-pole offsets from EOP 14 C04
     (false: zero -- for tests and comparisons only).
     """
@@ -315,10 +318,11 @@ class ForcesConfig:
     moon_libration: str = "de421"
     sun_j2: bool = False
     relativity: bool = False
+    earth_field_indirect: bool = False
     eop: bool = True
 
     def __post_init__(self) -> None:
-        for key in ("earth_monopole", "solid_tides", "pole_tides", "sun_j2", "relativity", "eop"):
+        for key in ("earth_monopole", "solid_tides", "pole_tides", "sun_j2", "relativity", "earth_field_indirect", "eop"):
             _require(isinstance(getattr(self, key), bool), f"forces.{key}", getattr(self, key), "is not a boolean", "true or false")
         _set(self, "gm_earth", _to_decimal(self.gm_earth, "forces.gm_earth"))
         _require(self.gm_earth > 0, "forces.gm_earth", self.gm_earth, "is not positive", "gm_earth > 0 m^3/s^2")
@@ -335,6 +339,8 @@ class ForcesConfig:
             _require(body in THIRD_BODIES, "forces.third_bodies", body, "is not a known body", _one_of(THIRD_BODIES))
         _require(len(set(bodies)) == len(bodies), "forces.third_bodies", list(bodies), "lists a body twice", "each body once")
         _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
+        _require(not self.earth_field_indirect or self.earth_degree >= 2, "forces.earth_field_indirect", True,
+                 "needs the Earth's non-central field", "false, or earth_degree >= 2")
 
 
 @dataclass(frozen=True)
@@ -449,7 +455,8 @@ class Scenario:
                 f"solid_tides = {b(f.solid_tides)}", f"ocean_tides_degree = {f.ocean_tides_degree}",
                 f"pole_tides = {b(f.pole_tides)}", f"moon_degree = {f.moon_degree}",
                 f"moon_libration = {_toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
-                f"relativity = {b(f.relativity)}", f"eop = {b(f.eop)}", ""]
+                f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
+                f"eop = {b(f.eop)}", ""]
         s = self.spacecraft
         out += ["[spacecraft]", f"d_tm = {_toml_dec(s.d_tm_m)}  # m", f"d_p = {_toml_dec(s.d_p_m)}  # m", ""]
         for sat in self.satellites:
@@ -494,7 +501,8 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
     "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "ephemeris": _STR,
                "third_bodies": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
-               "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL, "eop": _BOOL},
+               "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
+               "earth_field_indirect": _BOOL, "eop": _BOOL},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM},
 }
 _SAT_SCHEMA: dict[str, str] = {

@@ -29,7 +29,11 @@ from numba import njit
 
 from ..precision import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
+from .earth import EarthField, earth_field_accel
+from .earth_indirect import EarthFieldIndirect, earth_field_indirect_accel
+from .moon import MoonField, moon_field_accel
 from .relativity import Relativity, relativity_accel
+from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
@@ -38,8 +42,16 @@ __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOT
 SLOT_EARTH_MONOPOLE = 0
 SLOT_THIRD_BODY = 1
 SLOT_RELATIVITY = 2
-SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY}
-_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY, Relativity: SLOT_RELATIVITY}
+SLOT_MOON_FIELD = 3
+SLOT_SUN_J2 = 4
+SLOT_EARTH_FIELD = 5
+SLOT_EARTH_FIELD_INDIRECT = 6
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY,
+         "moon_field": SLOT_MOON_FIELD, "sun_j2": SLOT_SUN_J2, "earth_field": SLOT_EARTH_FIELD,
+         "earth_field_indirect": SLOT_EARTH_FIELD_INDIRECT}
+_TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY, Relativity: SLOT_RELATIVITY,
+              MoonField: SLOT_MOON_FIELD, SunJ2: SLOT_SUN_J2, EarthField: SLOT_EARTH_FIELD,
+              EarthFieldIndirect: SLOT_EARTH_FIELD_INDIRECT}
 
 
 class ForceModel:
@@ -99,17 +111,66 @@ def _ephemeris(name_or_path: str):
     return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
 
 
+def _no_eop_rotation(epoch, t_hi, t_lo):
+    """T_ITRS_GCRS without EOP (no polar motion, UT1 = UTC, no pole offsets)."""
+    from ..frames import earth_orientation
+
+    return earth_orientation(epoch, t_hi, t_lo, use_eop=False).T_ITRS_GCRS
+
+
+def _tide_models(forces, eph, rotation) -> tuple:
+    """The tide providers switched on in ``forces`` (coefficient corrections
+    summed into the Earth field)."""
+    orientation = None
+    if rotation is not None:
+        from ..frames import earth_orientation
+
+        def orientation(epoch, t_hi, t_lo):
+            return earth_orientation(epoch, t_hi, t_lo, use_eop=False)
+    tides = []
+    if forces.solid_tides:
+        from .solid_tides import SolidTides
+
+        tides.append(SolidTides(orientation=orientation, ephemeris=eph, gm_earth=float(forces.gm_earth)))
+    if forces.ocean_tides_degree:
+        from .ocean_tides import OceanTides
+
+        tides.append(OceanTides(nmax=forces.ocean_tides_degree, orientation=orientation))
+    if forces.pole_tides:
+        from .pole_tides import OceanPoleTide, SolidPoleTide
+
+        tides += [SolidPoleTide(orientation=orientation), OceanPoleTide(orientation=orientation)]
+    return tuple(tides)
+
+
 def build_force_model(forces) -> ForceModel:
     """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)."""
     terms = []
     if forces.earth_monopole:
         terms.append(EarthMonopole(gm=forces.gm_earth))
-    needs_ephemeris = forces.third_bodies or forces.relativity
+    needs_ephemeris = (forces.third_bodies or forces.relativity or forces.moon_degree or forces.sun_j2
+                       or forces.solid_tides or forces.earth_field_indirect)
     eph = _ephemeris(forces.ephemeris) if needs_ephemeris else None
+    rotation = None if forces.eop else _no_eop_rotation
+    if forces.earth_degree:
+        terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, rotation),
+                                rotation=rotation))
+    if forces.earth_field_indirect:
+        from ..ephemeris import planetary_gm
+
+        gm = planetary_gm()
+        bodies = tuple(b for b in ("moon", "sun") if b in forces.third_bodies)
+        terms.append(EarthFieldIndirect(field=EarthField(degree=forces.earth_degree, rotation=rotation),
+                                        bodies=bodies, gms=tuple(gm[b] for b in bodies),
+                                        gm_earth=float(forces.gm_earth), ephemeris=eph))
     if forces.third_bodies:
         from .third_body_ephemeris import third_bodies
 
         terms.append(third_bodies(eph, forces.third_bodies))
+    if forces.moon_degree:
+        terms.append(MoonField(degree=forces.moon_degree, libration=forces.moon_libration, ephemeris=eph))
+    if forces.sun_j2:
+        terms.append(SunJ2(ephemeris=eph))
     if forces.relativity:
         terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth)))
     return ForceModel(terms)
@@ -139,6 +200,22 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     if layout[SLOT_THIRD_BODY, 0]:
         o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
         gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_EARTH_FIELD, 0]:
+        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
+        gx, gy, gz = earth_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_EARTH_FIELD_INDIRECT, 0]:
+        o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
+        gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_MOON_FIELD, 0]:
+        o, c = layout[SLOT_MOON_FIELD, 1], layout[SLOT_MOON_FIELD, 2]
+        gx, gy, gz = moon_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_SUN_J2, 0]:
+        o, c = layout[SLOT_SUN_J2, 1], layout[SLOT_SUN_J2, 2]
+        gx, gy, gz = sun_j2_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if layout[SLOT_RELATIVITY, 0]:
         o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]

@@ -1,0 +1,1 @@
+"""Analyses of propagated trajectories (force budgets, spectra, metrics)."""

@@ -1,0 +1,334 @@
+"""The Earth's non-spherical gravity field (static EGM2008 + time-variable
+coefficient corrections), as a tqdyn force term.
+
+The satellite's geocentric GCRS position r is rotated into the ITRS,
+r_ITRS = T_ITRS_GCRS r, the acceleration of the spherical-harmonic field of
+degrees 2 .. N (orders 0 .. M) is evaluated there
+(:func:`tqdyn.forces.spherical_harmonics.sh_accel_flat`, float64) and
+rotated back, a_GCRS = T_ITRS_GCRS^T a_ITRS.  The monopole (degree 0) is the
+separate extended-precision term :class:`tqdyn.forces.central.EarthMonopole`;
+degree 1 vanishes (geocentric ITRS origin).
+
+Time-only inputs (:meth:`EarthField.precompute`, once per chunk of
+instants): the rotation matrix T_ITRS_GCRS (9 values, row-major), by default
+from ``tqdyn.frames.earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS``
+(IAU 2006/2000A + EOP), and the sum of the coefficient corrections dC, dS
+of the tide providers in ``tides`` (solid, ocean, pole, atmospheric tides),
+each a callable (epoch, t_hi, t_lo) -> (dC, dS) of shape (..., k+1, k+1)
+(fully normalised, referred to this field's GM and radius), zero-padded to
+the largest degree nt and summed.  The corrections are added to the static
+coefficients inside the compiled kernel, so the tides cost no extra
+harmonic synthesis.
+
+Permanent tide: the default static field is EGM2008 **tide-free**, which is
+consistent with an IERS 2010 solid-tide model that keeps the permanent
+(time-average) part of its dC20 (TN36 sec. 6.2 step 1 as computed).  With a
+zero-tide field the solid-tide model must remove it (TN36 eq. 6.14).  See
+:mod:`tqdyn.forces.gravity_models`.  A tide provider may declare
+``permanent_tide = "included"`` or ``"removed"``; :class:`EarthField`
+rejects a combination that counts the permanent deformation zero or two
+times.
+
+Magnitudes along a TianQin orbit (r = 1e8 m, i = 74.5 deg, EGM2008, max
+over one revolution, tests/test_spherical_harmonics.py): degree 2
+4.9e-7 m/s^2, 3: 2.7e-10, 4: 1.1e-11, 5: 5.8e-13, 6: 3.7e-14, 7: 2.5e-15,
+8: 1.1e-16, ..., 12: 7.7e-22 m/s^2 (each degree ~ (R/r) ~ 0.064 smaller).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from numba import njit
+
+from .. import _jit  # noqa: F401  (package-wide kernel cache)
+from .gravity_models import GravityModel, egm2008
+from .spherical_harmonics import NMAX_SH, sh_accel_flat
+
+__all__ = [
+    "EarthField",
+    "earth_field_accel",
+    "earth_field_static_accel",
+    "earth_tides_accel",
+    "earth_field_accel_batch",
+    "PARAM_HEADER",
+    "N_ROT",
+]
+
+#: Leading entries of :meth:`EarthField.params`: gm, radius, N, M, nt.
+PARAM_HEADER = 5
+#: Leading time-only inputs: T_ITRS_GCRS row-major.
+N_ROT = 9
+
+
+def _frames_rotation(epoch, t_hi, t_lo):
+    """T_ITRS_GCRS (..., 3, 3) from :func:`tqdyn.frames.earth_orientation`."""
+    try:
+        from ..frames import earth_orientation
+    except ImportError as exc:
+        raise ImportError("EarthField: tqdyn.frames.earth_orientation is not available; "
+                          "pass a rotation provider (rotation=...)") from exc
+    return earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS
+
+
+@njit(cache=True)
+def _pack(out, col, c, filled, lt):
+    """Packed lower triangle of c (n_inst, k+1, k+1) into out[:, col:col+lt]
+    (index n (n+1)/2 + m): added to the entries of degree <= filled, stored
+    into the others; entries beyond degree k are zeroed if filled < 0."""
+    k1 = c.shape[1]
+    f = (filled + 1) * (filled + 2) // 2  # entries already holding data
+    for i in range(c.shape[0]):
+        j = col
+        for n in range(k1):
+            for m in range(n + 1):
+                if j - col < f:
+                    out[i, j] += c[i, n, m]
+                else:
+                    out[i, j] = c[i, n, m]
+                j += 1
+        if filled < 0:
+            for jj in range(j, col + lt):
+                out[i, jj] = 0.0
+
+
+def _provider_degree(p):
+    for attr in ("degree", "nmax", "max_degree"):
+        d = getattr(p, attr, None)
+        if d is not None:
+            return int(d)
+    return None
+
+
+@dataclass(frozen=True)
+class EarthField:
+    """The Earth's gravity field beyond the monopole, GCRS, geocentric.
+
+    Parameters
+    ----------
+    degree : int
+        Highest degree N of the static field (2 <= N <= the model's degree,
+        90 for the shipped EGM2008).  Default 12 (the paper's Table II).
+    order : int, optional
+        Highest order M (default: N).
+    model : GravityModel, optional
+        Static field (body-fixed frame ITRS).  Default:
+        ``egm2008(degree)``, tide-free.
+    tides : tuple of callables
+        Coefficient-correction providers (epoch, t_hi, t_lo) -> (dC, dS),
+        float64 arrays (*shape(t_hi), k+1, k+1), fully normalised, ITRS,
+        at t = t_hi + t_lo [s TDB since epoch].  Each must expose its degree
+        k as an attribute ``degree`` (or ``nmax``), unless ``tide_degree``
+        is given.
+    rotation : callable, optional
+        (epoch, t_hi, t_lo) -> T_ITRS_GCRS (*shape(t_hi), 3, 3) float64
+        (maps GCRS vectors into ITRS).  Default:
+        ``tqdyn.frames.earth_orientation(...).T_ITRS_GCRS``.
+    tide_degree : int, optional
+        Degree nt of the summed corrections (default: the largest degree of
+        the providers; -1 if there are none).
+
+    Compiled-model interface: ``params()`` = [gm, radius, N, M, nt,
+    C (N+1)^2 row-major, S (N+1)^2 row-major]; time-only inputs
+    (``n_tdat`` = 9 + (nt+1)(nt+2) per instant) = [T_ITRS_GCRS row-major
+    (9), dC and dS as packed lower triangles ((nt+1)(nt+2)/2 each, dC_nm
+    at n (n+1)/2 + m)]; kernel :func:`earth_field_accel`.
+    """
+
+    degree: int = 12
+    order: int | None = None
+    model: GravityModel | None = None
+    tides: tuple = ()
+    rotation: Callable | None = None
+    tide_degree: int | None = None
+    name: str = field(default="earth_field", init=False)
+    description: str = field(
+        default="Earth spherical harmonics, degrees 2..N (+ tidal coefficient corrections), ITRS via T_ITRS_GCRS",
+        init=False)
+    source: str = field(default="EGM2008 (Pavlis et al. 2012), tide-free, fully normalised, to degree 90 shipped",
+                        init=False)
+
+    def __post_init__(self):
+        deg = self.degree
+        if isinstance(deg, bool) or not isinstance(deg, (int, np.integer)):
+            raise ValueError(f"EarthField: degree must be an integer, got {deg!r}")
+        deg = int(deg)
+        model = self.model
+        if model is None:
+            if deg > 90:
+                raise ValueError(f"EarthField: degree {deg} requested, but the shipped EGM2008 holds degrees up to 90 only")
+            if deg < 2:
+                raise ValueError(f"EarthField: degree {deg} < 2 (degrees 0 and 1 are not part of this term)")
+            model = egm2008(deg)
+        if deg < 2:
+            raise ValueError(f"EarthField: degree {deg} < 2 (degrees 0 and 1 are not part of this term)")
+        if deg > model.nmax:
+            raise ValueError(f"EarthField: degree {deg} requested, but {model.name} holds degrees up to {model.nmax} only")
+        order = deg if self.order is None else int(self.order)
+        if not 0 <= order <= deg:
+            raise ValueError(f"EarthField: order {order} must be between 0 and the degree {deg}")
+        tides = tuple(self.tides)
+        nt = self.tide_degree
+        if nt is None:
+            degs = [_provider_degree(p) for p in tides]
+            if any(d is None for d in degs):
+                raise ValueError("EarthField: a tide provider has no 'degree' attribute; pass tide_degree=")
+            nt = max(degs) if degs else -1
+        nt = int(nt)
+        if tides and not 2 <= nt <= NMAX_SH:
+            raise ValueError(f"EarthField: tide degree {nt} must be between 2 and {NMAX_SH}")
+        for p in tides:
+            perm = getattr(p, "permanent_tide", None)
+            if perm == "included" and model.tide_system == "zero_tide":
+                raise ValueError("EarthField: a zero-tide static field with a tide model that includes the "
+                                 "permanent tide counts the permanent deformation twice; use the tide-free field")
+            if perm == "removed" and model.tide_system == "tide_free":
+                raise ValueError("EarthField: a tide-free static field with a tide model that removes the "
+                                 "permanent tide omits the permanent deformation; use the zero-tide field")
+        object.__setattr__(self, "degree", deg)
+        object.__setattr__(self, "order", order)
+        object.__setattr__(self, "model", model.truncated(deg))
+        object.__setattr__(self, "tides", tides)
+        object.__setattr__(self, "tide_degree", nt)
+        object.__setattr__(self, "source", f"{model.name} ({model.tide_system}), degree {deg}, order {order}: "
+                                           f"{model.source}")
+
+    @property
+    def n_tdat(self) -> int:
+        """Time-only inputs per instant: 9 (rotation) + (nt+1)(nt+2)
+        (corrections dC, dS as packed lower triangles)."""
+        nt = self.tide_degree
+        return N_ROT + (nt + 1) * (nt + 2)
+
+    def params(self) -> np.ndarray:
+        """[gm, radius, N, M, nt, C (N+1)^2, S (N+1)^2] float64 (gm [m^3/s^2],
+        radius [m], the fully-normalised coefficients row-major)."""
+        m = self.model
+        return np.concatenate([[m.gm, m.radius, self.degree, self.order, self.tide_degree],
+                               m.C.ravel(), m.S.ravel()]).astype(np.float64)
+
+    def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
+        """Time-only inputs at t = t_hi + t_lo [s TDB since epoch]: float64
+        (*shape, n_tdat) = [T_ITRS_GCRS row-major (9), dC, dS (each the
+        packed lower triangle, dC_nm at n (n+1)/2 + m, (nt+1)(nt+2)/2
+        values; the sum of all tide providers)], shape = broadcast shape of
+        t_hi and t_lo."""
+        shape = np.broadcast_shapes(np.shape(t_hi), np.shape(t_lo))
+        rotation = self.rotation or _frames_rotation
+        T = np.asarray(rotation(epoch, t_hi, t_lo), dtype=np.float64)
+        if T.shape != shape + (3, 3):
+            raise ValueError(f"EarthField: rotation provider returned shape {T.shape}, expected {shape + (3, 3)}")
+        out = np.empty(shape + (self.n_tdat,))
+        out[..., :N_ROT] = T.reshape(shape + (N_ROT,))
+        nt = self.tide_degree
+        if nt >= 0:
+            # dC, dS as packed lower triangles (index n (n+1)/2 + m): the
+            # first (k+1)(k+2)/2 entries are the degrees <= k, so each
+            # provider adds into a prefix of the block
+            lt = (nt + 1) * (nt + 2) // 2
+            n_inst = int(np.prod(shape, dtype=np.int64))
+            flat = out.reshape(n_inst, self.n_tdat)
+            filled = -1  # degree up to which the blocks hold data
+            for p in self.tides:
+                c, s = p(epoch, t_hi, t_lo)
+                c = np.asarray(c, dtype=np.float64)
+                s = np.asarray(s, dtype=np.float64)
+                k = c.shape[-1] - 1 if c.ndim >= 2 else -1
+                if c.shape != shape + (k + 1, k + 1) or s.shape != c.shape:
+                    raise ValueError(f"EarthField: tide provider {p!r} returned shapes {c.shape}, {s.shape}; "
+                                     f"expected {shape} + (k+1, k+1)")
+                if k > nt:
+                    raise ValueError(f"EarthField: tide provider {p!r} returned degree {k}, above the tide degree {nt}")
+                # the first provider is stored (and the rest of its block
+                # zeroed), the others added: no separate zeroing pass
+                _pack(flat, N_ROT, c.reshape(n_inst, k + 1, k + 1), filled, lt)
+                _pack(flat, N_ROT + lt, s.reshape(n_inst, k + 1, k + 1), filled, lt)
+                filled = max(filled, k)
+            if filled < 0:
+                flat[:, N_ROT:] = 0.0
+        return out
+
+
+@njit(cache=True)
+def _earth_field(rx, ry, rz, tdat, params, static, tides):
+    gm, radius = params[0], params[1]
+    n = int(params[2])
+    mo = int(params[3])
+    nt = int(params[4])
+    ld = n + 1
+    L = ld * ld
+    C = params[PARAM_HEADER:PARAM_HEADER + L]
+    S = params[PARAM_HEADER + L:PARAM_HEADER + 2 * L]
+    if not static:
+        n = -1
+    lt = (nt + 1) * (nt + 2) // 2 if nt >= 0 else 0
+    dC = tdat[N_ROT:N_ROT + lt]
+    dS = tdat[N_ROT + lt:N_ROT + 2 * lt]
+    if not tides:
+        nt = -1
+    # r_ITRS = T r
+    x = tdat[0] * rx + tdat[1] * ry + tdat[2] * rz
+    y = tdat[3] * rx + tdat[4] * ry + tdat[5] * rz
+    z = tdat[6] * rx + tdat[7] * ry + tdat[8] * rz
+    ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, 0, nt, 2)
+    # a_GCRS = T^T a_ITRS
+    return (tdat[0] * ax + tdat[3] * ay + tdat[6] * az,
+            tdat[1] * ax + tdat[4] * ay + tdat[7] * az,
+            tdat[2] * ax + tdat[5] * ay + tdat[8] * az)
+
+
+@njit(cache=True)
+def earth_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
+    """Acceleration [m/s^2, GCRS] of the Earth's field, degrees 2..N of the
+    static model plus the tidal corrections, at the geocentric GCRS position
+    (rx, ry, rz) [m] (velocity unused).  tdat: this term's (n_tdat,)
+    time-only inputs at the instant; params: :meth:`EarthField.params`.
+    float64 scalars; returns (ax, ay, az)."""
+    return _earth_field(rx, ry, rz, tdat, params, True, True)
+
+
+@njit(cache=True)
+def earth_field_static_accel(rx, ry, rz, vx, vy, vz, tdat, params):
+    """As :func:`earth_field_accel`, the static field only (no corrections):
+    for force budgets.  m, m/s in, m/s^2 out, GCRS."""
+    return _earth_field(rx, ry, rz, tdat, params, True, False)
+
+
+@njit(cache=True)
+def earth_tides_accel(rx, ry, rz, vx, vy, vz, tdat, params):
+    """As :func:`earth_field_accel`, the summed coefficient corrections only
+    (the tides' acceleration, for force budgets; for one tide model alone
+    build an EarthField with that provider only).  m/s^2, GCRS."""
+    return _earth_field(rx, ry, rz, tdat, params, False, True)
+
+
+@njit(cache=True)
+def _batch(r, tdat, params, static, tides, out):
+    n = r.shape[0]
+    one = tdat.shape[0] == 1
+    for i in range(n):
+        row = tdat[0] if one else tdat[i]
+        ax, ay, az = _earth_field(r[i, 0], r[i, 1], r[i, 2], row, params, static, tides)
+        out[i, 0], out[i, 1], out[i, 2] = ax, ay, az
+
+
+def earth_field_accel_batch(r, tdat, params, part: str = "total") -> np.ndarray:
+    """Accelerations [m/s^2, GCRS] at many points (analysis and force budgets).
+
+    r: (n, 3) geocentric GCRS positions [m]; tdat: (n, n_tdat) or (n_tdat,)
+    time-only inputs (from :meth:`EarthField.precompute`); params:
+    :meth:`EarthField.params`; part: ``"total"`` (static + corrections),
+    ``"static"`` or ``"tides"``.  Returns (n, 3) float64.
+    """
+    flags = {"total": (True, True), "static": (True, False), "tides": (False, True)}
+    if part not in flags:
+        raise ValueError(f"earth_field_accel_batch: part {part!r} not one of {tuple(flags)}")
+    r = np.ascontiguousarray(np.atleast_2d(r), dtype=np.float64)
+    tdat = np.ascontiguousarray(np.atleast_2d(tdat), dtype=np.float64)
+    if r.shape[-1] != 3 or tdat.shape[0] not in (1, r.shape[0]):
+        raise ValueError(f"earth_field_accel_batch: r {r.shape} and tdat {tdat.shape} do not match")
+    out = np.empty(r.shape)
+    _batch(r, tdat, np.ascontiguousarray(params, dtype=np.float64), *flags[part], out)
+    return out
