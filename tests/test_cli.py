@@ -182,3 +182,39 @@ def test_bench_short(capsys):
     status, out, err = _run(["bench", "--duration", "1h", "--no-heyoka"], capsys)
     assert status == 0, err
     assert "tqdyn dd" in out and "tqdyn float64" in out and "dd / float64" in out
+
+
+def test_forces_budget_orders(tmp_path, capsys):
+    """`tqdyn forces` on the full model: every term present, with the known
+    orders at r ~ 1e8 m (first principles: GM/r^2 = 4.0e-2; lunar tidal
+    2 GM_m r/d^3 ~ 1e-5; solar ~ 2 GM_s r/AU^3 ~ 6e-6; J2: 1.5 J2 GM R^2/r^4
+    ~ 5e-7; Schwarzschild 3 GM^2/(c^2 r^3) = 5.3e-12 ...), and the plot."""
+    png = tmp_path / "budget.png"
+    status, out, err = _run(["forces", "--duration", "1d", "--every", "3600", "--plot", str(png)], capsys)
+    assert status == 0, err
+    rows = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) >= 3 and parts[1][0].isdigit():
+            rows[parts[0]] = float(parts[1])
+    expected = {  # max |a| [m/s^2]: (low, high), factor-3 brackets around the first-principles orders
+        "earth_monopole": (3.9e-2, 4.1e-2), "third_body:moon": (3e-6, 3e-5), "third_body:sun": (2e-6, 2e-5),
+        "earth_field": (2e-7, 1e-6), "relativity": (3e-12, 5e-11), "solid_tides": (1e-12, 3e-11),
+        "ocean_tides": (1e-13, 1e-11), "moon_field": (3e-14, 3e-12), "solid_pole_tide": (3e-14, 3e-12),
+        "ocean_pole_tide": (3e-15, 3e-13), "sun_j2": (1e-18, 1e-15), "earth_field_indirect": (3e-12, 5e-11),
+    }
+    for name, (low, high) in expected.items():
+        assert low <= rows[name] <= high, (name, rows[name])
+    assert "atmospheric_tides" in out and "NOT modelled" in out
+    assert png.exists() and png.stat().st_size > 10_000
+
+
+def test_data_limits_are_bad_input(tmp_path, capsys):
+    """A date outside the lunar kernel / ephemeris span, a missing ephemeris
+    file: exit 2 with a line naming the limit, before any output."""
+    status, _, err = _run(["run", "--set", "scenario.epoch_utc=2052-06-01T00:00:00", "-o", str(tmp_path / "x.h5")],
+                          capsys)
+    assert status == 2 and "span" in err and len(err.strip().splitlines()) == 1
+    status, _, err = _run(["run", "--set", "forces.ephemeris=/nope/de440.bsp", "-o", str(tmp_path / "x.h5")], capsys)
+    assert status == 2 and "/nope/de440.bsp" in err
+    assert _no_files(tmp_path) == []

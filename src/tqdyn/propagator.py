@@ -36,7 +36,7 @@ from .precision import add, ld, mul, mp_from_dd, st
 from .timescales import Epoch
 
 __all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs", "warm_up",
-           "two_body_energy"]
+           "two_body_energy", "check_inputs"]
 
 PRECISIONS = ("dd", "float64")
 _DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
@@ -243,6 +243,19 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
         with mpmath.workdps(60):
             result.energy_rel_drift = np.array([float((b - a) / abs(a)) for a, b in zip(e0, e1)])
     return result
+
+
+def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:
+    """Build the scenario's force model and evaluate its time-only inputs at
+    the first and last instants, so that data limits (a date outside the
+    ephemeris, EOP or lunar-kernel span, a missing file, a degree above what
+    a file holds) raise ValueError / FileNotFoundError before any
+    propagation or output starts.  Returns the model."""
+    model = build_force_model(scenario.forces) if model is None else model
+    epoch = Epoch.from_utc(scenario.epoch_utc)
+    t_end = float(scenario.run.duration_s)
+    model.precompute(epoch, np.array([0.0, t_end]), np.zeros(2))
+    return model
 
 
 def _workspace(y0_dd, precision):

@@ -73,7 +73,8 @@ def _tide_evaluator(field):
 def split_terms(model: ForceModel) -> list[tuple[str, str, str, object]]:
     """(name, description, source, evaluator) for each term of ``model``;
     an Earth field with tide models is split into its static part and one
-    entry per tide model (its coefficient corrections alone).  An evaluator
+    entry per tide model (its coefficient corrections alone), point-mass
+    third bodies into one entry per body.  An evaluator
     maps (epoch, t_hi (n_t,), t_lo, r (n_t, n_sat, 3), v) to |a| (n_t, n_sat)."""
     out = []
     for term in model.terms:
@@ -87,6 +88,10 @@ def split_terms(model: ForceModel) -> list[tuple[str, str, str, object]]:
                 label = getattr(provider, "name", type(provider).__name__)
                 out.append((label, getattr(provider, "description", label), getattr(provider, "source", ""),
                             _tide_evaluator(one)))
+        elif hasattr(term, "split") and len(term.names) > 1:
+            for one in term.split():
+                out.append((f"{term.name}:{one.names[0]}", term.description, term.source,
+                            _model_evaluator(ForceModel([one]))))
         else:
             out.append((term.name, term.description, term.source, _model_evaluator(ForceModel([term]))))
     return out

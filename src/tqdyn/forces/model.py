@@ -100,8 +100,14 @@ class ForceModel:
 
 
 def describe_terms() -> list[tuple[str, str, str]]:
-    """(name, description, source) of every force term tqdyn can evaluate."""
-    return [(cls.name, cls.description, cls.source) for cls in _TERM_SLOT]
+    """(name, description, source) of every force term tqdyn can evaluate,
+    including the tide models summed into the Earth field."""
+    from .ocean_tides import OceanTides
+    from .pole_tides import OceanPoleTide, SolidPoleTide
+    from .solid_tides import SolidTides
+
+    classes = list(_TERM_SLOT) + [SolidTides, OceanTides, SolidPoleTide, OceanPoleTide]
+    return [(cls.name, cls.description, cls.source) for cls in classes]
 
 
 def _ephemeris(name_or_path: str):

@@ -64,6 +64,17 @@ def third_bodies_accel(rx, ry, rz, vx, vy, vz, tdat, params):
 
 
 @dataclass(frozen=True)
+class _OneBody:
+    """Position provider of body k of a multi-body provider: (..., 1, 3)."""
+
+    position: Callable
+    k: int
+
+    def __call__(self, epoch, t_hi, t_lo):
+        return np.asarray(self.position(epoch, t_hi, t_lo))[..., self.k:self.k + 1, :]
+
+
+@dataclass(frozen=True)
 class ThirdBodies:
     """Point-mass perturbations of a list of bodies.
 
@@ -89,6 +100,11 @@ class ThirdBodies:
     def params(self) -> np.ndarray:
         """[n, gm_1, ..., gm_n] float64."""
         return np.array([len(self.gms), *self.gms], dtype=np.float64)
+
+    def split(self) -> tuple["ThirdBodies", ...]:
+        """One single-body term per body (force budgets per body)."""
+        return tuple(ThirdBodies(names=(n,), gms=(g,), position=_OneBody(self.position, k), source=self.source)
+                     for k, (n, g) in enumerate(zip(self.names, self.gms)))
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         """Body positions at t_hi + t_lo [s TDB since epoch], flattened to
