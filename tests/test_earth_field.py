@@ -208,9 +208,10 @@ def test_params_and_tdat_layout():
     f = EarthField(rotation=_spin_rotation)
     m = egm2008(12)
     p = f.params()
-    assert p.dtype == np.float64 and p.shape == (5 + 2 * 169,)
+    assert p.dtype == np.float64 and p.shape == (5 + 2 * 169 + 1,)  # + the extended-degree-2 flag
+    assert p[-1] == 0.0
     assert list(p[:5]) == [m.gm, m.radius, 12.0, 12.0, -1.0]
-    assert np.array_equal(p[5:174], m.C.ravel()) and np.array_equal(p[174:], m.S.ravel())
+    assert np.array_equal(p[5:174], m.C.ravel()) and np.array_equal(p[174:343], m.S.ravel())
     assert f.n_tdat == 9 and f.model.tide_system == "tide_free" and "tide_free" in f.source
     t = np.arange(12.0).reshape(3, 4) * 100.0
     td = f.precompute(EPOCH, t, 0.25)

@@ -289,9 +289,13 @@ class ForcesConfig:
     ``earth_monopole``: Earth point mass; ``gm_earth`` [m^3/s^2] (> 0),
     default EGM2008 3.986004415e14.
     ``earth_degree``: degree and order of the Earth's static field EGM2008
-    (0 = off, 2..90).
+    (0 = off, 2..90); ``earth_degree2_extended``: its degree-2 part (J2,
+    ~5e-7 m/s^2, with the degree-2 tides) in extended precision.
     ``ephemeris``: "de421" (shipped) or the path of a JPL DE .bsp file.
-    ``third_bodies``: point-mass bodies, a subset of THIRD_BODIES.
+    ``third_bodies``: point-mass bodies, a subset of THIRD_BODIES;
+    ``third_bodies_extended``: those of them evaluated in the propagation's
+    extended precision (default Moon and Sun: their float64 round-off,
+    ~1e-21 m/s^2, would move the orbits by ~1e-12 m per day).
     ``solid_tides``: IERS 2010 solid Earth tides (steps 1 and 2).
     ``ocean_tides_degree``: FES2004 ocean tides to this degree (0 = off).
     ``pole_tides``: solid Earth and ocean pole tides.
@@ -309,8 +313,10 @@ class ForcesConfig:
     earth_monopole: bool = True
     gm_earth: Decimal = Decimal(GM_EARTH_EGM2008)
     earth_degree: int = 0
+    earth_degree2_extended: bool = True
     ephemeris: str = "de421"
     third_bodies: tuple[str, ...] = ()
+    third_bodies_extended: tuple[str, ...] = ("moon", "sun")
     solid_tides: bool = False
     ocean_tides_degree: int = 0
     pole_tides: bool = False
@@ -322,7 +328,8 @@ class ForcesConfig:
     eop: bool = True
 
     def __post_init__(self) -> None:
-        for key in ("earth_monopole", "solid_tides", "pole_tides", "sun_j2", "relativity", "earth_field_indirect", "eop"):
+        for key in ("earth_monopole", "earth_degree2_extended", "solid_tides", "pole_tides", "sun_j2", "relativity",
+                    "earth_field_indirect", "eop"):
             _require(isinstance(getattr(self, key), bool), f"forces.{key}", getattr(self, key), "is not a boolean", "true or false")
         _set(self, "gm_earth", _to_decimal(self.gm_earth, "forces.gm_earth"))
         _require(self.gm_earth > 0, "forces.gm_earth", self.gm_earth, "is not positive", "gm_earth > 0 m^3/s^2")
@@ -338,6 +345,10 @@ class ForcesConfig:
         for body in bodies:
             _require(body in THIRD_BODIES, "forces.third_bodies", body, "is not a known body", _one_of(THIRD_BODIES))
         _require(len(set(bodies)) == len(bodies), "forces.third_bodies", list(bodies), "lists a body twice", "each body once")
+        ext = tuple(self.third_bodies_extended)
+        _set(self, "third_bodies_extended", ext)
+        for body in ext:
+            _require(body in THIRD_BODIES, "forces.third_bodies_extended", body, "is not a known body", _one_of(THIRD_BODIES))
         _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
         _require(not self.earth_field_indirect or self.earth_degree >= 2, "forces.earth_field_indirect", True,
                  "needs the Earth's non-central field", "false, or earth_degree >= 2")
@@ -450,8 +461,10 @@ class Scenario:
         b = lambda x: "true" if x else "false"  # noqa: E731
         out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}",
                 f"gm_earth = {_toml_dec(f.gm_earth)}  # m^3/s^2", f"earth_degree = {f.earth_degree}",
+                f"earth_degree2_extended = {b(f.earth_degree2_extended)}",
                 f"ephemeris = {_toml_str(f.ephemeris)}",
                 "third_bodies = [" + ", ".join(_toml_str(x) for x in f.third_bodies) + "]",
+                "third_bodies_extended = [" + ", ".join(_toml_str(x) for x in f.third_bodies_extended) + "]",
                 f"solid_tides = {b(f.solid_tides)}", f"ocean_tides_degree = {f.ocean_tides_degree}",
                 f"pole_tides = {b(f.pole_tides)}", f"moon_degree = {f.moon_degree}",
                 f"moon_libration = {_toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
@@ -499,8 +512,8 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH},
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
-    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "ephemeris": _STR,
-               "third_bodies": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
+    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
+               "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
                "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
                "earth_field_indirect": _BOOL, "eop": _BOOL},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM},

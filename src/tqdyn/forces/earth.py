@@ -44,6 +44,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jit  # noqa: F401  (package-wide kernel cache)
+from ..precision import add, const, div, mul, sqrt, sub
 from .gravity_models import GravityModel, egm2008
 from .spherical_harmonics import NMAX_SH, sh_accel_flat
 
@@ -130,8 +131,12 @@ class EarthField:
         Degree nt of the summed corrections (default: the largest degree of
         the providers; -1 if there are none).
 
+    extended_degree2 : bool
+        Leave degree 2 (static + corrections) to :func:`degree2_accel_ext`,
+        which the model evaluates in extended precision.
+
     Compiled-model interface: ``params()`` = [gm, radius, N, M, nt,
-    C (N+1)^2 row-major, S (N+1)^2 row-major]; time-only inputs
+    C (N+1)^2 row-major, S (N+1)^2 row-major, extended_degree2 (1.0/0.0)]; time-only inputs
     (``n_tdat`` = 9 + (nt+1)(nt+2) per instant) = [T_ITRS_GCRS row-major
     (9), dC and dS as packed lower triangles ((nt+1)(nt+2)/2 each, dC_nm
     at n (n+1)/2 + m)]; kernel :func:`earth_field_accel`.
@@ -143,6 +148,7 @@ class EarthField:
     tides: tuple = ()
     rotation: Callable | None = None
     tide_degree: int | None = None
+    extended_degree2: bool = False
     name: str = field(default="earth_field", init=False)
     description: str = field(
         default="Earth spherical harmonics, degrees 2..N (+ tidal coefficient corrections), ITRS via T_ITRS_GCRS",
@@ -207,7 +213,7 @@ class EarthField:
         radius [m], the fully-normalised coefficients row-major)."""
         m = self.model
         return np.concatenate([[m.gm, m.radius, self.degree, self.order, self.tide_degree],
-                               m.C.ravel(), m.S.ravel()]).astype(np.float64)
+                               m.C.ravel(), m.S.ravel(), [float(self.extended_degree2)]]).astype(np.float64)
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         """Time-only inputs at t = t_hi + t_lo [s TDB since epoch]: float64
@@ -268,15 +274,81 @@ def _earth_field(rx, ry, rz, tdat, params, static, tides):
     dS = tdat[N_ROT + lt:N_ROT + 2 * lt]
     if not tides:
         nt = -1
+    # degree 2 evaluated elsewhere (in extended precision, degree2_accel_ext)?
+    nmin = 3 if params[PARAM_HEADER + 2 * L] != 0.0 else 2
     # r_ITRS = T r
     x = tdat[0] * rx + tdat[1] * ry + tdat[2] * rz
     y = tdat[3] * rx + tdat[4] * ry + tdat[5] * rz
     z = tdat[6] * rx + tdat[7] * ry + tdat[8] * rz
-    ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, 0, nt, 2)
+    ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, 0, nt, nmin)
     # a_GCRS = T^T a_ITRS
     return (tdat[0] * ax + tdat[3] * ay + tdat[6] * az,
             tdat[1] * ax + tdat[4] * ay + tdat[7] * az,
             tdat[2] * ax + tdat[5] * ay + tdat[8] * az)
+
+
+@njit(cache=True)
+def degree2_accel_ext(rx, ry, rz, tdat, params):
+    """Degree-2 part of the Earth field (static + tidal corrections) in the
+    number type of r (generic: dd tuples or float64), GCRS [m/s^2].
+
+    Closed form: with the unnormalised C20u = sqrt(5) C20, C21u =
+    sqrt(5/3) C21, C22u = sqrt(5/12) C22 (same for S), the degree-2
+    potential is V2 = GM R^2 Q / r^5 with the traceless quadratic form
+    Q = x^T M x, M = [[-C20u/2 + 3 C22u, 3 S22u, 3/2 C21u],
+    [3 S22u, -C20u/2 - 3 C22u, 3/2 S21u], [3/2 C21u, 3/2 S21u, C20u]]
+    (ITRS), so a = GM R^2 (2 M x / r^5 - 5 Q x / r^7).  Used by the model
+    when ``extended_degree2`` is set (J2 is ~5e-7 m/s^2 at 1e5 km: its
+    float64 round-off would move the orbit by ~5e-14 m per day).
+    """
+    gm, radius = params[0], params[1]
+    ld = int(params[2]) + 1
+    L = ld * ld
+    nt = int(params[4])
+    c20, c21, c22 = params[PARAM_HEADER + 2 * ld], params[PARAM_HEADER + 2 * ld + 1], params[PARAM_HEADER + 2 * ld + 2]
+    s21, s22 = params[PARAM_HEADER + L + 2 * ld + 1], params[PARAM_HEADER + L + 2 * ld + 2]
+    # static coefficients plus the tidal corrections, summed in the number type of r
+    one = const(1.0, 0.0, rx)
+    c20, c21, s21, c22, s22 = mul(one, c20), mul(one, c21), mul(one, s21), mul(one, c22), mul(one, s22)
+    if nt >= 2:  # packed corrections: dC_nm at n (n+1)/2 + m
+        lt = (nt + 1) * (nt + 2) // 2
+        c20 = add(c20, tdat[N_ROT + 3])
+        c21 = add(c21, tdat[N_ROT + 4])
+        c22 = add(c22, tdat[N_ROT + 5])
+        s21 = add(s21, tdat[N_ROT + lt + 4])
+        s22 = add(s22, tdat[N_ROT + lt + 5])
+    # unnormalised coefficients and M
+    u20 = mul(sqrt(mul(one, 5.0)), c20)
+    k21 = sqrt(div(mul(one, 5.0), 3.0))
+    k22 = sqrt(div(mul(one, 5.0), 12.0))
+    u21, v21, u22, v22 = mul(k21, c21), mul(k21, s21), mul(k22, c22), mul(k22, s22)
+    m_xx = sub(mul(u22, 3.0), mul(u20, 0.5))
+    m_yy = sub(mul(u20, -0.5), mul(u22, 3.0))
+    m_zz = u20
+    m_xy = mul(v22, 3.0)
+    m_xz = mul(u21, 1.5)
+    m_yz = mul(v21, 1.5)
+    # r_ITRS = T r (T float64, r generic)
+    x = add(add(mul(rx, tdat[0]), mul(ry, tdat[1])), mul(rz, tdat[2]))
+    y = add(add(mul(rx, tdat[3]), mul(ry, tdat[4])), mul(rz, tdat[5]))
+    z = add(add(mul(rx, tdat[6]), mul(ry, tdat[7])), mul(rz, tdat[8]))
+    mx = add(add(mul(x, m_xx), mul(y, m_xy)), mul(z, m_xz))
+    my = add(add(mul(x, m_xy), mul(y, m_yy)), mul(z, m_yz))
+    mz = add(add(mul(x, m_xz), mul(y, m_yz)), mul(z, m_zz))
+    q = add(add(mul(x, mx), mul(y, my)), mul(z, mz))
+    r2 = add(add(mul(x, x), mul(y, y)), mul(z, z))
+    r5 = mul(mul(r2, r2), sqrt(r2))
+    gmr2 = mul(mul(mul(one, gm), radius), radius)
+    # a = (2 GM R^2 / r^5) M x - (5 GM R^2 Q / r^7) x
+    s1 = div(mul(gmr2, 2.0), r5)
+    s2 = div(mul(mul(gmr2, 5.0), q), mul(r5, r2))
+    ax = sub(mul(s1, mx), mul(s2, x))
+    ay = sub(mul(s1, my), mul(s2, y))
+    az = sub(mul(s1, mz), mul(s2, z))
+    # a_GCRS = T^T a_ITRS
+    return (add(add(mul(ax, tdat[0]), mul(ay, tdat[3])), mul(az, tdat[6])),
+            add(add(mul(ax, tdat[1]), mul(ay, tdat[4])), mul(az, tdat[7])),
+            add(add(mul(ax, tdat[2]), mul(ay, tdat[5])), mul(az, tdat[8])))
 
 
 @njit(cache=True)

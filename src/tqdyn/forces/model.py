@@ -29,12 +29,13 @@ from numba import njit
 
 from ..precision import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
-from .earth import EarthField, earth_field_accel
+from .earth import PARAM_HEADER as _EF_HEADER
+from .earth import EarthField, degree2_accel_ext, earth_field_accel
 from .earth_indirect import EarthFieldIndirect, earth_field_indirect_accel
 from .moon import MoonField, moon_field_accel
 from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
-from .third_body import ThirdBodies, third_bodies_accel
+from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
 
@@ -160,7 +161,7 @@ def build_force_model(forces) -> ForceModel:
     rotation = None if forces.eop else _no_eop_rotation
     if forces.earth_degree:
         terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, rotation),
-                                rotation=rotation))
+                                rotation=rotation, extended_degree2=forces.earth_degree2_extended))
     if forces.earth_field_indirect:
         from ..ephemeris import planetary_gm
 
@@ -172,7 +173,7 @@ def build_force_model(forces) -> ForceModel:
     if forces.third_bodies:
         from .third_body_ephemeris import third_bodies
 
-        terms.append(third_bodies(eph, forces.third_bodies))
+        terms.append(third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended))
     if forces.moon_degree:
         terms.append(MoonField(degree=forces.moon_degree, libration=forces.moon_libration, ephemeris=eph))
     if forces.sun_j2:
@@ -197,6 +198,20 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
         o = layout[SLOT_EARTH_MONOPOLE, 1]
         gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
         ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
+    if layout[SLOT_THIRD_BODY, 0]:
+        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+        n = int(params[o])
+        for k in range(n):
+            if params[o + 1 + n + k] != 0.0:  # this body in extended precision
+                gx, gy, gz = third_body_accel_ext(x, y, z, tdat[c + 3 * k], tdat[c + 3 * k + 1],
+                                                  tdat[c + 3 * k + 2], params[o + 1 + k])
+                ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
+    if layout[SLOT_EARTH_FIELD, 0]:
+        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
+        ld = int(params[o + 2]) + 1
+        if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 in extended precision
+            gx, gy, gz = degree2_accel_ext(x, y, z, tdat[c:], params[o:])
+            ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
     # perturbations: float64 kernels at the float64-rounded state (~1e-16
     # relative); each has the signature (rx, ry, rz, vx, vy, vz, tdat, params)
     # -> (ax, ay, az) on its own slices of tdat and params

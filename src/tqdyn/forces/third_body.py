@@ -33,7 +33,9 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel"]
+from ..precision import add, const, div, mul, neg, sqrt, sub
+
+__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel", "third_body_accel_ext"]
 
 
 @njit(cache=True)
@@ -52,14 +54,36 @@ def third_body_accel(rx, ry, rz, sx, sy, sz, gm):
 
 
 @njit(cache=True)
+def third_body_accel_ext(rx, ry, rz, sx, sy, sz, gm):
+    """:func:`third_body_accel` in the number type of r (generic: dd tuples
+    or float64): for extended-precision evaluation of the large third-body
+    terms (Moon ~1e-5, Sun ~6e-6 m/s^2, whose float64 round-off, ~1e-21
+    m/s^2, accumulates to ~1e-12 m per day of orbit).  s, gm: float64."""
+    sx, sy, sz = const(sx, 0.0, rx), const(sy, 0.0, rx), const(sz, 0.0, rx)
+    s2 = add(add(mul(sx, sx), mul(sy, sy)), mul(sz, sz))
+    q = div(add(add(mul(rx, sub(rx, mul(sx, 2.0))), mul(ry, sub(ry, mul(sy, 2.0)))),
+                mul(rz, sub(rz, mul(sz, 2.0)))), s2)
+    w = sqrt(add(q, 1.0))
+    f = div(mul(q, add(add(mul(q, q), mul(q, 3.0)), 3.0)), add(mul(w, mul(w, w)), 1.0))
+    dx, dy, dz = sub(rx, sx), sub(ry, sy), sub(rz, sz)
+    d2 = add(add(mul(dx, dx), mul(dy, dy)), mul(dz, dz))
+    k = neg(div(gm, mul(d2, sqrt(d2))))
+    return (mul(k, add(rx, mul(f, sx))), mul(k, add(ry, mul(f, sy))), mul(k, add(rz, mul(f, sz))))
+
+
+@njit(cache=True)
 def third_bodies_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Sum of the point-mass terms of all bodies (the perturbation-kernel
     signature of :mod:`tqdyn.forces.model`): tdat = body positions (3 n,) [m]
-    at this instant, params = [n, gm_1, ..., gm_n].  float64, m/s^2."""
+    at this instant, params = [n, gm_1, ..., gm_n, ext_1, ..., ext_n]; the
+    bodies with ext_k != 0 are skipped here (evaluated in extended precision
+    by the model).  float64, m/s^2."""
     ax, ay, az = 0.0, 0.0, 0.0
-    for k in range(int(params[0])):
-        gx, gy, gz = third_body_accel(rx, ry, rz, tdat[3 * k], tdat[3 * k + 1], tdat[3 * k + 2], params[1 + k])
-        ax, ay, az = ax + gx, ay + gy, az + gz
+    n = int(params[0])
+    for k in range(n):
+        if params[1 + n + k] == 0.0:  # bodies flagged extended are evaluated by third_body_accel_ext
+            gx, gy, gz = third_body_accel(rx, ry, rz, tdat[3 * k], tdat[3 * k + 1], tdat[3 * k + 2], params[1 + k])
+            ax, ay, az = ax + gx, ay + gy, az + gz
     return ax, ay, az
 
 
@@ -82,13 +106,17 @@ class ThirdBodies:
     (epoch, t_hi, t_lo) -> (..., n_bodies, 3) float64 geocentric GCRS
     positions [m]; source: where the positions and GMs come from.
     Parameters handed to the compiled model: [n, gm_1, ..., gm_n];
-    time-only inputs: the 3 n coordinates.
+    time-only inputs: the 3 n coordinates.  extended: names of the bodies
+    whose term is evaluated in the propagation's number type (dd) instead of
+    float64 -- worth it for the Moon and the Sun, whose float64 round-off
+    (~1e-21 m/s^2) moves a 1e8 m orbit by ~1e-12 m per day.
     """
 
     names: tuple[str, ...]
     gms: tuple[float, ...]
     position: Callable
     source: str = "user-supplied positions"
+    extended: tuple[str, ...] = ()
     name: str = field(default="third_body", init=False)
     description: str = field(default="point-mass third bodies, direct + indirect term (Battin)", init=False)
 
@@ -98,12 +126,18 @@ class ThirdBodies:
         return 3 * len(self.names)
 
     def params(self) -> np.ndarray:
-        """[n, gm_1, ..., gm_n] float64."""
-        return np.array([len(self.gms), *self.gms], dtype=np.float64)
+        """[n, gm_1, ..., gm_n, ext_1, ..., ext_n] float64 (ext_k = 1.0 for
+        a body evaluated in extended precision)."""
+        unknown = set(self.extended) - set(self.names)
+        if unknown:
+            raise ValueError(f"third bodies: extended names {sorted(unknown)} are not among {self.names}")
+        return np.array([len(self.gms), *self.gms, *(float(n in self.extended) for n in self.names)],
+                        dtype=np.float64)
 
     def split(self) -> tuple["ThirdBodies", ...]:
         """One single-body term per body (force budgets per body)."""
-        return tuple(ThirdBodies(names=(n,), gms=(g,), position=_OneBody(self.position, k), source=self.source)
+        return tuple(ThirdBodies(names=(n,), gms=(g,), position=_OneBody(self.position, k), source=self.source,
+                                 extended=tuple(x for x in self.extended if x == n))
                      for k, (n, g) in enumerate(zip(self.names, self.gms)))
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:

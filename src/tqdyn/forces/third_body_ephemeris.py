@@ -37,11 +37,12 @@ class EphemerisPositions:
         return pos
 
 
-def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES) -> ThirdBodies:
+def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=()) -> ThirdBodies:
     """Third-body term for ``names`` (default: all of
     :data:`tqdyn.ephemeris.BODIES`) with positions from ``ephemeris``
     (``None``: the shipped DE421, :func:`tqdyn.ephemeris.default_ephemeris`)
-    and GMs [m^3/s^2] from ``data/gm_de431.tpc``.
+    and GMs [m^3/s^2] from ``data/gm_de431.tpc``; the bodies named in
+    ``extended`` (and in ``names``) are evaluated in extended precision.
 
     Returns a ThirdBodies (parameters [n, gm_1..gm_n]; time-only inputs: the
     3 n geocentric GCRS coordinates [m] per instant).  Raises ValueError for
@@ -63,4 +64,5 @@ def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES) -> ThirdBodie
         position=EphemerisPositions(eph, names),
         source=(f"JPL {eph.name} ({eph.path}) via jplephem; GM: tqdyn/data/gm_de431.tpc "
                 f"(DE430/DE431; planets as systems at their barycenters)"),
+        extended=tuple(n for n in names if n in extended),
     )
