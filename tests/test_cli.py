@@ -179,7 +179,7 @@ def test_info(capsys):
 
 def test_bench_short(capsys):
     """The benchmark command runs (short span; the 90-day numbers are in the README)."""
-    status, out, err = _run(["bench", "--duration", "1h", "--no-heyoka"], capsys)
+    status, out, err = _run(["bench", "--duration", "1h", "--no-heyoka"], capsys)  # both benchmarks
     assert status == 0, err
     assert "tqdyn dd" in out and "tqdyn float64" in out and "dd / float64" in out
 

@@ -30,7 +30,13 @@ from . import propagator
 from .precision import mp_from_dd
 from .scenario import load_scenario
 
-__all__ = ["kepler_benchmark", "format_report"]
+__all__ = ["kepler_benchmark", "format_report", "force_model_benchmark", "format_force_report"]
+
+#: The reduced model of the heyoka comparison: Earth 12x12 + Sun + Moon
+#: (point masses), no EOP (heyoka's Earth rotation has none).
+REDUCED = ["forces.earth_degree=12", "forces.third_bodies=sun,moon", "forces.solid_tides=false",
+           "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.moon_degree=0", "forces.sun_j2=false",
+           "forces.relativity=false", "forces.earth_field_indirect=false", "forces.eop=false"]
 
 
 def _analytic_final(scenario) -> np.ndarray:
@@ -122,4 +128,72 @@ def format_report(report: dict) -> str:
     elif "heyoka" in report:
         lines.append(f"heyoka real128: {report['heyoka']}")
     lines.append(f"peak resident memory: {report['peak_rss_mb']:.0f} MB")
+    return "\n".join(lines)
+
+
+def _timed_run(scen, precision):
+    """Propagate after a one-step warm-up (JIT, data files, caches); wall
+    time [s], peak resident memory of the process so far [MB], result."""
+    import dataclasses
+
+    model = propagator.check_inputs(scen)
+    one_step = dataclasses.replace(scen, run=dataclasses.replace(scen.run, duration_s=scen.integrator.step_s))
+    propagator.propagate(one_step, precision=precision, model=model)
+    t0 = time.perf_counter()
+    res = propagator.propagate(scen, precision=precision, model=model)
+    wall = time.perf_counter() - t0
+    return wall, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, res
+
+
+def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
+    """Full force model (tianqin scenario) in dd and float64, and the
+    reduced model (Earth 12x12 + Sun + Moon) in dd beside heyoka real128
+    (EGM2008 12x12 + ELP2000 + VSOP2013) when available; wall times [s]
+    (including the per-chunk time-only inputs), peak memory [MB]."""
+    report = {"duration_s": None, "runs": {}}
+    full = load_scenario("tianqin", [f"run.duration={duration}"])
+    reduced = load_scenario("tianqin", [f"run.duration={duration}"] + REDUCED)
+    report["duration_s"] = float(full.run.duration_s)
+    report["n_steps"] = full.n_steps
+    for name, scen, precision in (("full model, dd", full, "dd"), ("full model, float64", full, "float64"),
+                                  ("reduced model, dd", reduced, "dd")):
+        wall, rss, res = _timed_run(scen, precision)
+        report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss}
+        if name == "reduced model, dd":
+            report["reduced_final"] = res.y_final
+    if heyoka:
+        try:
+            from . import _heyoka_peer
+            peer = getattr(_heyoka_peer, "propagate_reduced_grid")
+        except (ImportError, AttributeError) as exc:
+            report["heyoka"] = f"skipped: {exc}"
+        else:
+            from .timescales import Epoch
+
+            y0 = propagator.initial_state(reduced)
+            out = peer((y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]),
+                       Epoch.from_utc(reduced.epoch_utc).tdb, float(reduced.integrator.step_s), reduced.n_steps)
+            r_final = mp_from_dd(np.stack([out["r_hi"][-1], out["r_lo"][-1]], axis=-1))
+            report["runs"]["reduced model, heyoka real128"] = {
+                "wall_s": out["wall_s"], "compile_s": out["setup_s"],
+                "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
+            report["reduced_dd_minus_heyoka_m"] = _max_dist(mp_from_dd(report["reduced_final"][:, 0:3]), r_final)
+    report.pop("reduced_final", None)
+    return report
+
+
+def format_force_report(report: dict) -> str:
+    """Human-readable table of a :func:`force_model_benchmark` report."""
+    lines = [f"force-model benchmark: 3 TianQin satellites, {report['duration_s'] / 86400:g} days at 50 s "
+             f"({report['n_steps']} steps), after compilation",
+             f"{'run':<32} {'wall [s]':>9} {'peak RSS [MB]':>14}"]
+    for name, r in report["runs"].items():
+        lines.append(f"{name:<32} {r['wall_s']:>9.2f} {r['peak_rss_mb']:>14.0f}")
+    runs = report["runs"]
+    if "reduced model, heyoka real128" in runs:
+        ratio = runs["reduced model, heyoka real128"]["wall_s"] / runs["reduced model, dd"]["wall_s"]
+        lines.append(f"heyoka real128 / tqdyn dd (reduced model): {ratio:.2f}; final positions differ by "
+                     f"{report['reduced_dd_minus_heyoka_m']:.2e} m (ELP2000/VSOP2013 vs DE421, Earth rotation models)")
+    elif "heyoka" in report:
+        lines.append(f"heyoka: {report['heyoka']}")
     return "\n".join(lines)

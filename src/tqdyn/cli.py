@@ -229,17 +229,24 @@ def info():
 @click.option("--duration", default="90d", show_default=True, help="Propagated span.")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s].")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
-def bench(duration, step, no_heyoka):
-    """Kepler benchmark: 3 TianQin satellites, Earth monopole: tqdyn dd vs
-    float64 vs heyoka real128 (optional) on the same output grid."""
+@click.option("--model", "which", type=click.Choice(["kepler", "full", "all"]), default="all", show_default=True,
+              help="kepler: monopole only; full: the full force model (and the reduced model vs heyoka).")
+def bench(duration, step, no_heyoka, which):
+    """Benchmarks: Kepler (3 TianQin satellites, Earth monopole: tqdyn dd vs
+    float64 vs heyoka real128 on the same grid) and the force model (full
+    model dd / float64, reduced model dd vs heyoka real128)."""
     from . import bench as _bench
     from .scenario import ScenarioError
 
     try:
-        report = _bench.kepler_benchmark(duration=duration, step=step, heyoka=not no_heyoka)
+        if which in ("kepler", "all"):
+            click.echo(_bench.format_report(_bench.kepler_benchmark(duration=duration, step=step,
+                                                                    heyoka=not no_heyoka)))
+        if which in ("full", "all"):
+            click.echo(_bench.format_force_report(_bench.force_model_benchmark(duration=duration,
+                                                                               heyoka=not no_heyoka)))
     except (ScenarioError, ValueError) as exc:
         _fail(str(exc))
-    click.echo(_bench.format_report(report))
 
 
 def main(argv=None):
