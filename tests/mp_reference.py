@@ -72,3 +72,15 @@ def mp_dp87(y0: list, h: str, n_steps: int, *, a_rows=tab.A_CORRECTED, b_row=tab
                 K.append(f([y[q] + mpmath.fsum(c * K[j][q] for j, c in ha[i]) for q in range(6)]))
             y = [y[q] + mpmath.fsum(c * K[j][q] for j, c in hb) for q in range(6)]
         return y
+
+
+def third_body_literal(r, s, gm, dps: int = 50) -> list:
+    """Geocentric third-body acceleration written literally, -GM (d/|d|^3 +
+    s/|s|^3) with d = r - s, in mpmath at ``dps`` digits [m/s^2]."""
+    with mpmath.workdps(dps):
+        r = [mpf(x) for x in r]
+        s = [mpf(x) for x in s]
+        d = [a - b for a, b in zip(r, s)]
+        nd = mpmath.sqrt(sum(x * x for x in d))
+        ns = mpmath.sqrt(sum(x * x for x in s))
+        return [-gm * (dd / nd**3 + ss / ns**3) for dd, ss in zip(d, s)]

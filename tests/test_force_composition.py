@@ -25,6 +25,8 @@ from tqdyn.forces.third_body import ThirdBodies, third_body_accel
 from tqdyn.precision import mp_from_dd
 from tqdyn.scenario import load_scenario
 
+from mp_reference import third_body_literal
+
 GM_MOON = 4.9028000661637961e12  # m^3/s^2 (DE430, gm_de431.tpc)
 GM_SUN = 1.32712440041939400e20  # m^3/s^2 (DE430)
 R_MOON = 3.844e8  # m, mean Earth-Moon distance
@@ -38,16 +40,6 @@ def _moon_position(epoch, t_hi, t_lo):
     inc = math.radians(20.0)
     pos = np.stack([R_MOON * c, R_MOON * s * math.cos(inc), R_MOON * s * math.sin(inc)], axis=-1)
     return pos[..., None, :]
-
-
-def _mp_literal(r, s, gm):
-    with mpmath.workdps(50):
-        r = [mpmath.mpf(x) for x in r]
-        s = [mpmath.mpf(x) for x in s]
-        d = [a - b for a, b in zip(r, s)]
-        nd = mpmath.sqrt(sum(x * x for x in d))
-        ns = mpmath.sqrt(sum(x * x for x in s))
-        return [-gm * (dd / nd**3 + ss / ns**3) for dd, ss in zip(d, s)]
 
 
 def _mp_gradient(r, s, gm, h=mpmath.mpf("1e-3")):
@@ -86,7 +78,7 @@ def test_third_body_accel_vs_mpmath(gm, s):
         r = rng.normal(size=3)
         r *= 1.0e8 / np.linalg.norm(r)
         got = third_body_accel(*r, *s, gm)
-        ref = _mp_literal(r, s, gm)
+        ref = third_body_literal(r, s, gm)
         grad = _mp_gradient(r, s, gm)
         scale = float(mpmath.sqrt(sum(x * x for x in ref)))
         for q in range(3):
@@ -101,7 +93,7 @@ def test_literal_formula_loses_digits_for_the_sun():
     loses ~3 digits for the Sun at 1e5 km; the Battin form does not."""
     r = np.array([6.0e7, -5.0e7, 6.0e7])
     s = np.array([1.2e11, 8.0e10, 3.0e10])
-    ref = np.array([float(x) for x in _mp_literal(r, s, GM_SUN)])
+    ref = np.array([float(x) for x in third_body_literal(r, s, GM_SUN)])
     d = r - s
     naive = -GM_SUN * (d / np.linalg.norm(d) ** 3 + s / np.linalg.norm(s) ** 3)
     battin = np.array(third_body_accel(*r, *s, GM_SUN))

@@ -25,6 +25,8 @@ from tqdyn.precision import mp_from_dd
 from tqdyn.scenario import load_scenario
 from tqdyn.timescales import Epoch
 
+from mp_reference import third_body_literal
+
 ALL_BODIES = '["sun","moon","mercury","venus","mars","jupiter","saturn","uranus","neptune"]'
 
 
@@ -62,12 +64,7 @@ def test_third_body_dd_vs_mpmath(gm, s):
     rdd = [(x, 0.0) for x in r]
     got = third_body_accel_ext(*rdd, *s, gm)
     with mpmath.workdps(50):
-        R = [mpmath.mpf(x) for x in r]
-        S = [mpmath.mpf(x) for x in s]
-        d = [a - b for a, b in zip(R, S)]
-        nd = mpmath.sqrt(sum(x * x for x in d))
-        ns = mpmath.sqrt(sum(x * x for x in S))
-        ref = [-gm * (dd / nd**3 + ss / ns**3) for dd, ss in zip(d, S)]
+        ref = third_body_literal(r, s, gm)
         scale = mpmath.sqrt(sum(x * x for x in ref))
         for q in range(3):
             err = abs(mpmath.mpf(got[q][0]) + mpmath.mpf(got[q][1]) - ref[q]) / scale

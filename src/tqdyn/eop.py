@@ -65,9 +65,11 @@ from typing import NamedTuple
 
 import erfa
 import numpy as np
+
 from numba import njit
 
 from . import _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ._data import read_iers_table
 
 __all__ = [
     "ARCSEC",
@@ -468,13 +470,6 @@ def _parse_tidal_table(text: str, n_coef: int, source: str):
     return np.array(mult, dtype=np.int64), np.array(per), np.array(coef)
 
 
-def _read_iers_table(name: str) -> str:
-    res = importlib.resources.files("tqdyn") / "data" / "iers2010" / name
-    if not res.is_file():
-        raise FileNotFoundError(f"IERS table not found: tqdyn/data/iers2010/{name}")
-    return res.read_text(encoding="utf-8")
-
-
 @functools.lru_cache(maxsize=4)
 def load_tidal_eop_terms(ocean: bool = True, libration: bool = True) -> TidalEOPTerms:
     """Sub-daily EOP correction terms from the shipped IERS 2010 tables.
@@ -492,13 +487,13 @@ def load_tidal_eop_terms(ocean: bool = True, libration: bool = True) -> TidalEOP
     ut_m, ut_c, ut_p = np.zeros((0, 6), np.int64), np.zeros((0, 2)), np.zeros(0)
     src = []
     if ocean:
-        m, p, c = _parse_tidal_table(_read_iers_table("tab8.2ab.txt"), 4, "tab8.2ab.txt")
+        m, p, c = _parse_tidal_table(read_iers_table("tab8.2ab.txt"), 4, "tab8.2ab.txt")
         pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
-        ut_m, ut_p, c = _parse_tidal_table(_read_iers_table("tab8.3ab.txt"), 2, "tab8.3ab.txt")
+        ut_m, ut_p, c = _parse_tidal_table(read_iers_table("tab8.3ab.txt"), 2, "tab8.3ab.txt")
         ut_c = c * 1e-6
         src.append("ocean tides: IERS 2010 Tables 8.2, 8.3 (interp.f)")
     if libration:
-        m, p, c = _parse_tidal_table(_read_iers_table("tab5.1a.txt"), 4, "tab5.1a.txt")
+        m, p, c = _parse_tidal_table(read_iers_table("tab5.1a.txt"), 4, "tab5.1a.txt")
         pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
         src.append("polar-motion libration: IERS 2010 Table 5.1a (PMSDNUT2)")
     return TidalEOPTerms(np.concatenate(pm_m), np.concatenate(pm_c), ut_m, ut_c,

@@ -64,16 +64,17 @@ which the permanent part 4.6e-12), degree 3 4.5e-15, degree 4 (k+)
 from __future__ import annotations
 
 import functools
-import importlib.resources
 import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from numba import njit
 
 from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from .._data import read_iers_table
 from ..constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
 from .tidal_arguments import (
     delaunay_arguments,
@@ -237,26 +238,19 @@ def parse_step2_table(text: str, order: int) -> Step2Table:
                       ip=np.array(ip), op=np.array(op), names=tuple(names))
 
 
-def _data_text(name: str) -> str:
-    path = importlib.resources.files("tqdyn") / "data" / "iers2010" / name
-    if not path.is_file():
-        raise FileNotFoundError(f"tqdyn data file not found: {path}")
-    return path.read_text(encoding="utf-8")
-
-
 @functools.lru_cache(maxsize=1)
 def load_love_numbers() -> LoveNumbers:
     """The shipped TN36 Table 6.3 (``data/iers2010/tab6.3.txt``), parsed once."""
-    return parse_love_numbers(_data_text("tab6.3.txt"))
+    return parse_love_numbers(read_iers_table("tab6.3.txt"))
 
 
 @functools.lru_cache(maxsize=1)
 def load_step2_table() -> Step2Table:
     """The shipped TN36 Tables 6.5b (m = 0), 6.5a (m = 1), 6.5c (m = 2),
     concatenated in that order (21 + 48 + 2 = 71 constituents)."""
-    parts = [parse_step2_table(_data_text("tab6.5b.txt"), 0),
-             parse_step2_table(_data_text("tab6.5a.txt"), 1),
-             parse_step2_table(_data_text("tab6.5c.txt"), 2)]
+    parts = [parse_step2_table(read_iers_table("tab6.5b.txt"), 0),
+             parse_step2_table(read_iers_table("tab6.5a.txt"), 1),
+             parse_step2_table(read_iers_table("tab6.5c.txt"), 2)]
     return Step2Table(order=np.concatenate([p.order for p in parts]),
                       doodson=np.concatenate([p.doodson for p in parts]),
                       ip=np.concatenate([p.ip for p in parts]),
