@@ -178,3 +178,93 @@ def test_several_bodies_match_single():
                   + (both["r_lo"][:, 1] - one["r_lo"][:, 0]))
     # the adaptive step is shared by all bodies, so allow roundoff-level noise
     assert diff.max() < 1e-22
+
+
+# ---------------------------------------------------------------------------
+# reduced force model (EGM2008 12x12 + Moon + Sun): heyoka vs tqdyn
+# ---------------------------------------------------------------------------
+
+#: tqdyn's reduced model: the tianqin scenario with everything but the Earth
+#: field (12x12), the Moon and the Sun switched off, EOP off.
+REDUCED = ["forces.earth_degree=12", "forces.third_bodies=sun,moon", "forces.eop=false",
+           "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false",
+           "forces.moon_degree=0", "forces.sun_j2=false", "forces.relativity=false",
+           "forces.earth_field_indirect=false"]
+
+
+def _third_body_acc(r, s, gm):
+    """-gm (d/|d|^3 + s/|s|^3), d = r - s; r, s (..., 3) float64."""
+    d = r - s
+    return -gm * (d / np.linalg.norm(d, axis=-1, keepdims=True) ** 3
+                  + s / np.linalg.norm(s, axis=-1, keepdims=True) ** 3)
+
+
+def test_reduced_model_vs_tqdyn_one_day():
+    from tqdyn import propagator
+    from tqdyn._heyoka_peer import _epoch_days, _reduced_system, propagate_reduced_grid
+    from tqdyn.ephemeris import default_ephemeris, planetary_gm
+    from tqdyn.scenario import load_scenario
+    from tqdyn.timescales import tdb_jd
+
+    scen = load_scenario("tianqin", ["run.duration=1d", *REDUCED])
+    assert scen.n_steps == N_DAY
+    epoch = scen.epoch
+    y0 = propagator.initial_state(scen)
+    out = propagate_reduced_grid((y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]),
+                                 epoch.tdb, STEP, N_DAY, gm=str(scen.forces.gm_earth))
+    assert out["fp_type"] == "real128"
+    assert out["r_hi"].shape == (N_DAY + 1, 3, 3)
+    # the grid starts exactly at the initial state
+    assert np.array_equal(out["r_hi"][0], y0[:, 0:3, 0])
+    assert np.array_equal(out["r_lo"][0], y0[:, 0:3, 1])
+
+    rows = []
+    res = propagator.propagate(scen, sink=rows.append)
+    r_hi = np.concatenate([np.asarray(x["sat/r"][0]) for x in rows])
+    r_lo = np.concatenate([np.asarray(x["sat/r"][1]) for x in rows])
+    assert r_hi.shape == out["r_hi"].shape
+    dist = np.linalg.norm((out["r_hi"] - r_hi) + (out["r_lo"] - r_lo), axis=-1)
+
+    # Expected size of the difference.  Both integrate the same EGM2008 12x12
+    # field (same GM, radius, tide-free coefficients) and the same GMs of the
+    # Moon and Sun; they differ by
+    # (1) the ephemerides: heyoka's truncated ELP2000 / VSOP2013 vs DE421.
+    #     The resulting acceleration difference is evaluated here exactly,
+    #     at tqdyn's grid positions, from the two sets of body positions;
+    # (2) the Earth rotation: tqdyn without EOP (UT1 = UTC, no polar motion)
+    #     vs heyoka's IAU 2006 + bundled EOP.  Polar motion (~0.5" = 2.4e-6
+    #     rad in 2004) tilts the degree-2 field (4.9e-7 m/s^2 at 1e5 km) by
+    #     <= 3 * 2.4e-6 * 4.9e-7 = 3.5e-12 m/s^2; UT1-UTC = -0.47 s turns the
+    #     tesseral field (~1e-9 m/s^2) by 3.4e-5 rad: ~7e-14 m/s^2.
+    #     Allowance: 5e-12 m/s^2;
+    # (3) integration errors: < 1e-6 m per day (tqdyn dd at 50 s; heyoka
+    #     real128), negligible.
+    # A perturbing acceleration da displaces the orbit by <= da T^2 / 2 for
+    # T well below the orbital period (3.65 d); the Keplerian along-track
+    # growth at T = 1 d = 0.27 P is covered by a factor 2.
+    t = np.arange(N_DAY + 1) * STEP
+    jd1, jd2 = tdb_jd(epoch, t)
+    de, _ = default_ephemeris().geocentric_states(("moon", "sun"), jd1, jd2, velocity=False)
+    _, expr = _reduced_system(hy, 1, 0, out["thresholds"]["elp2000"], out["thresholds"]["vsop2013"],
+                              out["thresholds"]["iau2006"], hy.eop_data())
+    eph = hy.cfunc(expr["moon"] + expr["sun"], [], compact_mode=True)
+    d0 = float(_epoch_days(epoch.tdb, R128))
+    pars = np.tile(np.array([[0.0], [0.0], [0.0], [d0]]), (1, t.size))
+    hy_pos = eph(np.zeros((0, t.size)), pars=pars, time=t).T.reshape(t.size, 2, 3)
+    gm = planetary_gm()
+    da = np.zeros(r_hi.shape)  # (n, sat, 3); body positions broadcast as (n, 1, 3)
+    for k, name in enumerate(("moon", "sun")):
+        da += (_third_body_acc(r_hi, hy_pos[:, None, k], gm[name])
+               - _third_body_acc(r_hi, de[:, None, k], gm[name]))
+    da_eph = np.linalg.norm(da, axis=-1).max()
+    eph_err = np.linalg.norm(hy_pos - de, axis=-1).max(axis=0)
+    da_rot = 5e-12
+    bound = 2 * (da_eph + da_rot) * (N_DAY * STEP) ** 2 / 2
+    print(f"\nreduced model, 1 day: |r_heyoka - r_tqdyn| final {dist[-1]} m, max {dist.max():.3g} m; "
+          f"bound {bound:.3g} m (ephemeris: Moon {eph_err[0]:.0f} m, Sun {eph_err[1]:.0f} m -> "
+          f"{da_eph:.2g} m/s^2); heyoka setup {out['setup_s']:.1f} s, propagate_grid "
+          f"{out['wall_s']:.2f} s ({out['n_taylor_steps']} Taylor steps); tqdyn {res.wall_s:.2f} s")
+    assert eph_err[0] < 250 and eph_err[1] < 1500  # thresholds' documented accuracy
+    assert dist.max() < bound
+    # the difference is not trivially zero either (different ephemerides)
+    assert dist.max() > 1e-4

@@ -181,32 +181,14 @@ def _propagate(r0, v0, gm, step, n_steps, tol, fp_type, compact_mode):
     n_steps = int(n_steps)
     if n_steps < 0:
         raise ValueError("n_steps must be >= 0")
-
-    if fp_type is R:
-        r = to_real128(r0)
-        v = to_real128(v0)
-        gm_v = _scalar_to_real128(gm, R)
+    dtype = R if fp_type is R else np.float64
+    state, n_bodies = _state_array(r0, v0, dtype, R)
+    if dtype is R:
+        pars = np.array([_scalar_to_real128(gm, R)], dtype=R)
         step_v = _scalar_to_real128(step, R)
-        dtype = R
     else:
-        r = np.asarray(r0, dtype=np.float64) if not isinstance(r0, tuple) else (
-            np.asarray(r0[0], dtype=np.float64) + np.asarray(r0[1], dtype=np.float64)
-        )
-        v = np.asarray(v0, dtype=np.float64) if not isinstance(v0, tuple) else (
-            np.asarray(v0[0], dtype=np.float64) + np.asarray(v0[1], dtype=np.float64)
-        )
-        gm_v = float(gm)
+        pars = np.array([float(gm)], dtype=np.float64)
         step_v = float(step)
-        dtype = np.float64
-    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
-        raise ValueError(f"r0, v0 must both be (N, 3); got {r.shape}, {v.shape}")
-    n_bodies = r.shape[0]
-
-    state = np.empty((n_bodies, 6), dtype=dtype)
-    state[:, :3] = r
-    state[:, 3:] = v
-    state = state.reshape(-1)
-    pars = np.array([gm_v], dtype=dtype)
 
     kwargs = dict(fp_type=dtype, compact_mode=compact_mode, pars=pars)
     if tol is not None:
@@ -216,25 +198,45 @@ def _propagate(r0, v0, gm, step, n_steps, tol, fp_type, compact_mode):
     ta = hy.taylor_adaptive(_kepler_system(hy, n_bodies), state, **kwargs)
     setup_s = time.perf_counter() - t0
 
-    # grid t_k = k*step, computed in the working precision (exact for
-    # integer-valued steps such as 50 s)
-    grid = np.arange(n_steps + 1, dtype=np.int64).astype(dtype) * step_v
+    out = _grid_outputs(hy, ta, dtype, n_bodies, step_v, n_steps)
+    out["setup_s"] = float(setup_s)
+    return out
 
+
+def _state_array(r0, v0, dtype, R):
+    """Flat initial state [x, y, z, vx, vy, vz] per body in dtype (real128:
+    exact conversion; float64: a dd pair is collapsed to hi + lo)."""
+    if dtype is R:
+        r, v = to_real128(r0), to_real128(v0)
+    else:
+        def f64(a):
+            if isinstance(a, tuple):
+                return np.asarray(a[0], dtype=np.float64) + np.asarray(a[1], dtype=np.float64)
+            return np.asarray(a, dtype=np.float64)
+        r, v = f64(r0), f64(v0)
+    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
+        raise ValueError(f"r0, v0 must both be (N, 3); got {r.shape}, {v.shape}")
+    state = np.empty((r.shape[0], 6), dtype=dtype)
+    state[:, :3] = r
+    state[:, 3:] = v
+    return state.reshape(-1), r.shape[0]
+
+
+def _grid_outputs(hy, ta, dtype, n_bodies, step_v, n_steps):
+    """propagate_grid on t_k = k*step (computed in the working precision:
+    exact for integer-valued steps such as 50 s); the dict of hi/lo outputs,
+    the wall time of the call and the step statistics."""
+    R = hy.real128
+    grid = np.arange(n_steps + 1, dtype=np.int64).astype(dtype) * step_v
     t0 = time.perf_counter()
     res = ta.propagate_grid(grid)
     wall_s = time.perf_counter() - t0
     outcome, states = res[0], res[-1]
     if outcome != hy.taylor_outcome.time_limit:
         raise RuntimeError(f"heyoka propagate_grid stopped early: {outcome}")
-
     states = np.asarray(states).reshape(n_steps + 1, n_bodies, 6)
-    out = {
-        "wall_s": float(wall_s),
-        "setup_s": float(setup_s),
-        "tol": float(ta.tol),
-        "order": int(ta.order),
-        "n_taylor_steps": int(res[3]),
-    }
+    out = {"wall_s": float(wall_s), "tol": float(ta.tol), "order": int(ta.order),
+           "n_taylor_steps": int(res[3])}
     if dtype is R:
         r_hi, r_lo = real128_to_dd(states[:, :, :3])
         v_hi, v_lo = real128_to_dd(states[:, :, 3:])
@@ -242,8 +244,7 @@ def _propagate(r0, v0, gm, step, n_steps, tol, fp_type, compact_mode):
     else:
         r_hi = np.ascontiguousarray(states[:, :, :3])
         v_hi = np.ascontiguousarray(states[:, :, 3:])
-        r_lo = np.zeros_like(r_hi)
-        v_lo = np.zeros_like(v_hi)
+        r_lo, v_lo = np.zeros_like(r_hi), np.zeros_like(v_hi)
         out["fp_type"] = "float64"
     out.update(r_hi=r_hi, r_lo=r_lo, v_hi=v_hi, v_lo=v_lo)
     return out
@@ -318,8 +319,8 @@ _GM_EARTH_DE431 = "3.9860043543609598e14"
 
 #: Default truncation thresholds of the reduced model (see
 #: :func:`propagate_reduced_grid` for the accuracy they give).
-ELP_THRESH = 1e-7
-VSOP_THRESH = 1e-9
+ELP_THRESH = 1e-8
+VSOP_THRESH = 1e-10
 IAU2006_THRESH = 1e-4
 
 
@@ -382,49 +383,6 @@ def _reduced_system(hy, n_sat, degree, elp_thresh, vsop_thresh, iau2006_thresh, 
             acc = [a - g * dc * d3 - ic for a, dc, ic in zip(acc, d, ind)]
         sys += [(x, vx), (y, vy), (z, vz), (vx, acc[0]), (vy, acc[1]), (vz, acc[2])]
     return sys, {"moon": moon, "sun": sun}
-
-
-def _state_array(r0, v0, dtype, R):
-    if dtype is R:
-        r, v = to_real128(r0), to_real128(v0)
-    else:
-        def f64(a):
-            if isinstance(a, tuple):
-                return np.asarray(a[0], dtype=np.float64) + np.asarray(a[1], dtype=np.float64)
-            return np.asarray(a, dtype=np.float64)
-        r, v = f64(r0), f64(v0)
-    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
-        raise ValueError(f"r0, v0 must both be (N, 3); got {r.shape}, {v.shape}")
-    state = np.empty((r.shape[0], 6), dtype=dtype)
-    state[:, :3] = r
-    state[:, 3:] = v
-    return state.reshape(-1), r.shape[0]
-
-
-def _grid_outputs(hy, ta, dtype, n_bodies, step_v, n_steps):
-    """propagate_grid on t_k = k*step; the dict of dd outputs and timings."""
-    R = hy.real128
-    grid = np.arange(n_steps + 1, dtype=np.int64).astype(dtype) * step_v
-    t0 = time.perf_counter()
-    res = ta.propagate_grid(grid)
-    wall_s = time.perf_counter() - t0
-    outcome, states = res[0], res[-1]
-    if outcome != hy.taylor_outcome.time_limit:
-        raise RuntimeError(f"heyoka propagate_grid stopped early: {outcome}")
-    states = np.asarray(states).reshape(n_steps + 1, n_bodies, 6)
-    out = {"wall_s": float(wall_s), "tol": float(ta.tol), "order": int(ta.order),
-           "n_taylor_steps": int(res[3])}
-    if dtype is R:
-        r_hi, r_lo = real128_to_dd(states[:, :, :3])
-        v_hi, v_lo = real128_to_dd(states[:, :, 3:])
-        out["fp_type"] = "real128"
-    else:
-        r_hi = np.ascontiguousarray(states[:, :, :3])
-        v_hi = np.ascontiguousarray(states[:, :, 3:])
-        r_lo, v_lo = np.zeros_like(r_hi), np.zeros_like(v_hi)
-        out["fp_type"] = "float64"
-    out.update(r_hi=r_hi, r_lo=r_lo, v_hi=v_hi, v_lo=v_lo)
-    return out
 
 
 def propagate_reduced_grid(r0, v0, epoch_tdb_jd, step, n_steps, *, gm="3.986004415e14", degree=12,

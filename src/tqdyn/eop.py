@@ -202,7 +202,8 @@ class EOP:
             v = float(mjd[~ok].flat[0])
             raise ValueError(
                 f"EOP: date MJD {v:.6f} (UTC, {_mjd_iso(v)}) is outside the EOP table span "
-                f"MJD {lo:.0f}..{hi:.0f} ({_mjd_iso(lo)} .. {_mjd_iso(hi)}) of {self.source}")
+                f"MJD {lo:.0f}..{hi:.0f} ({_mjd_iso(lo)} .. {_mjd_iso(hi)}) of {self.source}; "
+                f"beyond it run without EOP (scenario: forces.eop = false)")
 
     def _day_index(self, mjd: np.ndarray) -> np.ndarray:
         return np.clip(np.floor(mjd - self.mjd[0]).astype(np.int64), 0, self.mjd.size - 1)
