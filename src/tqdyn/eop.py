@@ -274,23 +274,27 @@ class EOP:
 
 
 @njit(cache=True)
+def _lagrange4(xi, n_nodes):
+    """Window start k (nodes k..k+3, clamped at the ends) and the 4-point
+    Lagrange weights at abscissa xi on unit-spaced nodes 0..n_nodes-1."""
+    k = int(math.floor(xi)) - 1
+    if k < 0:
+        k = 0
+    if k > n_nodes - 4:
+        k = n_nodes - 4
+    s = xi - k
+    s1, s2, s3 = s - 1.0, s - 2.0, s - 3.0
+    return k, -(s1 * s2 * s3) / 6.0, (s * s2 * s3) * 0.5, -(s * s1 * s3) * 0.5, (s * s1 * s2) / 6.0
+
+
+@njit(cache=True)
 def _lagrange4_window(x, n_nodes, k_out, w_out):
     """Window start (nodes k..k+3) and 4-point Lagrange weights at abscissae x
     [d] relative to the first of n_nodes unit-spaced nodes."""
     for i in range(x.size):
-        xi = x[i]
-        k = int(math.floor(xi)) - 1
-        if k < 0:
-            k = 0
-        if k > n_nodes - 4:
-            k = n_nodes - 4
-        s = xi - k
-        s1, s2, s3 = s - 1.0, s - 2.0, s - 3.0
+        k, w0, w1, w2, w3 = _lagrange4(x[i], n_nodes)
         k_out[i] = k
-        w_out[i, 0] = -(s1 * s2 * s3) / 6.0
-        w_out[i, 1] = (s * s2 * s3) * 0.5
-        w_out[i, 2] = -(s * s1 * s3) * 0.5
-        w_out[i, 3] = (s * s1 * s2) / 6.0
+        w_out[i, 0], w_out[i, 1], w_out[i, 2], w_out[i, 3] = w0, w1, w2, w3
 
 
 @njit(cache=True)
@@ -299,18 +303,7 @@ def _lagrange4_table(x, table, out):
     nodes 0, 1, ...) at x[i]; window i-1..i+2, clamped at the ends."""
     n_nodes, m = table.shape
     for i in range(x.size):
-        xi = x[i]
-        k = int(math.floor(xi)) - 1
-        if k < 0:
-            k = 0
-        if k > n_nodes - 4:
-            k = n_nodes - 4
-        s = xi - k
-        s1, s2, s3 = s - 1.0, s - 2.0, s - 3.0
-        w0 = -(s1 * s2 * s3) / 6.0
-        w1 = (s * s2 * s3) * 0.5
-        w2 = -(s * s1 * s3) * 0.5
-        w3 = (s * s1 * s2) / 6.0
+        k, w0, w1, w2, w3 = _lagrange4(x[i], n_nodes)
         for c in range(m):
             out[i, c] = w0 * table[k, c] + w1 * table[k + 1, c] + w2 * table[k + 2, c] + w3 * table[k + 3, c]
 

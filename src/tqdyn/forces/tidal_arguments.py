@@ -181,6 +181,23 @@ def tidal_phase(beta, multipliers) -> np.ndarray:
 
 
 @njit(cache=True)
+def _exp_powers(beta_row, pmax, pr, pi_):
+    """pr[k, pmax + p] + i pi_[k, pmax + p] = exp(i p beta_row[k]) for
+    p = -pmax..pmax (by repeated multiplication; negative p by conjugation)."""
+    for k in range(6):
+        c = math.cos(beta_row[k])
+        s = math.sin(beta_row[k])
+        pr[k, pmax] = 1.0
+        pi_[k, pmax] = 0.0
+        for p in range(1, pmax + 1):
+            a, b = pr[k, pmax + p - 1], pi_[k, pmax + p - 1]
+            pr[k, pmax + p] = a * c - b * s
+            pi_[k, pmax + p] = a * s + b * c
+            pr[k, pmax - p] = pr[k, pmax + p]  # exp(-i p beta) = conj(exp(i p beta))
+            pi_[k, pmax - p] = -pi_[k, pmax + p]
+
+
+@njit(cache=True)
 def _cos_sin_kernel(beta, mult, pmax, cos_out, sin_out):
     """cos/sin of theta[i, f] = sum_k mult[f, k] beta[i, k] via powers of
     exp(i beta[i, k]).  beta (n, 6), mult (n_f, 6) int64 with |entries| <=
@@ -191,17 +208,7 @@ def _cos_sin_kernel(beta, mult, pmax, cos_out, sin_out):
     pr = np.empty((6, width))
     pi_ = np.empty((6, width))
     for i in range(n):
-        for k in range(6):
-            c = math.cos(beta[i, k])
-            s = math.sin(beta[i, k])
-            pr[k, pmax] = 1.0
-            pi_[k, pmax] = 0.0
-            for p in range(1, pmax + 1):
-                a, b = pr[k, pmax + p - 1], pi_[k, pmax + p - 1]
-                pr[k, pmax + p] = a * c - b * s
-                pi_[k, pmax + p] = a * s + b * c
-                pr[k, pmax - p] = pr[k, pmax + p]        # exp(-i p beta) = conj(exp(i p beta))
-                pi_[k, pmax - p] = -pi_[k, pmax + p]
+        _exp_powers(beta[i], pmax, pr, pi_)
         for f in range(nf):
             re, im = 1.0, 0.0
             for k in range(6):
@@ -245,17 +252,7 @@ def _harmonic_sum_kernel(beta, mult, pmax, wc, ws, out):
     pr = np.empty((6, width))
     pi_ = np.empty((6, width))
     for i in range(n):
-        for k in range(6):
-            c = math.cos(beta[i, k])
-            s = math.sin(beta[i, k])
-            pr[k, pmax] = 1.0
-            pi_[k, pmax] = 0.0
-            for p in range(1, pmax + 1):
-                a, b = pr[k, pmax + p - 1], pi_[k, pmax + p - 1]
-                pr[k, pmax + p] = a * c - b * s
-                pi_[k, pmax + p] = a * s + b * c
-                pr[k, pmax - p] = pr[k, pmax + p]
-                pi_[k, pmax - p] = -pi_[k, pmax + p]
+        _exp_powers(beta[i], pmax, pr, pi_)
         for q in range(nq):
             out[i, q] = 0.0
         for f in range(nf):
