@@ -53,7 +53,8 @@ __all__ = [
     "ld", "st", "const",
     "two_sum", "two_prod", "fast_two_sum",
     "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "mp_from_pair", "split_dd", "join_dd",
-    "np_two_sum", "np_two_prod", "mp_exact",
+    "np_two_sum", "np_two_prod", "mp_exact", "np_fast_two_sum", "np_dd_add", "np_dd_sqr",
+    "np_dd_sqrt", "np_dd_div_d",
     "is_dd_array",
 ]
 
@@ -398,6 +399,45 @@ def dd_from_mp(x) -> tuple[float, float]:
         hi = to_float(v._mpf_, rnd=round_nearest)
         lo = to_float(mpmath.fsub(v, mpmath.mpf(hi), exact=True)._mpf_, rnd=round_nearest)
     return hi, lo
+
+
+def np_fast_two_sum(a, b):
+    """Vectorised error-free sum for |a| >= |b| (numpy): a + b = s + e."""
+    s = a + b
+    return s, b - (s - a)
+
+
+def np_dd_add(ah, al, bh, bl):
+    """Vectorised dd + dd (numpy; hi/lo arrays): (sh, sl) ~ (ah + al) + (bh + bl)."""
+    s, e = np_two_sum(ah, bh)
+    t, f = np_two_sum(al, bl)
+    e = e + t
+    s, e = np_fast_two_sum(s, e)
+    e = e + f
+    return np_fast_two_sum(s, e)
+
+
+def np_dd_sqr(ah, al):
+    """Vectorised dd square (numpy): (ah + al)^2 as a dd pair."""
+    p, e = np_two_prod(ah, ah)
+    e = e + 2.0 * ah * al + al * al
+    return np_fast_two_sum(p, e)
+
+
+def np_dd_sqrt(ah, al):
+    """Vectorised dd square root (numpy), one Newton correction of the float64 root."""
+    q = np.sqrt(ah)
+    p, e = np_two_prod(q, q)
+    r = ((ah - p) - e + al) / (2.0 * q)
+    return np_fast_two_sum(q, r)
+
+
+def np_dd_div_d(ah, al, b):
+    """Vectorised dd / float64 (numpy): (ah + al) / b as a dd pair."""
+    q = ah / b
+    p, e = np_two_prod(q, b)
+    r = ((ah - p) - e + al) / b
+    return np_fast_two_sum(q, r)
 
 
 def mp_from_pair(hi: float, lo: float):

@@ -1,0 +1,1 @@
+"""Constellation geometry, pointing laws and attitude of the three satellites."""

@@ -1,0 +1,223 @@
+"""Tests of tqdyn.constellation.pointing.
+
+References: (1) mpmath evaluation of the light-travel-time equation on the
+dd result (residual); (2) an exact mpmath root of the equation for a rigidly
+rotating equilateral triangle (positions evaluated analytically in mpmath);
+(3) the geometric convention (Rodrigues rotation of X_S about Z_S by
++-theta/2 must give the beams from k and j); (4) the iterative solution on a
+real 1-day TianQin (Kepler) trajectory at 50 s with Hermite dense output
+(degree 11, tqdyn.integrators.hermite) as the reference for the other laws.
+Numbers are printed (pytest -s); bounds are orders of magnitude, not tuned.
+"""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+
+from tqdyn.constants import C_LIGHT
+from tqdyn.constellation import geometry as G
+from tqdyn.constellation import pointing as P
+from tqdyn.constellation.indices import Sat
+from tqdyn.precision import mp_from_pair
+
+
+def _load(scenario):
+    """1-day trajectory of a built-in scenario on its 50 s grid, with a dd
+    Hermite (degree 11) position interpolator."""
+    from tqdyn import propagator
+    from tqdyn.integrators.hermite import interpolate_states
+    from tqdyn.scenario import load_scenario
+
+    rows = []
+    propagator.propagate(load_scenario(scenario, ["run.duration=1d"]), sink=rows.append)
+
+    def cat(k):
+        if isinstance(rows[0][k], tuple):
+            return tuple(np.concatenate([r[k][q] for r in rows]) for q in (0, 1))
+        return np.concatenate([r[k] for r in rows])
+
+    t, R, V, A = cat("t"), cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+    tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)
+
+    def position_at(sat, th, tl):
+        r, _ = interpolate_states(tn, Rd[:, sat.index], Vd[:, sat.index], A[:, sat.index],
+                                  np.stack([th, tl], -1), n_nodes=4)
+        return r
+
+    sl = slice(1, None)  # the first node has no emission time inside the grid
+    return ((t[0][sl], t[1][sl]), (R[0][sl], R[1][sl]), (V[0][sl], V[1][sl]), A[sl], position_at)
+
+
+@pytest.fixture(scope="module")
+def trajectory():
+    return _load("tianqin-kepler")
+
+
+def _all_laws(trajectory):
+    t, R, V, A, position_at = trajectory
+    return {law: P.beam_directions(law, R, V, A, t=t, position_at=position_at) for law in P.LAWS}
+
+
+@pytest.fixture(scope="module")
+def beams(trajectory):
+    return _all_laws(trajectory)
+
+
+def _rotate(v, axis, angle):
+    """Rodrigues rotation of v about the unit axis by angle (right-handed)."""
+    c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
+    return v * c + np.cross(axis, v) * s + axis * np.einsum("...k,...k->...", axis, v)[..., None] * (1 - c)
+
+
+def test_mosa_rotation_convention(trajectory):
+    # OA_1 = X_S rotated by +theta/2 about Z_S faces k, OA_2 (-theta/2) faces j;
+    # Z_S = n_ij x n_ik / sin(alpha_i) is the same for the three satellites;
+    # X_S (bisector) points at the incenter (geometry.incenter, independent formula).
+    t, R, V, A, _ = trajectory
+    b = P.beam_directions("global", R)
+    f = P.pointing_frames(b.n)
+    half = f.theta / 2
+    assert np.max(np.abs(_rotate(f.X_S, f.Z_S, +half) - b.n[..., 0, :])) < 1e-15  # towards k
+    assert np.max(np.abs(_rotate(f.X_S, f.Z_S, -half) - b.n[..., 1, :])) < 1e-15  # towards j
+    g = G.constellation_geometry(R)
+    assert np.max(np.abs(f.theta - g.alpha)) < 1e-15
+    assert np.max(np.abs(f.Z_S - f.Z_S[:, :1])) < 1e-14
+    xs = g.incenter.offset / np.linalg.norm(g.incenter.offset, axis=-1, keepdims=True)
+    assert np.max(P.angle_between(f.X_S, xs)) < 1e-14
+    T = f.T_S_I
+    assert np.max(np.abs(T @ np.swapaxes(T, -1, -2) - np.eye(3))) < 1e-15
+    assert np.max(np.abs(np.linalg.det(T) - 1)) < 1e-15
+    # the S frame with Z_S = n_ij x n_ik: the flight direction (velocity) is along -Y_S here
+    vy = np.einsum("nsk,nsk->ns", f.Y_S, V[0])
+    print(f"velocity . Y_S in [{vy.min():.1f}, {vy.max():.1f}] m/s")
+
+
+def test_iterative_residual_in_mpmath(trajectory, beams):
+    # reference: the equation tau = |r_j(t0 - tau) - r_i(t0)| / c, evaluated in
+    # mpmath (40 digits) on the dd tau, the dd emitter position the solver's
+    # interpolator returns at the dd time t0 - tau, and the dd receiver position.
+    t, R, V, A, position_at = trajectory
+    it = beams["iterative"]
+    mpmath.mp.dps = 40
+    c = mpmath.mpf(C_LIGHT)
+    worst = 0.0
+    for n in (0, 1, 500, 1727):
+        for s in Sat:
+            for m, e in ((0, s.k), (1, s.j)):
+                tau = mp_from_pair(*it.tau_dd[n, s.index, m])
+                te = mp_from_pair(t[0][n], t[1][n]) - tau
+                th = float(te)
+                tl = float(te - th)
+                re = position_at(e, np.array([th]), np.array([tl]))[0]
+                d2 = sum((mp_from_pair(*re[q]) - mp_from_pair(R[0][n, s.index, q], R[1][n, s.index, q])) ** 2
+                         for q in range(3))
+                worst = max(worst, float(abs(mpmath.sqrt(d2) / c - tau)))
+    print(f"iterative LTT residual (mpmath) max {worst:.2e} s; last correction max "
+          f"{np.max(np.abs(it.last_step)):.2e} s")
+    assert worst < 1e-20
+
+
+def test_iterative_vs_exact_root_rigid_triangle():
+    # reference: mpmath.findroot of the LTT equation for an equilateral triangle
+    # rotating rigidly on a circle (rho = 1e8 m, omega = 2e-5 rad/s), positions
+    # evaluated analytically in mpmath (the position_at callable does the same,
+    # rounded to dd).
+    mpmath.mp.dps = 50
+    rho, w = mpmath.mpf(10) ** 8, mpmath.mpf(2) / 10 ** 5
+
+    def pos(s_index, tm):
+        ph = w * tm + 2 * mpmath.pi * s_index / 3
+        return [rho * mpmath.cos(ph), rho * mpmath.sin(ph), mpmath.mpf(0)]
+
+    def position_at(sat, th, tl):
+        out = np.empty((th.size, 3, 2))
+        for q, (a, b) in enumerate(zip(th, tl)):
+            p = pos(sat.index, mpmath.mpf(a) + mpmath.mpf(b))
+            for k in range(3):
+                hi = float(p[k])
+                out[q, k] = hi, float(p[k] - hi)
+        return out
+
+    times = [mpmath.mpf(1000), mpmath.mpf("123456.789")]
+    th = np.array([float(x) for x in times])
+    tl = np.array([float(x - float(x)) for x in times])
+    Rdd = np.empty((2, 3, 3, 2))
+    for q, tm in enumerate(times):
+        for s in range(3):
+            p = pos(s, tm)
+            for k in range(3):
+                Rdd[q, s, k] = float(p[k]), float(p[k] - float(p[k]))
+    tau, r_emit, last = P.solve_light_travel_time((th, tl), Rdd, position_at)
+    worst = 0.0
+    for q, tm in enumerate(times):
+        for s in Sat:
+            for m, e in ((0, s.k), (1, s.j)):
+                ri = pos(s.index, tm)
+                f = lambda x: mpmath.sqrt(sum((a - b) ** 2 for a, b in zip(pos(e.index, tm - x), ri))) / C_LIGHT - x
+                exact = mpmath.findroot(f, mpmath.sqrt(3) * rho / C_LIGHT)
+                worst = max(worst, float(abs(mp_from_pair(*tau[q, s.index, m]) - exact)))
+    print(f"iterative tau vs exact mpmath root (rigid triangle): {worst:.2e} s")
+    assert worst < 1e-20
+
+
+def test_laws_vs_iterative_real_trajectory(trajectory, beams):
+    # reference: the iterative law (LTT solved to < 1e-20 s, dense output of the trajectory)
+    _compare_laws(beams)
+
+
+@pytest.mark.slow
+def test_laws_vs_iterative_full_force_model():
+    # same comparison on the full-force-model scenario "tianqin" (accelerations
+    # include all perturbations, so taylor2 uses the real a_j)
+    _compare_laws(_all_laws(_load("tianqin")))
+
+
+def _compare_laws(beams):
+    it = beams["iterative"]
+    fi = P.pointing_frames(it.n)
+    res = {}
+    for law in ("global", "taylor1", "taylor2"):
+        f = P.pointing_frames(beams[law].n)
+        per_beam = P.angle_between(beams[law].n, it.n).max(axis=0)  # (3, 2)
+        xs = P.angle_between(f.X_S, fi.X_S).max(axis=0)
+        th = np.abs(f.theta - fi.theta).max(axis=0)
+        res[law] = per_beam.max(), xs.max(), th.max()
+        print(f"{law:8s} vs iterative, max over 1 day [rad]: per beam (sat, MOSA1<-k, MOSA2<-j) "
+              f"{np.array2string(per_beam, precision=2)}; X_S {np.array2string(xs, precision=2)}; "
+              f"theta {np.array2string(th, precision=2)}")
+    dtau = np.abs(beams["global"].tau - it.tau).max(axis=0)
+    print(f"tau = L/c vs iterative tau: max {np.array2string(dtau, precision=3)} s")
+    # the paper's Fig. 5: ~1e-6 rad (global) and ~1e-11 rad (Taylor); orders of magnitude only
+    assert 1e-7 < res["global"][0] < 1e-4
+    for law in ("taylor1", "taylor2"):
+        assert 1e-13 < res[law][0] < 1e-10
+        assert res[law][1] < 1e-13  # the two beams' errors cancel in X_S ...
+        assert res[law][2] > res[law][0]  # ... and add up in theta
+    assert 1e-7 < dtau.max() < 1e-5  # not the paper's 1e-7 s
+
+
+def test_normalisation_matters(trajectory, beams):
+    # DESIGN 4b: bisector of the unnormalised Taylor vectors n' = n - v_j / c
+    t, R, V, A, _ = trajectory
+    a = G.arms(R)
+    n = G.by_mosa(a.n)
+    vj = (V[0] + V[1])[:, P._EMITTER, :]
+    raw = n - vj / C_LIGHT
+    x_raw = raw[..., 0, :] + raw[..., 1, :]
+    x_raw /= np.linalg.norm(x_raw, axis=-1, keepdims=True)
+    x_it = P.pointing_frames(beams["iterative"].n).X_S
+    err = P.angle_between(x_raw, x_it).max()
+    print(f"X_S from unnormalised Taylor-1 beams vs iterative: {err:.2e} rad")
+    assert err > 1e-7
+
+
+def test_bad_inputs():
+    R = np.array([[[1e8, 0, 0], [0, 1e8, 0], [0, 0, 1e8]]])
+    with pytest.raises(ValueError):
+        P.beam_directions("local", R)
+    with pytest.raises(ValueError):
+        P.beam_directions("taylor1", R)
+    with pytest.raises(ValueError):
+        P.beam_directions("iterative", R)
