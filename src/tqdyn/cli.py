@@ -64,9 +64,13 @@ def _format_state_table(scenario, y_dd) -> list[str]:
               help="Override a scenario value, e.g. --set integrator.mode=adaptive or "
                    "--set satellites.2.nu_deg=151 (repeatable).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def run(scenario, duration, step, output, precision, sets, quiet):
+@click.option("--checkpoint-every", type=click.IntRange(min=0), default=20000, show_default=True,
+              help="Write a resumable checkpoint every N steps (fixed mode; 0 = never).")
+@click.option("--resume", is_flag=True, help="Continue an interrupted run from its checkpoint (same arguments).")
+def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_every, resume):
     """Propagate SCENARIO (a built-in name or a TOML file; default: tianqin)
-    and write the trajectory file."""
+    and write the trajectory file.  Interrupted runs (Ctrl-C, a crash) keep
+    their last checkpoint; `--resume` continues them to a bit-identical file."""
     from tqdm import tqdm
 
     from . import io, propagator
@@ -95,24 +99,54 @@ def run(scenario, duration, step, output, precision, sets, quiet):
                f"{scen.run.precision} precision, DP87 {integ.mode} "
                + (f"{integ.step_s} s x {n_total} steps" if fixed else f"rtol {integ.rtol}, output every {integ.step_s} s")
                + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC", err=True)
+    if not fixed:
+        checkpoint_every = 0
+    ckpt_path = out_path.with_name(out_path.name + ".checkpoint")
+    try:
+        if resume:
+            start, writer = _resume(ckpt_path, scen, out_path)
+        else:
+            if ckpt_path.exists():
+                raise ValueError(f"{ckpt_path} holds the checkpoint of an interrupted run: continue it with "
+                                 f"--resume, or delete it to start again")
+            start = None
+            writer = io.TrajectoryWriter(out_path, attrs, fields, n_sat=len(scen.satellites),
+                                         expected_rows=n_total // scen.run.output_every + 1)
+    except (ValueError, io.OutputError) as exc:
+        _fail(str(exc))
     t_compile = time.perf_counter()
     propagator.warm_up(scen.run.precision)
     t_compile = time.perf_counter() - t_compile
     bar = tqdm(total=n_total if fixed else float(scen.run.duration_s), disable=True if quiet else None,
                unit="step" if fixed else "s", unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True,
-               desc="propagating")
+               desc="propagating", initial=start.n if start else 0)
+
+    def save_checkpoint(c):
+        partial = writer.sync()
+        _write_checkpoint(ckpt_path, scen.to_toml(), scen.run.precision, c, partial, writer.rows_written)
+
     try:
-        with io.TrajectoryWriter(out_path, attrs, fields, n_sat=len(scen.satellites),
-                                 expected_rows=n_total // scen.run.output_every + 1) as writer:
-            result = propagator.propagate(scen, sink=writer.append, progress=bar.update, model=model)
-            rows = writer.rows_written
+        result = propagator.propagate(scen, sink=writer.append, progress=bar.update, model=model, start=start,
+                                      checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
+        rows = writer.rows_written
+        writer.close()
     except KeyboardInterrupt:
         bar.close()
+        if ckpt_path.exists():
+            writer.keep_partial()
+            _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt_path})",
+                  _EXIT_INTERRUPTED)
+        writer.abort()
         _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     except io.OutputError as exc:
         bar.close()
+        writer.abort()
         _fail(str(exc))
+    except BaseException:
+        writer.abort()
+        raise
     bar.close()
+    ckpt_path.unlink(missing_ok=True)
     size_mb = out_path.stat().st_size / 1e6
     lines = [
         f"steps: {result.n_steps} accepted" + (f", {result.n_rejected} rejected" if not fixed else "")
@@ -126,6 +160,42 @@ def run(scenario, duration, step, output, precision, sets, quiet):
                      + ", ".join(f"{s.name} {d:.2e}" for s, d in zip(scen.satellites, result.energy_rel_drift)))
     lines.append(f"output: {out_path} ({rows} rows, {size_mb:.1f} MB)")
     click.echo("\n".join(lines))
+
+
+def _write_checkpoint(path, scenario_toml, precision, c, partial, rows):
+    """Atomically write a run checkpoint (npz): the resolved scenario, the
+    step count, the state and its compensation, the partial trajectory file
+    and how many of its rows the checkpoint covers."""
+    import os
+
+    import numpy as np
+
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as fh:
+        np.savez(fh, scenario=np.array(scenario_toml), precision=np.array(precision), n=np.array(c.n),
+                 y=c.y, comp=c.comp, partial=np.array(partial), rows=np.array(rows))
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def _resume(ckpt_path, scen, out_path):
+    """(Checkpoint, reopened writer) of an interrupted run; ValueError if
+    there is none or it belongs to another scenario."""
+    import numpy as np
+
+    from . import io
+    from .propagator import Checkpoint
+
+    if not ckpt_path.exists():
+        raise ValueError(f"--resume: no checkpoint {ckpt_path} to continue from")
+    with np.load(ckpt_path, allow_pickle=False) as data:
+        if str(data["scenario"]) != scen.to_toml() or str(data["precision"]) != scen.run.precision:
+            raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
+                             f"precision; give the same arguments as the interrupted run")
+        start = Checkpoint(int(data["n"]), np.array(data["y"]), np.array(data["comp"]))
+        writer = io.TrajectoryWriter.reopen(str(data["partial"]), out_path, int(data["rows"]))
+    return start, writer
 
 
 @cli.command()

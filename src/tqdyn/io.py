@@ -651,6 +651,73 @@ class TrajectoryWriter:
         self._finalizer.detach()
         return self._path
 
+    # -- checkpoints ---------------------------------------------------------
+    def sync(self) -> str:
+        """Write every buffered row to the temporary file and flush it to
+        disk, so that its first :attr:`rows_written` rows survive a crash;
+        returns the temporary file's path (for a checkpoint)."""
+        h5 = self._require_open("sync")
+        self._flush()
+        h5.flush()
+        _fsync_path(self._state["tmp"])
+        return self._state["tmp"]
+
+    def keep_partial(self) -> str | None:
+        """Close the temporary file WITHOUT deleting it (a run interrupted
+        after a checkpoint keeps its partial trajectory for ``--resume``);
+        :attr:`path` is untouched.  Returns the partial file's path."""
+        if self._status != "open":
+            return None
+        tmp = self._state.get("tmp")
+        h5 = self._state.pop("h5", None)
+        if h5 is not None:
+            try:
+                h5.close()
+            except Exception:  # pragma: no cover - best effort
+                pass
+        self._state.pop("tmp", None)
+        self._finalizer.detach()
+        self._status = "aborted"
+        return tmp
+
+    @classmethod
+    def reopen(cls, partial, path, rows: int) -> "TrajectoryWriter":
+        """Continue a partial trajectory written by an interrupted run: the
+        temporary file ``partial`` is truncated to its first ``rows`` time
+        rows (those covered by the checkpoint) and appended to; close()
+        renames it to ``path`` as usual."""
+        self = cls.__new__(cls)
+        self._path = check_writable(path)
+        if not os.path.isfile(partial):
+            raise OutputError(f"partial trajectory {str(partial)!r} of the checkpoint is missing; cannot resume")
+        self._state = {"tmp": str(partial)}
+        self._finalizer = weakref.finalize(self, _cleanup, self._state)
+        try:
+            h5 = h5py.File(partial, "r+")
+        except OSError as exc:
+            self._finalizer.detach()
+            raise OutputError(f"cannot reopen partial trajectory {str(partial)!r}: {exc}") from None
+        self._state["h5"] = h5
+        self._fields = tuple(f for f in FIELDS if f in h5)
+        self._tfields = tuple(f for f in self._fields if FIELDS[f].time_dependent)
+        self._static_pending = set()
+        self._dsets = {f: ((h5[f]["hi"], h5[f]["lo"]) if FIELDS[f].kind == "dd" else (h5[f],))
+                       for f in self._tfields}
+        self._n_sat = int(self._dsets["sat/r"][0].shape[1]) if "sat/r" in self._dsets else 1
+        for dsets in self._dsets.values():
+            for ds in dsets:
+                if ds.shape[0] < rows:
+                    raise OutputError(f"partial trajectory {str(partial)!r} holds {ds.shape[0]} rows, "
+                                      f"the checkpoint needs {rows}; cannot resume")
+                ds.resize(rows, axis=0)
+        self._expected = rows
+        self._chunk_rows = self._dsets["t"][0].chunks[0] if "t" in self._dsets else _DEFAULT_CHUNK_ROWS
+        self._rows = self._rows_on_disk = rows
+        self._buf = {f: [] for f in self._tfields}
+        self._buf_rows = 0
+        self._status = "open"
+        return self
+
     def abort(self) -> None:
         """Discard everything: close and delete the temporary file; :attr:`path` is untouched."""
         if self._status == "closed":

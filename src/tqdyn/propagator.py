@@ -36,7 +36,7 @@ from .precision import add, ld, mul, mp_from_dd, st
 from .timescales import Epoch
 
 __all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs", "warm_up",
-           "two_body_energy", "check_inputs"]
+           "two_body_energy", "check_inputs", "Checkpoint"]
 
 PRECISIONS = ("dd", "float64")
 _DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
@@ -155,6 +155,18 @@ def warm_up(precision: str = "dd") -> None:
 # Python driver
 
 
+@dataclass(frozen=True)
+class Checkpoint:
+    """State of a fixed-step run after ``n`` steps: y (working precision,
+    (n_sat, 6[, 2])) and its Kahan compensation ``comp``.  Resuming from it
+    reproduces the uninterrupted run bit for bit (every step depends only on
+    y, comp and the step index)."""
+
+    n: int
+    y: np.ndarray
+    comp: np.ndarray
+
+
 @dataclass
 class RunResult:
     """Outcome of a propagation.
@@ -213,7 +225,9 @@ def _check_precision(precision):
 
 def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping], None] | None = None,
               progress: Callable[[int], None] | None = None, chunk: int = _DEFAULT_CHUNK,
-              y0: np.ndarray | None = None, model: ForceModel | None = None) -> RunResult:
+              y0: np.ndarray | None = None, model: ForceModel | None = None,
+              start: Checkpoint | None = None, checkpoint: Callable[[Checkpoint], None] | None = None,
+              checkpoint_every: int = 0) -> RunResult:
     """Propagate the scenario's satellites over ``scenario.run.duration_s``.
 
     precision: "dd" | "float64" (default: the scenario's run.precision).
@@ -226,6 +240,10 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
     the seconds of propagation time just covered (adaptive).
     y0: optional initial dd states (n_sat, 6, 2) instead of the scenario's elements.
     model: optional force model instead of the one built from scenario.forces.
+    start: resume a fixed-step run from this checkpoint (its rows before
+    start.n are not emitted again).  checkpoint(Checkpoint): called every
+    ``checkpoint_every`` steps (fixed mode; 0 = never) after the rows up to
+    that step went to the sink.
     """
     precision = precision or scenario.run.precision
     _check_precision(precision)
@@ -234,9 +252,12 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario) if y0 is None else np.asarray(y0, np.float64)
     if scenario.integrator.mode == "adaptive":
+        if start is not None or checkpoint_every:
+            raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
         result = _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress)
     else:
-        result = _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk)
+        result = _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                                  start, checkpoint, checkpoint_every)
     if [t.name for t in model.terms] == ["earth_monopole"]:
         e0 = two_body_energy(result.y0, model.terms[0].gm)
         e1 = two_body_energy(result.y_final, model.terms[0].gm)
@@ -265,18 +286,28 @@ def _workspace(y0_dd, precision):
     return y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros(y.shape[:2])
 
 
-def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk):
+def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                     start=None, checkpoint=None, checkpoint_every=0):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
     n_total = scenario.n_steps
     every = scenario.run.output_every
     y, comp, K, ystage, err = _workspace(y0_dd, precision)
+    n = 0
+    if start is not None:
+        if start.y.shape != y.shape or not 0 <= start.n <= n_total:
+            raise ValueError(f"checkpoint: state shape {start.y.shape} at step {start.n} does not fit this run "
+                             f"({y.shape}, {n_total} steps)")
+        n = int(start.n)
+        y[...] = start.y
+        comp[...] = start.comp
     h = np.array(coef.h)
     nb = y.shape[0]
     acc_shape = (nb, 3) + y.shape[2:]
     t_start = _time.perf_counter()
-    n = 0
     while n < n_total:
         m = min(chunk, n_total - n)
+        if checkpoint_every:
+            m = min(m, (n // checkpoint_every + 1) * checkpoint_every - n)
         t_out = np.empty((m, 2))
         t_nodes = np.empty((m if model.time_dependent else 0, 13, 2))
         _grid_times(n, m, h, coef.c, t_out, t_nodes)
@@ -291,6 +322,8 @@ def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progre
         n += m
         if progress is not None:
             progress(m)
+        if checkpoint is not None and checkpoint_every and n % checkpoint_every == 0 and n < n_total:
+            checkpoint(Checkpoint(n, y.copy(), comp.copy()))
     # the final state and its acceleration
     t_end = np.empty((1, 2))
     t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))
