@@ -101,6 +101,9 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
                + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC", err=True)
     if not fixed:
         checkpoint_every = 0
+    t_compile = time.perf_counter()
+    propagator.warm_up(scen.run.precision)
+    t_compile = time.perf_counter() - t_compile
     ckpt_path = out_path.with_name(out_path.name + ".checkpoint")
     try:
         if resume:
@@ -114,9 +117,6 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
                                          expected_rows=n_total // scen.run.output_every + 1)
     except (ValueError, io.OutputError) as exc:
         _fail(str(exc))
-    t_compile = time.perf_counter()
-    propagator.warm_up(scen.run.precision)
-    t_compile = time.perf_counter() - t_compile
     bar = tqdm(total=n_total if fixed else float(scen.run.duration_s), disable=True if quiet else None,
                unit="step" if fixed else "s", unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True,
                desc="propagating", initial=start.n if start else 0)
@@ -130,20 +130,16 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
                                       checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
         rows = writer.rows_written
         writer.close()
-    except KeyboardInterrupt:
+    except BaseException as exc:
         bar.close()
-        if ckpt_path.exists():
-            writer.keep_partial()
-            _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt_path})",
-                  _EXIT_INTERRUPTED)
-        writer.abort()
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
-    except io.OutputError as exc:
-        bar.close()
-        writer.abort()
-        _fail(str(exc))
-    except BaseException:
-        writer.abort()
+        # keep the partial trajectory while a checkpoint refers to it; else discard it
+        resumable = ckpt_path.exists()
+        writer.keep_partial() if resumable else writer.abort()
+        if isinstance(exc, KeyboardInterrupt):
+            _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt_path})"
+                  if resumable else "interrupted; no output file written", _EXIT_INTERRUPTED)
+        if isinstance(exc, io.OutputError):
+            _fail(str(exc))
         raise
     bar.close()
     ckpt_path.unlink(missing_ok=True)
