@@ -71,6 +71,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .attitude import T_OA_S_of
 from .spacecraft import Spacecraft
 
 __all__ = [
@@ -100,13 +101,8 @@ def oa_rotation(theta) -> np.ndarray:
     (..., 2, 3, 3); ``[..., l-1, :, :]`` maps S vectors into OA_l.  OA_1 is
     X_S rotated by +theta/2 about Z_S, OA_2 by -theta/2.
     """
-    th = np.asarray(theta, dtype=np.float64)
-    s, c = np.sin(0.5 * th), np.cos(0.5 * th)
-    z = np.zeros_like(th)
-    o = np.ones_like(th)
-    t1 = np.stack([np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -2)
-    t2 = np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-    return np.stack([t1, t2], -3)
+    half = 0.5 * np.asarray(theta, dtype=np.float64)
+    return T_OA_S_of(np.stack([half, -half], axis=-1))
 
 
 def mosa_angular_rates(alpha_dot, alpha_ddot) -> tuple[np.ndarray, np.ndarray]:
