@@ -198,6 +198,19 @@ def _exp_powers(beta_row, pmax, pr, pi_):
 
 
 @njit(cache=True)
+def _phase(pr, pi_, pmax, mult, f):
+    """(cos, sin) of theta_f = sum_k mult[f, k] beta_k from the powers of
+    exp(i beta_k) tabulated by :func:`_exp_powers`."""
+    re, im = 1.0, 0.0
+    for k in range(6):
+        m = mult[f, k]
+        if m != 0:
+            a, b = pr[k, pmax + m], pi_[k, pmax + m]
+            re, im = re * a - im * b, re * b + im * a
+    return re, im
+
+
+@njit(cache=True)
 def _cos_sin_kernel(beta, mult, pmax, cos_out, sin_out):
     """cos/sin of theta[i, f] = sum_k mult[f, k] beta[i, k] via powers of
     exp(i beta[i, k]).  beta (n, 6), mult (n_f, 6) int64 with |entries| <=
@@ -210,12 +223,7 @@ def _cos_sin_kernel(beta, mult, pmax, cos_out, sin_out):
     for i in range(n):
         _exp_powers(beta[i], pmax, pr, pi_)
         for f in range(nf):
-            re, im = 1.0, 0.0
-            for k in range(6):
-                m = mult[f, k]
-                if m != 0:
-                    a, b = pr[k, pmax + m], pi_[k, pmax + m]
-                    re, im = re * a - im * b, re * b + im * a
+            re, im = _phase(pr, pi_, pmax, mult, f)
             cos_out[i, f] = re
             sin_out[i, f] = im
 
@@ -256,12 +264,7 @@ def _harmonic_sum_kernel(beta, mult, pmax, wc, ws, out):
         for q in range(nq):
             out[i, q] = 0.0
         for f in range(nf):
-            re, im = 1.0, 0.0
-            for k in range(6):
-                m = mult[f, k]
-                if m != 0:
-                    a, b = pr[k, pmax + m], pi_[k, pmax + m]
-                    re, im = re * a - im * b, re * b + im * a
+            re, im = _phase(pr, pi_, pmax, mult, f)
             for q in range(nq):
                 out[i, q] += re * wc[f, q] + im * ws[f, q]
 
