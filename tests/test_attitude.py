@@ -170,7 +170,8 @@ def real_orbit():
     from tqdyn.scenario import load_scenario
 
     rows = []
-    propagator.propagate(load_scenario("tianqin", ["run.duration=1d"]), sink=rows.append)
+    propagator.propagate(load_scenario("tianqin", ["run.duration=1d", "constellation.pointing=none",
+                                                                "constellation.control=off"]), sink=rows.append)
     cat = lambda k, p: np.concatenate([x[k][p] for x in rows])  # noqa: E731
     t = cat("t", 0) + cat("t", 1)
     r = (cat("sat/r", 0), cat("sat/r", 1))

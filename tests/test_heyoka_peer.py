@@ -189,7 +189,7 @@ def test_several_bodies_match_single():
 REDUCED = ["forces.earth_degree=12", "forces.third_bodies=sun,moon", "forces.eop=false",
            "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false",
            "forces.moon_degree=0", "forces.sun_j2=false", "forces.relativity=false",
-           "forces.earth_field_indirect=false"]
+           "forces.earth_field_indirect=false", "constellation.pointing=none", "constellation.control=off"]
 
 
 def _third_body_acc(r, s, gm):

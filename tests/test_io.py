@@ -111,7 +111,15 @@ def test_fields_catalogue_matches_contract():
         "tm/alpha_suspension": ("f8", ("sat", "tm", 3)),
         "tm/self_gravity": ("f8", ("sat", "tm", 3)),
     }
-    assert {f: (s.kind, s.shape) for f, s in FIELDS.items()} == expected
+    # DESIGN section 7: every contract field exactly as specified; the rest
+    # are documented extensions (never renames or reshapes)
+    extensions = {
+        "tm/v": ("dd", ("sat", "tm", 3)),
+        "tm/a": ("f8", ("sat", "tm", 3)),
+        "tm/housing_offset": ("f8", ("sat", "tm", 3)),
+    }
+    assert {f: (s.kind, s.shape) for f, s in FIELDS.items()} == {**expected, **extensions}
+    assert [f for f in FIELDS if f in expected] == list(expected)  # contract order kept
     assert [f for f, s in FIELDS.items() if not s.time_dependent] == ["tm/self_gravity"]
     for f, s in FIELDS.items():
         assert s.unit and s.frame and s.description, f

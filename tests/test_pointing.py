@@ -31,7 +31,8 @@ def _load(scenario):
     from tqdyn.scenario import load_scenario
 
     rows = []
-    propagator.propagate(load_scenario(scenario, ["run.duration=1d"]), sink=rows.append)
+    propagator.propagate(load_scenario(scenario, ["run.duration=1d", "constellation.pointing=none",
+                                                            "constellation.control=off"]), sink=rows.append)
 
     def cat(k):
         if isinstance(rows[0][k], tuple):

@@ -73,125 +73,66 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     their last checkpoint; `--resume` continues them to a bit-identical file."""
     from tqdm import tqdm
 
-    from . import io, propagator
+    from . import io, propagator, runner
     from .scenario import ScenarioError, load_scenario
 
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
-        out_path = io.check_writable(scen.run.output)
+        io.check_writable(scen.run.output)
         model = propagator.check_inputs(scen)
     except (ScenarioError, io.OutputError, ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
     integ = scen.integrator
     fixed = integ.mode == "fixed"
     n_total = scen.n_steps
-    attrs = {
-        "scenario": scen.to_toml(),
-        "epoch_utc": scen.epoch_utc,
-        "precision": scen.run.precision,
-        "step_s": float(integ.step_s),
-        "integrator": f"dp87-{integ.mode}-{integ.tableau}",
-        "pointing": "none",
-        "control": "off",
-    }
-    fields = ("t", "sat/r", "sat/v", "sat/a_gravity")
+    c = scen.constellation
     click.echo(f"tqdyn {__version__}: scenario {scen.name!r}, {len(scen.satellites)} satellite(s), "
                f"{scen.run.precision} precision, DP87 {integ.mode} "
                + (f"{integ.step_s} s x {n_total} steps" if fixed else f"rtol {integ.rtol}, output every {integ.step_s} s")
-               + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC", err=True)
-    if not fixed:
-        checkpoint_every = 0
-    t_compile = time.perf_counter()
-    propagator.warm_up(scen.run.precision)
-    t_compile = time.perf_counter() - t_compile
-    ckpt_path = out_path.with_name(out_path.name + ".checkpoint")
+               + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC"
+               + (f"; pointing {c.pointing}, control {c.control}" + (", free TMs" if c.free_tms else "")
+                  if c.coupled else ""), err=True)
+    state = {"bar": None}
+
+    def progress(n):
+        if state["bar"] is None:
+            state["bar"] = tqdm(total=n_total if fixed else float(scen.run.duration_s),
+                                disable=True if quiet else None, unit="step" if fixed else "s",
+                                unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True, desc="propagating")
+        state["bar"].update(n)
+
     try:
-        if resume:
-            start, writer = _resume(ckpt_path, scen, out_path)
-        else:
-            if ckpt_path.exists():
-                raise ValueError(f"{ckpt_path} holds the checkpoint of an interrupted run: continue it with "
-                                 f"--resume, or delete it to start again")
-            start = None
-            writer = io.TrajectoryWriter(out_path, attrs, fields, n_sat=len(scen.satellites),
-                                         expected_rows=n_total // scen.run.output_every + 1)
+        summary = runner.run_to_file(scen, model=model, progress=progress,
+                                     checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
     except (ValueError, io.OutputError) as exc:
+        if state["bar"] is not None:
+            state["bar"].close()
+        if hasattr(exc, "tqdyn_checkpoint") and not isinstance(exc, io.OutputError):
+            raise  # a failure inside the propagation, not bad input
         _fail(str(exc))
-    bar = tqdm(total=n_total if fixed else float(scen.run.duration_s), disable=True if quiet else None,
-               unit="step" if fixed else "s", unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True,
-               desc="propagating", initial=start.n if start else 0)
-
-    def save_checkpoint(c):
-        partial = writer.sync()
-        _write_checkpoint(ckpt_path, scen.to_toml(), scen.run.precision, c, partial, writer.rows_written)
-
-    try:
-        result = propagator.propagate(scen, sink=writer.append, progress=bar.update, model=model, start=start,
-                                      checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
-        rows = writer.rows_written
-        writer.close()
-    except BaseException as exc:
-        bar.close()
-        # keep the partial trajectory while a checkpoint refers to it; else discard it
-        resumable = ckpt_path.exists()
-        writer.keep_partial() if resumable else writer.abort()
-        if isinstance(exc, KeyboardInterrupt):
-            _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt_path})"
-                  if resumable else "interrupted; no output file written", _EXIT_INTERRUPTED)
-        if isinstance(exc, io.OutputError):
-            _fail(str(exc))
-        raise
-    bar.close()
-    ckpt_path.unlink(missing_ok=True)
-    size_mb = out_path.stat().st_size / 1e6
+    except KeyboardInterrupt as exc:
+        if state["bar"] is not None:
+            state["bar"].close()
+        ckpt = getattr(exc, "tqdyn_checkpoint", None)
+        _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt})"
+              if ckpt else "interrupted; no output file written", _EXIT_INTERRUPTED)
+    if state["bar"] is not None:
+        state["bar"].close()
+    result = summary.result
     lines = [
         f"steps: {result.n_steps} accepted" + (f", {result.n_rejected} rejected" if not fixed else "")
         + f", {result.n_rhs} right-hand-side evaluations",
-        f"wall time: {result.wall_s:.2f} s propagation (+ {t_compile:.2f} s JIT compilation)",
+        f"wall time: {result.wall_s:.2f} s propagation (+ {summary.compile_s:.2f} s JIT compilation)",
         f"final states (GCRS, t = {result.t_final[0] + result.t_final[1]:.3f} s TDB after the epoch):",
         *_format_state_table(scen, result.y_final),
     ]
     if result.energy_rel_drift is not None:
         lines.append("two-body energy drift (relative): "
                      + ", ".join(f"{s.name} {d:.2e}" for s, d in zip(scen.satellites, result.energy_rel_drift)))
-    lines.append(f"output: {out_path} ({rows} rows, {size_mb:.1f} MB)")
+    for key, text in result.extra.items():
+        lines.append(f"{key}: {text}")
+    lines.append(f"output: {summary.path} ({summary.rows} rows, {summary.size_mb:.1f} MB)")
     click.echo("\n".join(lines))
-
-
-def _write_checkpoint(path, scenario_toml, precision, c, partial, rows):
-    """Atomically write a run checkpoint (npz): the resolved scenario, the
-    step count, the state and its compensation, the partial trajectory file
-    and how many of its rows the checkpoint covers."""
-    import os
-
-    import numpy as np
-
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
-        np.savez(fh, scenario=np.array(scenario_toml), precision=np.array(precision), n=np.array(c.n),
-                 y=c.y, comp=c.comp, partial=np.array(partial), rows=np.array(rows))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
-def _resume(ckpt_path, scen, out_path):
-    """(Checkpoint, reopened writer) of an interrupted run; ValueError if
-    there is none or it belongs to another scenario."""
-    import numpy as np
-
-    from . import io
-    from .propagator import Checkpoint
-
-    if not ckpt_path.exists():
-        raise ValueError(f"--resume: no checkpoint {ckpt_path} to continue from")
-    with np.load(ckpt_path, allow_pickle=False) as data:
-        if str(data["scenario"]) != scen.to_toml() or str(data["precision"]) != scen.run.precision:
-            raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
-                             f"precision; give the same arguments as the interrupted run")
-        start = Checkpoint(int(data["n"]), np.array(data["y"]), np.array(data["comp"]))
-        writer = io.TrajectoryWriter.reopen(str(data["partial"]), out_path, int(data["rows"]))
-    return start, writer
 
 
 @cli.command()
@@ -295,12 +236,15 @@ def info():
 @click.option("--duration", default="90d", show_default=True, help="Propagated span.")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s].")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
-@click.option("--model", "which", type=click.Choice(["kepler", "full", "all"]), default="all", show_default=True,
-              help="kepler: monopole only; full: the full force model (and the reduced model vs heyoka).")
+@click.option("--model", "which", type=click.Choice(["kepler", "full", "coupled", "all"]), default="all",
+              show_default=True,
+              help="kepler: monopole only; full: the full force model, pure gravity (and the reduced model vs "
+                   "heyoka); coupled: the full coupled run (attitude + drag-free control).")
 def bench(duration, step, no_heyoka, which):
     """Benchmarks: Kepler (3 TianQin satellites, Earth monopole: tqdyn dd vs
-    float64 vs heyoka real128 on the same grid) and the force model (full
-    model dd / float64, reduced model dd vs heyoka real128)."""
+    float64 vs heyoka real128 on the same grid), the force model (full
+    model dd / float64, reduced model dd vs heyoka real128) and the coupled
+    constellation (dd / float64)."""
     from . import bench as _bench
     from .scenario import ScenarioError
 
@@ -311,8 +255,15 @@ def bench(duration, step, no_heyoka, which):
         if which in ("full", "all"):
             click.echo(_bench.format_force_report(_bench.force_model_benchmark(duration=duration,
                                                                                heyoka=not no_heyoka)))
+        if which in ("coupled", "all"):
+            click.echo(_bench.format_coupled_report(_bench.coupled_benchmark(duration=duration)))
     except (ScenarioError, ValueError) as exc:
         _fail(str(exc))
+
+
+from .cli_export import export as _export_command  # noqa: E402  (commands in their own modules)
+
+cli.add_command(_export_command)
 
 
 def main(argv=None):

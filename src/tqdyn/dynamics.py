@@ -1,27 +1,158 @@
 """The right-hand side of the propagated system.
 
 State layout: y (n_body, 6[, 2]) with rows (x, y, z, vx, vy, vz) [m, m/s],
-GCRS, geocentric; trailing axis 2 in dd mode (see :mod:`tqdyn.precision`).
-Each body moves under the force model of :mod:`tqdyn.forces.model`.
+GCRS, geocentric, TDB; trailing axis 2 in dd mode (see :mod:`tqdyn.precision`).
+
+Two systems share one compiled entry point, :func:`system_rhs`, selected by
+``cpar[CP_MODE]``:
+
+* ``MODE_POINT_MASS`` -- every body moves under the force model of
+  :mod:`tqdyn.forces.model` (independent satellites).
+* ``MODE_COUPLED`` / ``MODE_FREE_TM`` -- the drag-free constellation
+  (paper eq. coreEquation): bodies 0..2 are the satellites,
+
+      r_i'' = a(r_i) + G_i,
+
+  with G_i the drag-free acceleration that keeps the satellite centred on its
+  two TMs (nominal control, :mod:`tqdyn.constellation.control` for the
+  derivation).  Per evaluation:
+
+  1. gravity at the three satellites (dd);
+  2. nominal attitude of the pointing law (:mod:`._kinematics_jit`): T_S_I,
+     omega, omega_dot, MOSA angle theta and its rates, from the satellites'
+     positions, velocities and accelerations;
+  3. the EH centers r_i + T_I_S r_0,l (dd) and gravity there (dd); the
+     differential gravity a(TM) - a(sat) is the difference of two dd
+     accelerations, rounded to float64 only afterwards, so it has no
+     cancellation (its error is ~1e-32 * 0.04 m/s^2 for the dd terms and
+     ~1e-16 of the differential float64 perturbations, ~1e-23 m/s^2);
+  4. g_l, A_c,l and G_i (:mod:`._control_jit`);
+  5. G feedback: omega_dot and theta_ddot depend on the satellites'
+     accelerations, which contain G.  Steps 2 and 4 are repeated once with
+     a(r_i) + G_i.  The remaining inconsistency is the change of G in that
+     second pass times d_TM / L ~ 1e-9, i.e. < 1e-30 m/s^2.  Without the
+     second pass omega_dot would miss ~|G| / L ~ 6e-22 rad/s^2, which moves
+     a TM 0.2 m from the CoM by ~1e-22 m/s^2 -- visible (~1e-11 m) in the
+     10-day free-TM check, hence included.
+
+  ``control = "off"`` skips adding G_i to the orbit (pure-gravity
+  constellation); attitude and the control that would be needed are still
+  evaluated (with accelerations a(r_i)).  In ``MODE_FREE_TM`` bodies 3..8
+  are the six TMs (body 3 + 2 i + l), propagated as free bodies under
+  gravity + self-gravity + the suspension acceleration A_c,l computed for
+  the nominal TM positions (the EH centers); how far they drift from the EH
+  centers verifies the control derivation and the integration.
+
+Per-evaluation diagnostics (attitude, control, TM states) are written into
+``aux`` (float64, layout constants ``AX_*`` below) -- the driver keeps the
+ones of the first stage of each step as the output row.
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
+from .constellation._control_jit import housing_geometry, satellite_control
+from .constellation._kinematics_jit import sat_kinematics
 from .forces.model import gravity
-from .precision import ld, st
+from .precision import add, ld, lo_part, st, sub, to_f64
 
-__all__ = ["system_rhs"]
+__all__ = ["system_rhs", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
+           "make_cpar", "aux_views", "n_bodies", "workspace"]
+
+MODE_POINT_MASS = 0
+MODE_COUPLED = 1
+MODE_FREE_TM = 2
+
+# cpar layout (float64)
+CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
+CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
+CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
+CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
+CP_LEN = 40
+
+# aux layout per satellite (float64), AX_SAT values each
+AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
+AX_TM = 23         # then per TM l: AX_TM + l * AX_TMLEN
+TM_RHI, TM_RLO, TM_VHI, TM_VLO, TM_A, TM_SUSP, TM_ALPHA, TM_OFF = 0, 3, 6, 9, 12, 15, 18, 21
+AX_TMLEN = 24
+AX_SAT = AX_TM + 2 * AX_TMLEN
+AUX_LEN = 3 * AX_SAT
+
+# float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
+_FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
+              ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
+              ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
+              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)))
+
+
+def n_bodies(mode: int) -> int:
+    """Bodies in the state of a 3-satellite run of ``mode`` (9 with free TMs)."""
+    return 9 if mode == MODE_FREE_TM else 3
+
+
+def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
+              r0_nom=None, sg_oa=None, sg_s=None) -> np.ndarray:
+    """Pack the constellation parameters for :func:`system_rhs`.
+
+    mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
+    control : apply G_i to the orbits; gm : Earth GM [m^3/s^2] (jerk/snap of
+    the remote satellite in the local pointing laws); c : m/s; d_p : pivot
+    distance [m]; theta_nom : nominal MOSA angle [rad]; r0_nom : (2, 3) EH
+    centers in S [m]; sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2];
+    sg_s : (3, 3) common self-gravity in S [m/s^2].
+    """
+    p = np.zeros(CP_LEN)
+    p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
+    p[CP_GM], p[CP_C], p[CP_DP], p[CP_THNOM] = gm, c, d_p, theta_nom
+    if r0_nom is not None:
+        p[CP_R0:CP_R0 + 6] = np.asarray(r0_nom, np.float64).ravel()
+    if sg_oa is not None:
+        p[CP_SG_OA:CP_SG_OA + 18] = np.asarray(sg_oa, np.float64).ravel()
+    if sg_s is not None:
+        p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
+    return p
+
+
+def workspace(y: np.ndarray):
+    """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
+    (15, 3[, 2]) accelerations in the working precision, fw a tuple of
+    float64 arrays, aux (AUX_LEN,)."""
+    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
+            np.zeros(AUX_LEN))
+
+
+def aux_views(aux: np.ndarray) -> dict:
+    """Named views of aux rows (..., AUX_LEN) -> arrays with (..., 3[, 2], k) shapes (float64).
+
+    Keys: T_S_I (..., 3, 3, 3); omega, omega_dot (..., 3, 3) [S];
+    breathing_angle, theta (..., 3); a_dragfree, a_gravity (..., 3, 3) [GCRS];
+    tm_r_hi, tm_r_lo, tm_v_hi, tm_v_lo, tm_a (..., 3, 2, 3) [GCRS];
+    tm_a_suspension, tm_alpha_suspension (..., 3, 2, 3) [OA_l];
+    tm_housing_offset (..., 3, 2, 3) [GCRS, m].
+    """
+    a = np.asarray(aux)
+    s = a.reshape(a.shape[:-1] + (3, AX_SAT))
+    tm = s[..., AX_TM:].reshape(a.shape[:-1] + (3, 2, AX_TMLEN))
+
+    def v(x, lo, n):
+        return x[..., lo:lo + n]
+
+    return {
+        "T_S_I": v(s, AX_T, 9).reshape(a.shape[:-1] + (3, 3, 3)),
+        "omega": v(s, AX_W, 3), "omega_dot": v(s, AX_WD, 3),
+        "breathing_angle": s[..., AX_ALPHA], "theta": s[..., AX_THETA],
+        "a_dragfree": v(s, AX_G, 3), "a_gravity": v(s, AX_AGRAV, 3),
+        "tm_r_hi": v(tm, TM_RHI, 3), "tm_r_lo": v(tm, TM_RLO, 3),
+        "tm_v_hi": v(tm, TM_VHI, 3), "tm_v_lo": v(tm, TM_VLO, 3), "tm_a": v(tm, TM_A, 3),
+        "tm_a_suspension": v(tm, TM_SUSP, 3), "tm_alpha_suspension": v(tm, TM_ALPHA, 3),
+        "tm_housing_offset": v(tm, TM_OFF, 3),
+    }
 
 
 @njit(cache=True)
-def system_rhs(y, tdat, params, layout, k):
-    """dy/dt for every body: k[b, 0:3] = v_b, k[b, 3:6] = a(r_b).
-
-    y, k: (n_body, 6[, 2]); tdat: (n_tdat,) float64 time-only inputs at the
-    instant of y; params, layout: the force model's.  Units m/s and m/s^2.
-    """
+def _point_masses(y, tdat, params, layout, k):
     for b in range(y.shape[0]):
         ax, ay, az = gravity(ld(y, b, 0), ld(y, b, 1), ld(y, b, 2), ld(y, b, 3), ld(y, b, 4), ld(y, b, 5),
                              tdat, params, layout)
@@ -30,3 +161,190 @@ def system_rhs(y, tdat, params, layout, k):
         st(k, ax, b, 3)
         st(k, ay, b, 4)
         st(k, az, b, 5)
+
+
+@njit(cache=True)
+def _gravity_into(gw, row, x, y, z, vx, vy, vz, tdat, params, layout):
+    ax, ay, az = gravity(x, y, z, vx, vy, vz, tdat, params, layout)
+    st(gw, ax, row, 0)
+    st(gw, ay, row, 1)
+    st(gw, az, row, 2)
+
+
+@njit(cache=True)
+def _breathing_angle(r_hi, r_lo, i):
+    """Angle at satellite i between its two arms (instantaneous positions) [rad]."""
+    j, kk = (i + 1) % 3, (i + 2) % 3
+    a0 = (r_hi[j, 0] - r_hi[i, 0]) + (r_lo[j, 0] - r_lo[i, 0])
+    a1 = (r_hi[j, 1] - r_hi[i, 1]) + (r_lo[j, 1] - r_lo[i, 1])
+    a2 = (r_hi[j, 2] - r_hi[i, 2]) + (r_lo[j, 2] - r_lo[i, 2])
+    b0 = (r_hi[kk, 0] - r_hi[i, 0]) + (r_lo[kk, 0] - r_lo[i, 0])
+    b1 = (r_hi[kk, 1] - r_hi[i, 1]) + (r_lo[kk, 1] - r_lo[i, 1])
+    b2 = (r_hi[kk, 2] - r_hi[i, 2]) + (r_lo[kk, 2] - r_lo[i, 2])
+    cx, cy, cz = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), a0 * b0 + a1 * b1 + a2 * b2)
+
+
+@njit(cache=True)
+def _control_pass(cpar, fw):
+    """Kinematics and EH geometry of the three satellites from the work
+    arrays (positions, velocities, accelerations)."""
+    r_hi, r_lo, v, a, T, om, omd, th, r0, rho, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], \
+        fw[8], fw[9], fw[10]
+    sat_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, cpar[CP_GM], cpar[CP_C], T, om, omd, th)
+    r0_nom = cpar[CP_R0:CP_R0 + 6].reshape((2, 3))
+    for i in range(3):
+        housing_geometry(i, th[i, 0], th[i, 1], cpar[CP_DP], r0_nom, cpar[CP_THNOM], om, r0, rho, vel)
+
+
+@njit(cache=True)
+def _control_laws(cpar, fw):
+    """g, A, G (S and GCRS), alpha of the three satellites from the work arrays."""
+    T, om, omd, th, r0, rho = fw[4], fw[5], fw[6], fw[7], fw[8], fw[9]
+    dgI, dgS, sgS, g, A, GS, alp, GI = fw[11], fw[12], fw[13], fw[14], fw[15], fw[16], fw[17], fw[18]
+    for i in range(3):
+        h = 0.5 * th[i, 0]
+        for l in range(2):
+            s = 1.0 if l == 0 else -1.0
+            c, sp = np.cos(s * h), np.sin(s * h)
+            o = CP_SG_OA + 6 * i + 3 * l
+            sx, sy, sz = cpar[o], cpar[o + 1], cpar[o + 2]
+            # T_S_OA sg (columns of T_OA_S) + the common part fixed in S
+            sgS[i, l, 0] = c * sx - sp * sy + cpar[CP_SG_S + 3 * i]
+            sgS[i, l, 1] = sp * sx + c * sy + cpar[CP_SG_S + 3 * i + 1]
+            sgS[i, l, 2] = sz + cpar[CP_SG_S + 3 * i + 2]
+            for q in range(3):
+                dgS[i, l, q] = T[i, q, 0] * dgI[i, l, 0] + T[i, q, 1] * dgI[i, l, 1] + T[i, q, 2] * dgI[i, l, 2]
+        satellite_control(i, dgS, sgS, om, omd, th[i, 0], th[i, 1], th[i, 2], r0, rho, g, A, GS, alp)
+        for q in range(3):
+            GI[i, q] = T[i, 0, q] * GS[i, 0] + T[i, 1, q] * GS[i, 1] + T[i, 2, q] * GS[i, 2]
+
+
+@njit(cache=True)
+def _oa_to_inertial(T, i, theta, l, x, y, z):
+    """OA_l vector of satellite i -> GCRS (T_I_S T_S_OA); T: (3, 3, 3)."""
+    s = 1.0 if l == 0 else -1.0
+    c, sp = np.cos(s * 0.5 * theta), np.sin(s * 0.5 * theta)
+    ux, uy, uz = c * x - sp * y, sp * x + c * y, z
+    return (T[i, 0, 0] * ux + T[i, 1, 0] * uy + T[i, 2, 0] * uz,
+            T[i, 0, 1] * ux + T[i, 1, 1] * uy + T[i, 2, 1] * uz,
+            T[i, 0, 2] * ux + T[i, 1, 2] * uy + T[i, 2, 2] * uz)
+
+
+@njit(cache=True)
+def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
+    free = cpar[CP_MODE] == MODE_FREE_TM
+    control_on = cpar[CP_CONTROL] != 0.0
+    r_hi, r_lo, v, a, T, om, omd, th, r0, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], fw[8], fw[10]
+    dgI, sgS, A, alp, GI = fw[11], fw[13], fw[15], fw[17], fw[18]
+    # 1. gravity at the satellites
+    for i in range(3):
+        _gravity_into(gw, i, ld(y, i, 0), ld(y, i, 1), ld(y, i, 2), ld(y, i, 3), ld(y, i, 4), ld(y, i, 5),
+                      tdat, params, layout)
+        for q in range(3):
+            x = ld(y, i, q)
+            r_hi[i, q] = to_f64(x)
+            r_lo[i, q] = lo_part(x)
+            v[i, q] = to_f64(ld(y, i, q + 3))
+            a[i, q] = to_f64(ld(gw, i, q))
+    # 2. attitude and EH geometry
+    _control_pass(cpar, fw)
+    # 3. gravity at the EH centers, differential gravity in dd
+    for i in range(3):
+        for l in range(2):
+            ox = T[i, 0, 0] * r0[i, l, 0] + T[i, 1, 0] * r0[i, l, 1] + T[i, 2, 0] * r0[i, l, 2]
+            oy = T[i, 0, 1] * r0[i, l, 0] + T[i, 1, 1] * r0[i, l, 1] + T[i, 2, 1] * r0[i, l, 2]
+            oz = T[i, 0, 2] * r0[i, l, 0] + T[i, 1, 2] * r0[i, l, 1] + T[i, 2, 2] * r0[i, l, 2]
+            ux = T[i, 0, 0] * vel[i, l, 0] + T[i, 1, 0] * vel[i, l, 1] + T[i, 2, 0] * vel[i, l, 2]
+            uy = T[i, 0, 1] * vel[i, l, 0] + T[i, 1, 1] * vel[i, l, 1] + T[i, 2, 1] * vel[i, l, 2]
+            uz = T[i, 0, 2] * vel[i, l, 0] + T[i, 1, 2] * vel[i, l, 1] + T[i, 2, 2] * vel[i, l, 2]
+            hx, hy, hz = add(ld(y, i, 0), ox), add(ld(y, i, 1), oy), add(ld(y, i, 2), oz)
+            hvx, hvy, hvz = add(ld(y, i, 3), ux), add(ld(y, i, 4), uy), add(ld(y, i, 5), uz)
+            row = 3 + 2 * i + l
+            _gravity_into(gw, row, hx, hy, hz, hvx, hvy, hvz, tdat, params, layout)
+            for q in range(3):
+                dgI[i, l, q] = to_f64(sub(ld(gw, row, q), ld(gw, i, q)))
+            b = AX_SAT * i + AX_TM + AX_TMLEN * l
+            aux[b + TM_RHI], aux[b + TM_RHI + 1], aux[b + TM_RHI + 2] = to_f64(hx), to_f64(hy), to_f64(hz)
+            aux[b + TM_RLO], aux[b + TM_RLO + 1], aux[b + TM_RLO + 2] = lo_part(hx), lo_part(hy), lo_part(hz)
+            aux[b + TM_VHI], aux[b + TM_VHI + 1], aux[b + TM_VHI + 2] = to_f64(hvx), to_f64(hvy), to_f64(hvz)
+            aux[b + TM_VLO], aux[b + TM_VLO + 1], aux[b + TM_VLO + 2] = lo_part(hvx), lo_part(hvy), lo_part(hvz)
+            if free:
+                tb = 3 + 2 * i + l
+                aux[b + TM_OFF] = to_f64(sub(ld(y, tb, 0), hx))
+                aux[b + TM_OFF + 1] = to_f64(sub(ld(y, tb, 1), hy))
+                aux[b + TM_OFF + 2] = to_f64(sub(ld(y, tb, 2), hz))
+    # 4. control
+    _control_laws(cpar, fw)
+    # 5. G feedback into omega_dot / theta_ddot (the orbit's accelerations contain G)
+    if control_on:
+        for i in range(3):
+            for q in range(3):
+                a[i, q] = to_f64(add(ld(gw, i, q), GI[i, q]))
+        _control_pass(cpar, fw)
+        _control_laws(cpar, fw)
+    # derivatives of the satellites
+    for i in range(3):
+        for q in range(3):
+            st(k, ld(y, i, q + 3), i, q)
+            if control_on:
+                st(k, add(ld(gw, i, q), GI[i, q]), i, q + 3)
+            else:
+                st(k, ld(gw, i, q), i, q + 3)
+    # aux: attitude, control, TM accelerations (and the free TMs' derivatives)
+    for i in range(3):
+        s0 = AX_SAT * i
+        for p in range(3):
+            for q in range(3):
+                aux[s0 + AX_T + 3 * p + q] = T[i, p, q]
+        for q in range(3):
+            aux[s0 + AX_W + q] = om[i, q]
+            aux[s0 + AX_WD + q] = omd[i, q]
+            aux[s0 + AX_G + q] = GI[i, q]
+            aux[s0 + AX_AGRAV + q] = to_f64(ld(gw, i, q))
+        theta = th[i, 0]
+        aux[s0 + AX_THETA] = theta
+        aux[s0 + AX_ALPHA] = _breathing_angle(r_hi, r_lo, i)
+        for l in range(2):
+            b = s0 + AX_TM + AX_TMLEN * l
+            for q in range(3):
+                aux[b + TM_SUSP + q] = A[i, l, q]
+                aux[b + TM_ALPHA + q] = alp[i, l, q]
+            # suspension (OA_l) and self-gravity (S) in GCRS
+            ax_, ay_, az_ = _oa_to_inertial(T, i, theta, l, A[i, l, 0], A[i, l, 1], A[i, l, 2])
+            sx, sy, sz = sgS[i, l, 0], sgS[i, l, 1], sgS[i, l, 2]
+            gx = T[i, 0, 0] * sx + T[i, 1, 0] * sy + T[i, 2, 0] * sz + ax_
+            gy = T[i, 0, 1] * sx + T[i, 1, 1] * sy + T[i, 2, 1] * sz + ay_
+            gz = T[i, 0, 2] * sx + T[i, 1, 2] * sy + T[i, 2, 2] * sz + az_
+            hrow = 3 + 2 * i + l
+            if free:
+                tb = 3 + 2 * i + l
+                trow = 9 + 2 * i + l
+                _gravity_into(gw, trow, ld(y, tb, 0), ld(y, tb, 1), ld(y, tb, 2), ld(y, tb, 3), ld(y, tb, 4),
+                              ld(y, tb, 5), tdat, params, layout)
+                tx, ty, tz = add(ld(gw, trow, 0), gx), add(ld(gw, trow, 1), gy), add(ld(gw, trow, 2), gz)
+                for q in range(3):
+                    st(k, ld(y, tb, q + 3), tb, q)
+                st(k, tx, tb, 3)
+                st(k, ty, tb, 4)
+                st(k, tz, tb, 5)
+            else:
+                tx, ty, tz = add(ld(gw, hrow, 0), gx), add(ld(gw, hrow, 1), gy), add(ld(gw, hrow, 2), gz)
+            aux[b + TM_A], aux[b + TM_A + 1], aux[b + TM_A + 2] = to_f64(tx), to_f64(ty), to_f64(tz)
+
+
+@njit(cache=True)
+def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
+    """dy/dt of the whole system at one instant.
+
+    y, k: (n_body, 6[, 2]) state and derivative (m, m/s; m/s, m/s^2; GCRS);
+    tdat: (n_tdat,) float64 time-only inputs of the force model at the
+    instant of y (TDB); params, layout: the force model's; cpar: (CP_LEN,)
+    constellation parameters (:func:`make_cpar`); aux: (AUX_LEN,) float64
+    diagnostics written by the coupled modes; gw, fw: scratch
+    (:func:`workspace`).
+    """
+    if cpar[CP_MODE] == MODE_POINT_MASS:
+        _point_masses(y, tdat, params, layout, k)
+    else:
+        _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw)

@@ -136,6 +136,14 @@ FIELDS: dict[str, FieldSpec] = {
                      "angle of X_OA_l from X_S about Z_S (MOSA l = 1, 2)"),
     "tm/r": _f("dd", ("sat", "tm", 3), ("sat", "tm", "comp"), "m", "GCRS",
                "test-mass centre-of-mass position"),
+    "tm/v": _f("dd", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s", "GCRS",
+               "test-mass centre-of-mass velocity (extension of format version 1)"),
+    "tm/a": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s^2", "GCRS",
+               "test-mass total acceleration: gravity + self-gravity + suspension "
+               "(extension of format version 1)"),
+    "tm/housing_offset": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m", "GCRS",
+                            "free-TM verification mode: TM position minus its housing centre "
+                            "(extension of format version 1)"),
     "tm/a_suspension": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s^2", "OA_l",
                           "test-mass suspension (actuation) acceleration"),
     "tm/alpha_suspension": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "rad/s^2", "OA_l",

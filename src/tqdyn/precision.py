@@ -50,7 +50,7 @@ from numba.extending import intrinsic, overload
 
 __all__ = [
     "add", "add_acc", "sub", "mul", "div", "sqrt", "neg", "fma_", "to_f64",
-    "ld", "st", "const",
+    "ld", "st", "const", "lo_part",
     "two_sum", "two_prod", "fast_two_sum",
     "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "mp_from_pair", "split_dd", "join_dd",
     "np_two_sum", "np_two_prod", "mp_exact", "np_fast_two_sum", "np_dd_add", "np_dd_sqr",
@@ -223,6 +223,10 @@ def const(hi, lo, like):
     """A constant (hi + lo) in the number type of ``like`` (dd or float64)."""
 
 
+def lo_part(a):
+    """Low part of a dd number (0.0 for float64): a = to_f64(a) + lo_part(a)."""
+
+
 @overload(add)
 def _ov_add(a, b):
     if _is_dd(a) and _is_dd(b):
@@ -300,6 +304,14 @@ def _ov_to_f64(a):
         return lambda a: a[0]
     if _is_f(a):
         return lambda a: float(a)
+
+
+@overload(lo_part)
+def _ov_lo_part(a):
+    if _is_dd(a):
+        return lambda a: a[1]
+    if _is_f(a):
+        return lambda a: 0.0
 
 
 @overload(const)

@@ -20,6 +20,7 @@ callable.
 from __future__ import annotations
 
 import time as _time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable, Mapping
@@ -29,6 +30,8 @@ import numpy as np
 from numba import njit
 
 from . import elements as _el
+from . import dynamics as _dyn
+from .constants import C_LIGHT
 from .dynamics import system_rhs
 from .forces.model import ForceModel, build_force_model
 from .integrators import dp87, hermite
@@ -36,23 +39,88 @@ from .precision import add, ld, mul, mp_from_dd, st
 from .timescales import Epoch
 
 __all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs", "warm_up",
-           "two_body_energy", "check_inputs", "Checkpoint"]
+           "two_body_energy", "check_inputs", "Checkpoint", "System", "build_system", "self_gravity_oa"]
 
 PRECISIONS = ("dd", "float64")
 _DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
 
 
-def initial_state(scenario) -> np.ndarray:
-    """Initial GCRS states of the scenario's satellites as a dd array
-    (n_sat, 6, 2): rows x, y, z [m], vx, vy, vz [m/s]; exact elements
-    converted in mpmath and rounded once to dd."""
+@dataclass(frozen=True)
+class System:
+    """What is propagated: the mode of :mod:`tqdyn.dynamics` and its parameters.
+
+    cpar : (dynamics.CP_LEN,) float64 constellation parameters (mode, pointing
+    law, control switch, spacecraft geometry, self-gravity);
+    coupled : attitude/control diagnostics are produced (pointing != "none");
+    free_tms : the six TMs are propagated as bodies 3..8.
+    """
+
+    cpar: np.ndarray
+    coupled: bool
+    free_tms: bool
+
+    @property
+    def mode(self) -> int:
+        return int(self.cpar[_dyn.CP_MODE])
+
+
+def self_gravity_oa(scenario) -> np.ndarray:
+    """DC self-gravity of the scenario's TMs, (3, 2, 3) [m/s^2] in OA_l."""
+    from .constellation.spacecraft import TABLE_IV_SELF_GRAVITY
+
+    oa, _ = scenario.spacecraft.self_gravity_values()
+    return np.broadcast_to(TABLE_IV_SELF_GRAVITY, (3, 2, 3)).copy() if oa is None else oa
+
+
+def build_system(scenario) -> System:
+    """The :class:`System` of a scenario (point masses unless
+    ``constellation.pointing`` names a law)."""
+    from .constellation._kinematics_jit import LAW_CODES
+    from .constellation.spacecraft import Spacecraft
+
+    c = scenario.constellation
+    if not c.coupled:
+        return System(_dyn.make_cpar(_dyn.MODE_POINT_MASS), False, False)
+    sc = scenario.spacecraft
+    craft = Spacecraft(d_tm=float(sc.d_tm_m), d_p=float(sc.d_p_m), tm_axis=sc.tm_axis)
+    _, common = sc.self_gravity_values()
+    mode = _dyn.MODE_FREE_TM if c.free_tms else _dyn.MODE_COUPLED
+    cpar = _dyn.make_cpar(mode, law=LAW_CODES[c.pointing], control=c.control == "on",
+                          gm=float(scenario.forces.gm_earth), c=C_LIGHT, d_p=craft.d_p,
+                          theta_nom=craft.theta_nominal, r0_nom=craft.nominal_housing_centers,
+                          sg_oa=self_gravity_oa(scenario), sg_s=common)
+    return System(cpar, True, c.free_tms)
+
+
+def initial_state(scenario, model: ForceModel | None = None, system: System | None = None) -> np.ndarray:
+    """Initial GCRS states as a dd array (n_body, 6, 2): rows x, y, z [m],
+    vx, vy, vz [m/s].  Satellites: exact elements converted in mpmath and
+    rounded once to dd.  With free TMs (bodies 3 + 2 i + l) the TMs start
+    at their EH centers with the EH centers' velocities (from the nominal
+    attitude at t = 0, which needs the force model)."""
     gm = scenario.forces.gm_earth
     rows = []
     for sat in scenario.satellites:
         r, v = _el.elements_to_state(sat.a_m, sat.e, _el.deg(sat.i_deg), _el.deg(sat.raan_deg),
                                      _el.deg(sat.argp_deg), _el.deg(sat.nu_deg), gm)
         rows.append(_el.state_to_dd(r, v))
-    return np.stack(rows)
+    y = np.stack(rows)
+    system = build_system(scenario) if system is None else system
+    if not system.free_tms:
+        return y
+    model = build_force_model(scenario.forces) if model is None else model
+    cpar = system.cpar.copy()
+    cpar[_dyn.CP_MODE] = _dyn.MODE_COUPLED
+    tdat = (model.precompute(Epoch.from_utc(scenario.epoch_utc), np.zeros(1), np.zeros(1))[0]
+            if model.time_dependent else np.zeros(0))
+    _, aux = evaluate_rhs(y, tdat, model, cpar, with_aux=True)
+    v = _dyn.aux_views(aux)
+    tm = np.zeros((6, 6, 2))
+    tm[:, 0:3, 0] = v["tm_r_hi"].reshape(6, 3)
+    tm[:, 0:3, 1] = v["tm_r_lo"].reshape(6, 3)
+    tm[:, 3:6, 0] = v["tm_v_hi"].reshape(6, 3)
+    tm[:, 3:6, 1] = v["tm_v_lo"].reshape(6, 3)
+    return np.concatenate([y, tm])
 
 
 def _as_precision(y_dd: np.ndarray, precision: str) -> np.ndarray:
@@ -74,26 +142,30 @@ def _to_dd(y: np.ndarray, ndim_value: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout):
-    """One DP87 step in place: the 13 stages (K[0] = f(y) first), then the
-    compensated update of y.  tdat_step: (13, n_tdat) time-only inputs at
-    the stage times."""
-    system_rhs(y, tdat_step[0], params, layout, K[0])
+def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout,
+              cpar, aux0, aux, gw, fw):
+    """One DP87 step in place: the 13 stages (K[0] = f(y) first, its
+    diagnostics into aux0), then the compensated update of y.  tdat_step:
+    (13, n_tdat) time-only inputs at the stage times."""
+    system_rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
     for i in range(1, 13):
         dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
-        system_rhs(ystage, tdat_step[i], params, layout, K[i])
+        system_rhs(ystage, tdat_step[i], params, layout, cpar, K[i], aux, gw, fw)
     dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-                 n_steps, out_y, out_a):
+                 cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
     """n_steps fixed DP87 steps.  Before step n it records the state y_n in
     out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s acceleration (stage 1) in
-    out_a[n] (n_body, 3[, 2]).  tdat: (n_steps, 13, n_tdat)."""
+    out_a[n] (n_body, 3[, 2]) and its diagnostics in out_aux[n] (AUX_LEN,)
+    (if out_aux has rows).  tdat: (n_steps, 13, n_tdat)."""
     for n in range(n_steps):
         out_y[n] = y
-        _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout)
+        aux0 = out_aux[n] if out_aux.shape[0] > 0 else aux
+        _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout,
+                  cpar, aux0, aux, gw, fw)
         out_a[n] = K[0][:, 3:6]
 
 
@@ -120,22 +192,31 @@ def _scale_tableau(a, b, h, ha, hb):
             st(ha, mul(ld(a, i, j), h), i, j)
 
 
-def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel) -> np.ndarray:
-    """dy/dt at one instant, same layout and precision as ``y``."""
+def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: np.ndarray | None = None,
+                 with_aux: bool = False):
+    """dy/dt at one instant, same layout and precision as ``y``.
+
+    cpar: the system's parameters (:attr:`System.cpar`; default: point
+    masses).  With ``with_aux`` returns (k, aux), aux the (AUX_LEN,)
+    diagnostics of the coupled modes (see :func:`tqdyn.dynamics.aux_views`).
+    """
     k = np.zeros_like(y)
-    _rhs_at(y, tdat_row, model.params, model.layout, k)
-    return k
+    cpar = _dyn.make_cpar(_dyn.MODE_POINT_MASS) if cpar is None else cpar
+    gw, fw, aux = _dyn.workspace(y)
+    _rhs_at(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
+    return (k, aux) if with_aux else k
 
 
 @njit(cache=True)
-def _rhs_at(y, tdat_row, params, layout, k):
-    system_rhs(y, tdat_row, params, layout, k)
+def _rhs_at(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
+    system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)
 
 
-def warm_up(precision: str = "dd") -> None:
+def warm_up(precision: str = "dd", scenario=None) -> None:
     """Compile the fixed-step kernels for ``precision`` (numba JIT, a few
-    seconds on first use in a process) so that later timings measure the
-    propagation alone."""
+    seconds on first use in a process, then cached on disk) so that later
+    timings measure the propagation alone.  (One compiled kernel serves all
+    systems; ``scenario`` is accepted for symmetry and not needed.)"""
     _check_precision(precision)
     tail = (2,) if precision == "dd" else ()
     y = np.zeros((1, 6) + tail)
@@ -144,9 +225,12 @@ def warm_up(precision: str = "dd") -> None:
     coef = dp87.step_coefficients(dp87.load_tableau(), 1, precision)
     model = ForceModel([])
     K = np.zeros((13,) + y.shape)
+    cpar = _dyn.make_cpar(_dyn.MODE_POINT_MASS)
+    gw, fw, aux = _dyn.workspace(y)
     _fixed_chunk(y, np.zeros_like(y), K, np.zeros_like(y), np.zeros((1, 6)), coef.ha, coef.nz, coef.nnz,
-                 coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((1, 13, 0)), model.params, model.layout, 1,
-                 np.empty((1,) + y.shape), np.empty((1, 1, 3) + tail))
+                 coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((1, 13, 0)), model.params, model.layout,
+                 cpar, aux, gw, fw, 1, np.empty((1,) + y.shape), np.empty((1, 1, 3) + tail),
+                 np.empty((0, _dyn.AUX_LEN)))
     _grid_times(0, 1, np.array(coef.h), coef.c, np.empty((1, 2)), np.empty((0, 13, 2)))
     evaluate_rhs(y, np.zeros(0), model)
 
@@ -205,17 +289,41 @@ def two_body_energy(y_dd: np.ndarray, gm) -> list:
     return out
 
 
-def _rows(t, y, a, precision, every, n0):
+def _rows(t, y, a, precision, every, n0, aux=None, system: System | None = None):
     """Output rows for global step indices n0.. whose index is a multiple of ``every``."""
     sel = (np.arange(n0, n0 + t.shape[0]) % every) == 0
     y_dd = _to_dd(y[sel], 3)
     a_f = a[sel][..., 0] if precision == "dd" else a[sel]
-    return {
+    rows = {
         "t": (t[sel, 0], t[sel, 1]),
-        "sat/r": (y_dd[:, :, 0:3, 0], y_dd[:, :, 0:3, 1]),
-        "sat/v": (y_dd[:, :, 3:6, 0], y_dd[:, :, 3:6, 1]),
+        "sat/r": (y_dd[:, :3, 0:3, 0], y_dd[:, :3, 0:3, 1]),
+        "sat/v": (y_dd[:, :3, 3:6, 0], y_dd[:, :3, 3:6, 1]),
         "sat/a_gravity": a_f,
     }
+    if system is None or not system.coupled:
+        return rows
+    v = _dyn.aux_views(aux[sel])
+    rows.update({
+        "sat/a_gravity": v["a_gravity"],
+        "sat/a_dragfree": v["a_dragfree"],
+        "sat/T_S_I": v["T_S_I"],
+        "sat/omega": v["omega"],
+        "sat/omega_dot": v["omega_dot"],
+        "sat/breathing_angle": v["breathing_angle"],
+        "mosa/angle": 0.5 * v["theta"][..., None] * np.array([1.0, -1.0]),
+        "tm/a": v["tm_a"],
+        "tm/a_suspension": v["tm_a_suspension"],
+        "tm/alpha_suspension": v["tm_alpha_suspension"],
+    })
+    if system.free_tms:
+        tm = y_dd[:, 3:9].reshape(y_dd.shape[0], 3, 2, 6, 2)
+        rows["tm/r"] = (tm[..., 0:3, 0], tm[..., 0:3, 1])
+        rows["tm/v"] = (tm[..., 3:6, 0], tm[..., 3:6, 1])
+        rows["tm/housing_offset"] = v["tm_housing_offset"]
+    else:
+        rows["tm/r"] = (v["tm_r_hi"], v["tm_r_lo"])
+        rows["tm/v"] = (v["tm_v_hi"], v["tm_v_lo"])
+    return rows
 
 
 def _check_precision(precision):
@@ -248,17 +356,18 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
     precision = precision or scenario.run.precision
     _check_precision(precision)
     model = build_force_model(scenario.forces) if model is None else model
+    system = build_system(scenario)
     epoch = Epoch.from_utc(scenario.epoch_utc)
     tab = dp87.load_tableau(scenario.integrator.tableau)
-    y0_dd = initial_state(scenario) if y0 is None else np.asarray(y0, np.float64)
+    y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)
     if scenario.integrator.mode == "adaptive":
         if start is not None or checkpoint_every:
             raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
-        result = _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress)
+        result = _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system)
     else:
         result = _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                                  start, checkpoint, checkpoint_every)
-    if [t.name for t in model.terms] == ["earth_monopole"]:
+                                  start, checkpoint, checkpoint_every, system)
+    if [t.name for t in model.terms] == ["earth_monopole"] and not system.coupled:
         e0 = two_body_energy(result.y0, model.terms[0].gm)
         e1 = two_body_energy(result.y_final, model.terms[0].gm)
         with mpmath.workdps(60):
@@ -287,7 +396,7 @@ def _workspace(y0_dd, precision):
 
 
 def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                     start=None, checkpoint=None, checkpoint_every=0):
+                     start=None, checkpoint=None, checkpoint_every=0, system=None):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
     n_total = scenario.n_steps
     every = scenario.run.output_every
@@ -303,37 +412,57 @@ def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progre
     h = np.array(coef.h)
     nb = y.shape[0]
     acc_shape = (nb, 3) + y.shape[2:]
+    cpar = system.cpar
+    gw, fw, aux = _dyn.workspace(y)
+    n_aux = _dyn.AUX_LEN if system.coupled else 0
     t_start = _time.perf_counter()
-    while n < n_total:
-        m = min(chunk, n_total - n)
+    # chunk boundaries (fixed by chunk and checkpoint_every, so a resumed run
+    # takes the same steps); the time-only inputs of the next chunk are
+    # computed in a second thread while the compiled loop (nogil) runs.
+    plan = []
+    n_plan = n
+    while n_plan < n_total:
+        m = min(chunk, n_total - n_plan)
         if checkpoint_every:
-            m = min(m, (n // checkpoint_every + 1) * checkpoint_every - n)
+            m = min(m, (n_plan // checkpoint_every + 1) * checkpoint_every - n_plan)
+        plan.append((n_plan, m))
+        n_plan += m
+
+    def inputs(n0, m):
         t_out = np.empty((m, 2))
         t_nodes = np.empty((m if model.time_dependent else 0, 13, 2))
-        _grid_times(n, m, h, coef.c, t_out, t_nodes)
+        _grid_times(n0, m, h, coef.c, t_out, t_nodes)
         tdat = (model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1]) if model.time_dependent
                 else np.zeros((m, 13, 0)))
-        out_y = np.empty((m,) + y.shape)
-        out_a = np.empty((m,) + acc_shape)
-        _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
-                     coef.he, tdat, model.params, model.layout, m, out_y, out_a)
-        if sink is not None:
-            sink(_rows(t_out, out_y, out_a, precision, every, n))
-        n += m
-        if progress is not None:
-            progress(m)
-        if checkpoint is not None and checkpoint_every and n % checkpoint_every == 0 and n < n_total:
-            checkpoint(Checkpoint(n, y.copy(), comp.copy()))
+        return t_out, tdat
+
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pending = pool.submit(inputs, *plan[0]) if plan else None
+        for idx, (n0, m) in enumerate(plan):
+            t_out, tdat = pending.result()
+            pending = pool.submit(inputs, *plan[idx + 1]) if idx + 1 < len(plan) else None
+            out_y = np.empty((m,) + y.shape)
+            out_a = np.empty((m,) + acc_shape)
+            out_aux = np.empty((m if n_aux else 0, _dyn.AUX_LEN))
+            _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                         coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, m, out_y, out_a, out_aux)
+            if sink is not None:
+                sink(_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
+            n = n0 + m
+            if progress is not None:
+                progress(m)
+            if checkpoint is not None and checkpoint_every and n % checkpoint_every == 0 and n < n_total:
+                checkpoint(Checkpoint(n, y.copy(), comp.copy()))
     # the final state and its acceleration
     t_end = np.empty((1, 2))
     t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))
     _grid_times(n_total, 1, h, coef.c, t_end, t_nodes)
     tdat_end = (model.precompute(epoch, t_nodes[0, 0, 0], t_nodes[0, 0, 1]) if model.time_dependent
                 else np.zeros(0))
-    k_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model)
+    k_end, aux_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model, cpar, with_aux=True)
     wall = _time.perf_counter() - t_start
     if sink is not None:
-        sink(_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total))
+        sink(_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
     return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,
                      y_final=_to_dd(y, 2), n_steps=n_total, n_rejected=0,
                      n_rhs=13 * n_total + 1, wall_s=wall)
@@ -375,7 +504,7 @@ def _dense_output_max_step(y, a, rtol) -> float:
     return _DENSE_OUTPUT_SAFETY * (_QUINTIC_ERROR_DIVISOR * rtol) ** (1.0 / 6.0) / w if w > 0 else np.inf
 
 
-def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress):
+def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system):
     """Embedded-error step-size control (7th-order estimate, local error
     per step <= rtol * |r| and rtol * |v| per body), output sampled on the
     grid k * integrator.step_s by quintic Hermite dense output.  Time is
@@ -391,25 +520,29 @@ def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, pro
     z = np.array([0.0, 1.0])
     nb = y.shape[0]
     rows: list = []
+    cpar = system.cpar
+    gw, fw, aux = _dyn.workspace(y)
 
     def flush(force=False):
         if sink is not None and rows and (force or len(rows) >= _DEFAULT_CHUNK):
             t_arr = np.array([r[0] for r in rows])
             y_arr = np.stack([r[1] for r in rows])
             a_arr = np.stack([r[2] for r in rows])
-            sink(_rows(t_arr, y_arr, a_arr, precision, 1, 0))
+            aux_arr = np.stack([r[3] for r in rows])
+            sink(_rows(t_arr, y_arr, a_arr, precision, 1, 0, aux_arr, system))
             rows.clear()
 
     def emit(t_exact, y_row):
-        k_row = evaluate_rhs(y_row, _node_tdat(model, epoch, [t_exact])[0], model)
-        rows.append((_dd_of(t_exact), y_row.copy(), k_row[:, 3:6].copy()))
+        k_row, aux_row = evaluate_rhs(y_row, _node_tdat(model, epoch, [t_exact])[0], model, cpar, with_aux=True)
+        rows.append((_dd_of(t_exact), y_row.copy(), k_row[:, 3:6].copy(), aux_row))
         flush()
 
     t_start = _time.perf_counter()
     t = Fraction(0)
     k_out = 1
     emit(t, y)
-    h_max = _dense_output_max_step(y, rows[0][2] if rows else evaluate_rhs(y, _node_tdat(model, epoch, [t])[0], model)[:, 3:6], rtol)
+    h_max = _dense_output_max_step(y, rows[0][2] if rows else evaluate_rhs(y, _node_tdat(model, epoch, [t])[0], model,
+                                                                            cpar)[:, 3:6], rtol)
     h = min(float(min(dt_out, T)), h_max)
     n_acc = n_rej = n_rhs = 0
     while t < T:
@@ -421,13 +554,13 @@ def _propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, pro
         tdat = _node_tdat(model, epoch, [t + ci * h_exact for ci in c_nodes])
         y_try, comp_try = y.copy(), comp.copy()
         _one_step(y_try, comp_try, K, ystage, err, ha, unit.nz, unit.nnz, hb, unit.nzb, unit.nnzb, he,
-                  tdat, model.params, model.layout)
+                  tdat, model.params, model.layout, cpar, aux, aux, gw, fw)
         n_rhs += 13
         norm = dp87.error_norm(y_try, err, rtol)
         if norm <= 1.0:
             t_new = t + h_exact
             a0 = K[0][:, 3:6].copy()
-            a1 = evaluate_rhs(y_try, _node_tdat(model, epoch, [t_new])[0], model)[:, 3:6]
+            a1 = evaluate_rhs(y_try, _node_tdat(model, epoch, [t_new])[0], model, cpar)[:, 3:6]
             n_rhs += 1
             while k_out * dt_out <= t_new:
                 t_k = k_out * dt_out

@@ -26,7 +26,12 @@ TOML layout (every section and key optional except at least one
     [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
                     tableau ("corrected" | "published"), rtol
     [forces]        earth_monopole, gm_earth [m^3/s^2]
-    [spacecraft]    d_tm [m], d_p [m]
+    [constellation] pointing ("none" | "global" | "taylor1" | "taylor2" |
+                    "iterative"), control ("on" | "off"), free_tms (bool)
+    [spacecraft]    d_tm [m], d_p [m], tm_axis ("x" | "y" | "z"),
+                    self_gravity ("table-iv" | "off" | array (2, 3) or
+                    (3, 2, 3) [m/s^2] in OA_l), self_gravity_common (array
+                    (3,) or (3, 3) [m/s^2] in S, on both TMs of a satellite)
     [[satellites]]  name, a_km, e, i_deg, raan_deg, argp_deg, nu_deg
 
 Errors are :class:`ScenarioError` (a ``ValueError``) with one line
@@ -55,6 +60,8 @@ __all__ = [
     "RunConfig",
     "ForcesConfig",
     "SpacecraftConfig",
+    "ConstellationConfig",
+    "POINTING_LAWS",
     "Scenario",
     "ScenarioError",
     "builtin_scenarios",
@@ -354,23 +361,121 @@ class ForcesConfig:
                  "needs the Earth's non-central field", "false, or earth_degree >= 2")
 
 
+SELF_GRAVITY_MODELS = ("table-iv", "off")
+TM_AXES = ("x", "y", "z")
+
+
+def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: str) -> tuple:
+    """Nested tuples of Decimal with one of ``shapes`` (ScenarioError otherwise)."""
+    allowed = " or ".join(str(tuple(s)) for s in shapes)
+    allowed = f"an array of shape {allowed} of finite numbers [{unit}]"
+
+    def conv(x, depth):
+        if isinstance(x, (list, tuple)):
+            return tuple(conv(e, depth + 1) for e in x)
+        if isinstance(x, bool) or not isinstance(x, (int, float, Decimal)):
+            raise ScenarioError(name, value, f"contains {_a(_toml_type(x))}", allowed)
+        d = Decimal(str(x)) if isinstance(x, float) else Decimal(x)
+        _require(d.is_finite(), name, value, "is not finite", allowed)
+        return d
+
+    arr = conv(value, 0)
+
+    def shape(x):
+        if not isinstance(x, tuple):
+            return ()
+        inner = {shape(e) for e in x}
+        return (len(x),) + inner.pop() if len(inner) == 1 else (len(x), -1)
+
+    _require(isinstance(arr, tuple) and shape(arr) in [tuple(s) for s in shapes], name,
+             value, "has the wrong shape", allowed)
+    return arr
+
+
 @dataclass(frozen=True)
 class SpacecraftConfig:
-    """Spacecraft geometry.
+    """Spacecraft architecture (the same for the three satellites).
 
     ``d_tm_m`` [m] (> 0): distance between the two test masses;
     ``d_p_m`` [m] (>= 0): distance of the MOSA pivots from the
-    electrode-housing centers.
+    electrode-housing centers; ``tm_axis``: S-frame axis along which the two
+    TMs lie (TM_1 at +d_tm/2);  ``self_gravity``: DC self-gravity of each TM
+    in its OA_l frame, "table-iv" (the paper's Table IV), "off", or an array
+    of shape (2, 3) (both satellites alike) or (3, 2, 3) [m/s^2];
+    ``self_gravity_common``: an extra DC acceleration on both TMs of a
+    satellite, fixed in the satellite frame S, shape (3,) (all satellites)
+    or (3, 3) [m/s^2] (the paper's common self-gravity studies).
     """
 
     d_tm_m: Decimal = Decimal("0.40")
     d_p_m: Decimal = Decimal("0")
+    tm_axis: str = "y"
+    self_gravity: Any = "table-iv"
+    self_gravity_common: Any = (Decimal(0), Decimal(0), Decimal(0))
 
     def __post_init__(self) -> None:
         _set(self, "d_tm_m", _to_decimal(self.d_tm_m, "spacecraft.d_tm_m"))
         _set(self, "d_p_m", _to_decimal(self.d_p_m, "spacecraft.d_p_m"))
         _require(self.d_tm_m > 0, "spacecraft.d_tm_m", self.d_tm_m, "is not positive", "d_tm > 0 m")
         _require(self.d_p_m >= 0, "spacecraft.d_p_m", self.d_p_m, "is negative", "d_p >= 0 m")
+        _require_choice(self.tm_axis, "spacecraft.tm_axis", TM_AXES)
+        if isinstance(self.self_gravity, str):
+            _require_choice(self.self_gravity, "spacecraft.self_gravity", SELF_GRAVITY_MODELS)
+        else:
+            _set(self, "self_gravity", _num_array(self.self_gravity, "spacecraft.self_gravity",
+                                                  ((2, 3), (3, 2, 3)), "m/s^2 in OA_l"))
+        _set(self, "self_gravity_common", _num_array(self.self_gravity_common, "spacecraft.self_gravity_common",
+                                                     ((3,), (3, 3)), "m/s^2 in S"))
+
+    def self_gravity_values(self):
+        """(oa, common): float64 arrays (3, 2, 3) [m/s^2, OA_l] and (3, 3) [m/s^2, S]."""
+        import numpy as np
+
+        if self.self_gravity == "off":
+            oa = np.zeros((3, 2, 3))
+        elif self.self_gravity == "table-iv":
+            oa = None
+        else:
+            oa = np.broadcast_to(np.array(self.self_gravity, dtype=np.float64), (3, 2, 3)).copy()
+        common = np.broadcast_to(np.array(self.self_gravity_common, dtype=np.float64), (3, 3)).copy()
+        return oa, common
+
+
+POINTING_LAWS = ("none", "global", "taylor1", "taylor2", "iterative")
+CONTROL_MODES = ("on", "off")
+
+
+@dataclass(frozen=True)
+class ConstellationConfig:
+    """Attitude and control of a three-satellite constellation.
+
+    ``pointing``: "none" (satellites are independent point masses, no
+    attitude) or the pointing law of the attitude (see
+    :mod:`tqdyn.constellation.pointing`); ``control``: "on" applies the
+    drag-free acceleration G_i to the satellites' orbits, "off" propagates
+    the pure-gravity constellation (attitude and the control that would be
+    needed are still output); ``free_tms``: verification mode that also
+    propagates the six TMs as free bodies.
+    """
+
+    pointing: str = "none"
+    control: str = "off"
+    free_tms: bool = False
+
+    def __post_init__(self) -> None:
+        _require_choice(self.pointing, "constellation.pointing", POINTING_LAWS)
+        _require_choice(self.control, "constellation.control", CONTROL_MODES)
+        _require(isinstance(self.free_tms, bool), "constellation.free_tms", self.free_tms, "is not a boolean",
+                 "true or false")
+        _require(self.pointing != "none" or self.control == "off", "constellation.control", self.control,
+                 'needs an attitude (constellation.pointing = "none")', 'control = "off", or a pointing law')
+        _require(self.pointing != "none" or not self.free_tms, "constellation.free_tms", True,
+                 'needs an attitude (constellation.pointing = "none")', "false, or a pointing law")
+
+    @property
+    def coupled(self) -> bool:
+        """True when the run has attitudes, TMs and control (pointing != "none")."""
+        return self.pointing != "none"
 
 
 @dataclass(frozen=True)
@@ -391,6 +496,7 @@ class Scenario:
     integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
     forces: ForcesConfig = field(default_factory=ForcesConfig)
     spacecraft: SpacecraftConfig = field(default_factory=SpacecraftConfig)
+    constellation: ConstellationConfig = field(default_factory=ConstellationConfig)
     satellites: tuple[SatelliteConfig, ...] = ()
 
     def __post_init__(self) -> None:
@@ -403,7 +509,8 @@ class Scenario:
             raise ScenarioError("scenario.epoch_utc", self.epoch_utc, f"is not a valid UTC epoch ({reason})",
                                 "a UTC date-time YYYY-MM-DDTHH:MM:SS[.fff] from 1960 on") from None
         _set(self, "epoch_utc", epoch.utc_iso)
-        for name, cls in (("run", RunConfig), ("integrator", IntegratorConfig), ("forces", ForcesConfig), ("spacecraft", SpacecraftConfig)):
+        for name, cls in (("run", RunConfig), ("integrator", IntegratorConfig), ("forces", ForcesConfig),
+                          ("spacecraft", SpacecraftConfig), ("constellation", ConstellationConfig)):
             _require(isinstance(getattr(self, name), cls), name, getattr(self, name), f"is not a {cls.__name__}", cls.__name__)
         sats = tuple(self.satellites)
         _require(len(sats) >= 1, "satellites", list(sats), "is empty", "at least one satellite")
@@ -414,6 +521,10 @@ class Scenario:
                 raise ScenarioError(f"satellites.{k}.name", sat.name, f"duplicates satellites.{seen[sat.name]}.name", "unique satellite names")
             seen[sat.name] = k
         _set(self, "satellites", sats)
+        if self.constellation.coupled:
+            _require(len(sats) == 3, "constellation.pointing", self.constellation.pointing,
+                     f"needs exactly 3 satellites (the scenario has {len(sats)})",
+                     '"none" for other constellations')
         if self.integrator.mode == "fixed":
             with localcontext() as ctx:
                 ctx.prec = _EXACT
@@ -471,7 +582,13 @@ class Scenario:
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
                 f"eop = {b(f.eop)}", ""]
         s = self.spacecraft
-        out += ["[spacecraft]", f"d_tm = {_toml_dec(s.d_tm_m)}  # m", f"d_p = {_toml_dec(s.d_p_m)}  # m", ""]
+        out += ["[spacecraft]", f"d_tm = {_toml_dec(s.d_tm_m)}  # m", f"d_p = {_toml_dec(s.d_p_m)}  # m",
+                f"tm_axis = {_toml_str(s.tm_axis)}",
+                f"self_gravity = {_toml_value(s.self_gravity)}  # m/s^2 in OA_l",
+                f"self_gravity_common = {_toml_value(s.self_gravity_common)}  # m/s^2 in S", ""]
+        c = self.constellation
+        out += ["[constellation]", f"pointing = {_toml_str(c.pointing)}", f"control = {_toml_str(c.control)}",
+                f"free_tms = {b(c.free_tms)}", ""]
         for sat in self.satellites:
             with localcontext() as ctx:
                 ctx.prec = _EXACT
@@ -480,6 +597,15 @@ class Scenario:
                     f"i_deg = {_toml_dec(sat.i_deg)}", f"raan_deg = {_toml_dec(sat.raan_deg)}",
                     f"argp_deg = {_toml_dec(sat.argp_deg)}", f"nu_deg = {_toml_dec(sat.nu_deg)}", ""]
         return "\n".join(out)
+
+
+def _toml_value(x: Any) -> str:
+    """A string or a nested tuple of Decimals as TOML."""
+    if isinstance(x, str):
+        return _toml_str(x)
+    if isinstance(x, tuple):
+        return "[" + ", ".join(_toml_value(e) for e in x) + "]"
+    return _toml_dec(x)
 
 
 def _toml_dec(d: Decimal) -> str:
@@ -507,6 +633,7 @@ def _toml_str(s: str) -> str:
 
 _STR, _NUM, _INT, _BOOL, _DUR, _EPOCH = "string", "number", "integer", "boolean", "duration", "epoch"
 _STRLIST = "list of strings"
+_ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
     "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH},
@@ -516,7 +643,8 @@ _SCHEMA: dict[str, dict[str, str]] = {
                "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
                "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
                "earth_field_indirect": _BOOL, "eop": _BOOL},
-    "spacecraft": {"d_tm": _NUM, "d_p": _NUM},
+    "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY},
+    "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
 }
 _SAT_SCHEMA: dict[str, str] = {
     "name": _STR, "a_km": _NUM, "e": _NUM, "i_deg": _NUM, "raan_deg": _NUM, "argp_deg": _NUM, "nu_deg": _NUM,
@@ -546,6 +674,8 @@ def _typed(value: Any, kind: str, name: str) -> Any:
         ok = isinstance(value, list) and all(isinstance(x, str) for x in value)
         _require(ok, name, value, f"is {_a(_toml_type(value))}", "a list of strings")
         return tuple(value)
+    if kind == _ANY:
+        return value
     if kind == _DUR:
         d = _parse_duration(value, name)
         return d
@@ -637,6 +767,7 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     integ = _build(IntegratorConfig, "integrator", raw.get("integrator", {}), _SCHEMA["integrator"])
     forces = _build(ForcesConfig, "forces", raw.get("forces", {}), _SCHEMA["forces"])
     craft = _build(SpacecraftConfig, "spacecraft", raw.get("spacecraft", {}), _SCHEMA["spacecraft"])
+    const = _build(ConstellationConfig, "constellation", raw.get("constellation", {}), _SCHEMA["constellation"])
     sats_raw = raw.get("satellites")
     _require(sats_raw is not None, "satellites", _NOVALUE, "is missing", "at least one [[satellites]] table")
     _require(isinstance(sats_raw, list) and len(sats_raw) >= 1, "satellites", sats_raw, "is not a non-empty array of tables",
@@ -646,7 +777,7 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     desc = _typed(meta.get("description", ""), _STR, "scenario.description")
     epoch = _typed(meta.get("epoch_utc", DEFAULT_EPOCH_UTC), _EPOCH, "scenario.epoch_utc")
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
-                    spacecraft=craft, satellites=sats)
+                    spacecraft=craft, constellation=const, satellites=sats)
 
 
 # --------------------------------------------------------------------------- overrides

@@ -1,0 +1,178 @@
+"""Run a scenario to a trajectory file: the job behind ``tqdyn run`` and ``tqdyn sweep``.
+
+This module composes the library: it chooses the fields and root attributes
+of the output file from the scenario, streams the propagator's rows into
+:class:`tqdyn.io.TrajectoryWriter` (atomic: no file, or a complete one),
+writes resumable checkpoints and resumes from them.  It prints nothing; the
+CLI and the sweep driver report.
+
+Errors: bad input (scenario, output path, data limits, a checkpoint of
+another run) raises ``ValueError`` / :class:`tqdyn.io.OutputError` before
+anything is written.  Any exception during the propagation (including
+``KeyboardInterrupt``) is re-raised after clean-up; its attribute
+``tqdyn_checkpoint`` is the checkpoint path if the run can be resumed
+(``--resume``), else None.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from . import io, propagator
+from .propagator import Checkpoint, RunResult
+
+__all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What :func:`run_to_file` did.
+
+    result : the propagator's :class:`~tqdyn.propagator.RunResult`;
+    path : the trajectory file; rows : time rows written;
+    compile_s : JIT compilation / warm-up time [s] (0 when cached in-process).
+    """
+
+    result: RunResult
+    path: Path
+    rows: int
+    compile_s: float
+
+    @property
+    def size_mb(self) -> float:
+        """Size of the trajectory file in MB."""
+        return self.path.stat().st_size / 1e6
+
+
+def output_fields(scen) -> tuple[str, ...]:
+    """Trajectory fields a run of ``scen`` writes (see :data:`tqdyn.io.FIELDS`)."""
+    fields = ["t", "sat/r", "sat/v", "sat/a_gravity"]
+    if scen.constellation.coupled:
+        fields += ["sat/a_dragfree", "sat/T_S_I", "sat/omega", "sat/omega_dot", "sat/breathing_angle",
+                   "mosa/angle", "tm/r", "tm/v", "tm/a", "tm/a_suspension", "tm/alpha_suspension",
+                   "tm/self_gravity"]
+        if scen.constellation.free_tms:
+            fields.append("tm/housing_offset")
+    return tuple(fields)
+
+
+def output_attrs(scen) -> dict:
+    """Root attributes of the trajectory file of ``scen``."""
+    integ = scen.integrator
+    c = scen.constellation
+    return {
+        "scenario": scen.to_toml(),
+        "epoch_utc": scen.epoch_utc,
+        "precision": scen.run.precision,
+        "step_s": float(integ.step_s),
+        "integrator": f"dp87-{integ.mode}-{integ.tableau}",
+        "pointing": c.pointing,
+        "control": c.control,
+        "free_tms": int(c.free_tms),
+    }
+
+
+def checkpoint_path(output) -> Path:
+    """Checkpoint file of a run writing ``output``: ``<output>.checkpoint``."""
+    p = Path(output)
+    return p.with_name(p.name + ".checkpoint")
+
+
+def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = None,
+                checkpoint_every: int = 0, resume: bool = False) -> RunSummary:
+    """Propagate ``scen`` and write its trajectory to ``scen.run.output``.
+
+    Parameters
+    ----------
+    scen : :class:`tqdyn.scenario.Scenario`.
+    model : the force model (built from ``scen.forces`` if None).
+    progress : called with the number of steps done since the last call
+        (fixed mode) or the TDB seconds advanced (adaptive mode).
+    checkpoint_every : write a checkpoint ``<output>.checkpoint`` every that
+        many steps (fixed mode; 0 = never).  An interrupted run keeps it and
+        its partial trajectory; ``resume=True`` continues it to the same file
+        bit for bit.
+    resume : continue from the checkpoint (it must belong to the same
+        resolved scenario and precision).
+    """
+    out_path = io.check_writable(scen.run.output)
+    if model is None:
+        model = propagator.check_inputs(scen)
+    fixed = scen.integrator.mode == "fixed"
+    if not fixed:
+        checkpoint_every = 0
+    ckpt = checkpoint_path(out_path)
+    if resume:
+        start, writer_factory = _resume(ckpt, scen, out_path)
+    else:
+        if ckpt.exists():
+            raise ValueError(f"{ckpt} holds the checkpoint of an interrupted run: continue it with "
+                             f"--resume, or delete it to start again")
+        start = None
+        writer_factory = None
+    t0 = time.perf_counter()
+    propagator.warm_up(scen.run.precision, scen)
+    compile_s = time.perf_counter() - t0
+    if writer_factory is not None:
+        writer = writer_factory()
+    else:
+        writer = io.TrajectoryWriter(out_path, output_attrs(scen), output_fields(scen),
+                                     n_sat=len(scen.satellites),
+                                     expected_rows=scen.n_steps // scen.run.output_every + 1)
+        if scen.constellation.coupled:
+            writer.set_static("tm/self_gravity", propagator.self_gravity_oa(scen))
+
+    def save_checkpoint(c: Checkpoint):
+        partial = writer.sync()
+        _write_checkpoint(ckpt, scen.to_toml(), scen.run.precision, c, partial, writer.rows_written)
+
+    try:
+        result = propagator.propagate(scen, sink=writer.append, progress=progress, model=model, start=start,
+                                      checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
+        rows = writer.rows_written
+        writer.close()
+    except BaseException as exc:
+        # keep the partial trajectory while a checkpoint refers to it; else discard it
+        resumable = ckpt.exists()
+        writer.keep_partial() if resumable else writer.abort()
+        try:
+            exc.tqdyn_checkpoint = ckpt if resumable else None
+        except AttributeError:  # pragma: no cover - exceptions without a __dict__
+            pass
+        raise
+    ckpt.unlink(missing_ok=True)
+    return RunSummary(result=result, path=out_path, rows=rows, compile_s=compile_s)
+
+
+def _write_checkpoint(path, scenario_toml, precision, c, partial, rows):
+    """Atomically write a run checkpoint (npz): the resolved scenario, the
+    step count, the state (all propagated bodies, TMs included in the free-TM
+    mode) and its compensation, the partial trajectory file and how many of
+    its rows the checkpoint covers."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as fh:
+        np.savez(fh, scenario=np.array(scenario_toml), precision=np.array(precision), n=np.array(c.n),
+                 y=c.y, comp=c.comp, partial=np.array(partial), rows=np.array(rows))
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def _resume(ckpt_path, scen, out_path):
+    """(Checkpoint, writer factory) of an interrupted run; ValueError if
+    there is none or it belongs to another scenario."""
+    if not ckpt_path.exists():
+        raise ValueError(f"--resume: no checkpoint {ckpt_path} to continue from")
+    with np.load(ckpt_path, allow_pickle=False) as data:
+        if str(data["scenario"]) != scen.to_toml() or str(data["precision"]) != scen.run.precision:
+            raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
+                             f"precision; give the same arguments as the interrupted run")
+        start = Checkpoint(int(data["n"]), np.array(data["y"]), np.array(data["comp"]))
+        partial, rows = str(data["partial"]), int(data["rows"])
+    return start, lambda: io.TrajectoryWriter.reopen(partial, out_path, rows)
