@@ -220,11 +220,13 @@ def test_data_limits_are_bad_input(tmp_path, capsys):
     assert _no_files(tmp_path) == []
 
 
-def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("extra", [[], ["--set", "constellation.free_tms=true"]], ids=["coupled", "free-tms"])
+def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch, extra):
     """Ctrl-C after a checkpoint: exit 130, no output file, a checkpoint;
     `--resume` with the same arguments finishes to a file identical bit for
-    bit to the uninterrupted run (full force model, 1 day)."""
-    args = ["run", "tianqin", "--duration", "1d", "--checkpoint-every", "500", "-q"]
+    bit to the uninterrupted run (full force model and coupled attitude /
+    control, 1 day; with free TMs the checkpoint carries the TM states)."""
+    args = ["run", "tianqin", "--duration", "1d", "--checkpoint-every", "500", "-q", *extra]
     ref = tmp_path / "ref.h5"
     status, _, err = _run(args + ["-o", str(ref)], capsys)
     assert status == 0, err

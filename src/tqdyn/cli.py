@@ -1,4 +1,4 @@
-"""Command line: ``tqdyn run | info | bench``.
+"""Command line: ``tqdyn run | info | forces | bench | export | sweep``.
 
 The CLI only composes library calls: it resolves the scenario, checks the
 output path, runs the propagator with a progress bar, streams the rows into
@@ -262,8 +262,10 @@ def bench(duration, step, no_heyoka, which):
 
 
 from .cli_export import export as _export_command  # noqa: E402  (commands in their own modules)
+from .cli_sweep import sweep as _sweep_command  # noqa: E402
 
 cli.add_command(_export_command)
+cli.add_command(_sweep_command)
 
 
 def main(argv=None):

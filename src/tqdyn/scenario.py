@@ -468,9 +468,10 @@ class ConstellationConfig:
         _require(isinstance(self.free_tms, bool), "constellation.free_tms", self.free_tms, "is not a boolean",
                  "true or false")
         _require(self.pointing != "none" or self.control == "off", "constellation.control", self.control,
-                 'needs an attitude (constellation.pointing = "none")', 'control = "off", or a pointing law')
+                 'needs an attitude, but constellation.pointing = "none"',
+                 'control = "off" (the pure-gravity constellation), or a pointing law')
         _require(self.pointing != "none" or not self.free_tms, "constellation.free_tms", True,
-                 'needs an attitude (constellation.pointing = "none")', "false, or a pointing law")
+                 'needs an attitude, but constellation.pointing = "none"', "false, or a pointing law")
 
     @property
     def coupled(self) -> bool:

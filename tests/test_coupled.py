@@ -1,0 +1,274 @@
+"""The coupled constellation: attitude + nominal control inside the integrator.
+
+References are independent of the compiled right-hand side:
+* the numpy implementations of the attitude (``constellation.attitude``) and
+  of the control (``constellation.control``), fed with the propagated states
+  and with gravity evaluated separately at the TM positions;
+* the three control conditions themselves (paper sec. IV; DESIGN 4);
+* finite differences of the output frames;
+* the pure-gravity propagation (control = "off" must reproduce it bit for bit);
+* the free-TM verification mode (TMs as free bodies stay at their EH centers).
+Magnitudes are compared with the paper's (sec. V.B), not tuned to them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tqdyn import cli, io, propagator, runner
+from tqdyn.constellation import attitude as att
+from tqdyn.constellation import control as ctl
+from tqdyn.constellation._control_jit import housing_geometry, satellite_control
+from tqdyn.constellation.spacecraft import Spacecraft
+from tqdyn.scenario import load_scenario
+from tqdyn.timescales import Epoch
+
+#: a cheap force model with the same structure (monopole, Moon and Sun in dd,
+#: degree-2 Earth field) for the short checks; the full model is the default
+#: scenario and is exercised by the CLI tests and the benchmarks.
+CHEAP = ["forces.earth_degree=2", "forces.third_bodies=sun,moon", "forces.solid_tides=false",
+         "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.moon_degree=0", "forces.sun_j2=false",
+         "forces.relativity=false", "forces.earth_field_indirect=false"]
+
+
+def _run(tmp_path, name, overrides, duration="2h"):
+    scen = load_scenario("tianqin", [f"run.duration={duration}", f"run.output={tmp_path / name}", *overrides])
+    summary = runner.run_to_file(scen)
+    return scen, io.read_trajectory(summary.path), summary.result
+
+
+@pytest.fixture(scope="module")
+def table_iv_run(tmp_path_factory):
+    return _run(tmp_path_factory.mktemp("c"), "tableiv.h5", CHEAP)
+
+
+@pytest.fixture(scope="module")
+def no_sg_run(tmp_path_factory):
+    return _run(tmp_path_factory.mktemp("c"), "nosg.h5", CHEAP + ["spacecraft.self_gravity=off"], duration="1d")
+
+
+def _gravity_at(scen, t_pair, positions_dd, velocities):
+    """Total gravity [m/s^2] of the scenario's model at dd positions (n, 3, 2)
+    at time t (dd pair): the point-mass right-hand side of tqdyn, evaluated
+    separately from the coupled kernel."""
+    model = propagator.check_inputs(scen)
+    tdat = model.precompute(Epoch.from_utc(scen.epoch_utc), np.array([t_pair[0]]), np.array([t_pair[1]]))[0]
+    y = np.zeros((positions_dd.shape[0], 6, 2))
+    y[:, 0:3] = positions_dd
+    y[:, 3:6, 0] = velocities
+    return propagator.evaluate_rhs(y, tdat, model)[:, 3:6]
+
+
+# ---------------------------------------------------------------------------
+# compiled control kernels vs the numpy reference
+
+
+def test_control_kernels_match_numpy():
+    rng = np.random.default_rng(7)
+    craft = Spacecraft(d_tm=0.4, d_p=0.05, tm_axis="y", self_gravity_on=False)
+    theta = np.pi / 3 + 1e-3 * rng.standard_normal(3)
+    th1, th2 = 1e-9 * rng.standard_normal(3), 1e-15 * rng.standard_normal(3)
+    w = np.array([1e-9, -2e-9, 2e-5]) + 1e-10 * rng.standard_normal((3, 3))
+    wd = 1e-13 * rng.standard_normal((3, 3))
+    dg = 1e-10 * rng.standard_normal((3, 2, 3))
+    sg = 1e-10 * rng.standard_normal((3, 2, 3))
+    r0, rho, vel = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 2, 3))
+    g, A, G, alpha = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 3)), np.zeros((3, 2, 3))
+    for i in range(3):
+        housing_geometry(i, theta[i], th1[i], craft.d_p, craft.nominal_housing_centers, craft.theta_nominal,
+                         w, r0, rho, vel)
+        satellite_control(i, dg, sg, w, wd, theta[i], th1[i], th2[i], r0, rho, g, A, G, alpha)
+    np.testing.assert_allclose(r0, craft.housing_centers(theta), rtol=0, atol=1e-16)
+    np.testing.assert_allclose(rho, craft.lever_arms(theta), rtol=0, atol=1e-16)
+    wm, wmd = ctl.mosa_angular_rates(th1, th2)
+    ref_v = np.cross(w[:, None, :], r0) + np.cross(wm, rho)
+    np.testing.assert_allclose(vel, ref_v, rtol=0, atol=1e-21)            # m/s, |vel| ~ 4e-6
+    g_ref = ctl.tm_relative_acceleration(dg, w, wd, wm, wmd, r0, rho, sg)
+    np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-24)              # m/s^2, |g| ~ 1e-10
+    np.testing.assert_allclose(A, ctl.suspension_acceleration(g_ref, theta), rtol=0, atol=1e-23)
+    np.testing.assert_allclose(G, ctl.dragfree_acceleration(g_ref, theta), rtol=0, atol=1e-23)
+    np.testing.assert_allclose(alpha, ctl.tm_angular_acceleration(w, wd, wm, wmd, theta), rtol=0, atol=1e-26)
+
+
+# ---------------------------------------------------------------------------
+# the coupled right-hand side vs the numpy pipeline on propagated states
+
+
+@pytest.mark.parametrize("row", [0, 77, 144])
+def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
+    """Attitude, differential gravity, suspension, G and TM angular
+    acceleration of an output row, recomputed with the numpy modules from
+    the row's states and gravity evaluated separately at the TM positions."""
+    scen, tr, _ = table_iv_run
+    r = tuple(x[row] for x in tr.dd("sat/r"))
+    v = tr["sat/v"][row]
+    a_tot = tr["sat/a_gravity"][row] + tr["sat/a_dragfree"][row]  # what the orbit follows
+    ref = att.attitude(r, v, a_tot, law="global")
+    np.testing.assert_allclose(tr["sat/T_S_I"][row], ref.T_S_I, rtol=0, atol=5e-16)  # a few ulp
+    np.testing.assert_allclose(tr["sat/omega"][row], ref.omega, rtol=0, atol=5e-20)       # rad/s, |w| 2e-5
+    np.testing.assert_allclose(tr["sat/omega_dot"][row], ref.omega_dot, rtol=0, atol=1e-24)  # rad/s^2
+    np.testing.assert_allclose(tr["mosa/angle"][row], ref.mosa_angle, rtol=0, atol=5e-16)
+
+    craft = Spacecraft(d_tm=float(scen.spacecraft.d_tm_m), d_p=float(scen.spacecraft.d_p_m))
+    r0_I = np.einsum("sji,slj->sli", ref.T_S_I, craft.housing_centers(ref.theta))  # T_I_S r0
+    tm_hi, tm_lo = tr.dd("tm/r")
+    np.testing.assert_allclose((tm_hi[row] - r[0][:, None, :]) + (tm_lo[row] - r[1][:, None, :]), r0_I,
+                               rtol=0, atol=1e-15)                                   # m
+    t_pair = tuple(x[row] for x in tr.dd("t"))
+    pos = np.concatenate([np.stack(r, axis=-1), np.stack([tm_hi[row], tm_lo[row]], axis=-1).reshape(6, 3, 2)])
+    vel = np.concatenate([v, tr["tm/v"][row].reshape(6, 3)])
+    acc = _gravity_at(scen, t_pair, pos, vel)
+    # differential gravity in dd, rounded afterwards (no cancellation)
+    dg = (acc[3:, :, 0] - acc[:3, None, :, 0].repeat(2, 1).reshape(6, 3)
+          + (acc[3:, :, 1] - acc[:3, None, :, 1].repeat(2, 1).reshape(6, 3))).reshape(3, 2, 3)
+    np.testing.assert_allclose(tr["sat/a_gravity"][row], acc[:3, :, 0] + acc[:3, :, 1], rtol=0, atol=1e-18)
+    wm, wmd = ctl.mosa_angular_rates(ref.theta_dot, ref.theta_ddot)
+    nc = ctl.nominal_control(ref.T_S_I, ref.omega, ref.omega_dot, ref.theta, wm, wmd, dg,
+                             Spacecraft(self_gravity=propagator.self_gravity_oa(scen)))
+    # m/s^2; suspension ~1e-10, G ~ 1e-11: agreement at ~1e-16 relative
+    np.testing.assert_allclose(tr["tm/a_suspension"][row], nc.a_suspension, rtol=0, atol=2e-25)
+    np.testing.assert_allclose(tr["sat/a_dragfree"][row], nc.a_dragfree, rtol=0, atol=2e-25)
+    np.testing.assert_allclose(tr["tm/alpha_suspension"][row], nc.alpha_suspension, rtol=0, atol=1e-24)  # as omega_dot
+    np.testing.assert_array_equal(tr["tm/self_gravity"], propagator.self_gravity_oa(scen))
+
+    # the three control conditions, with the compiled A and G and the reference g
+    A_S = np.einsum("slji,slj->sli", ctl.oa_rotation(ref.theta), tr["tm/a_suspension"][row])  # T_S_OA A
+    G_S = np.einsum("sij,sj->si", ref.T_S_I, tr["sat/a_dragfree"][row])
+    cond_a = np.abs(A_S + nc.g - G_S[:, None, :]).max()
+    assert cond_a < 1e-25, cond_a                                                   # (a) G = A_l + g_l
+    assert np.all(tr["tm/a_suspension"][row][..., 0] == 0.0)                         # (b) no x actuation
+    np.testing.assert_array_equal(tr["tm/a_suspension"][row][:, 0, 2], -tr["tm/a_suspension"][row][:, 1, 2])  # (c)
+
+
+def test_frames_and_pointing_on_trajectory(table_iv_run):
+    _, tr, _ = table_iv_run
+    T = tr["sat/T_S_I"]
+    assert np.abs(T @ np.swapaxes(T, -1, -2) - np.eye(3)).max() < 1e-15
+    assert np.abs(np.linalg.det(T) - 1.0).max() < 1e-15
+    hi, lo = tr.dd("sat/r")
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        nj = (hi[:, j] - hi[:, i]) + (lo[:, j] - lo[:, i])
+        nk = (hi[:, k] - hi[:, i]) + (lo[:, k] - lo[:, i])
+        nj /= np.linalg.norm(nj, axis=-1, keepdims=True)
+        nk /= np.linalg.norm(nk, axis=-1, keepdims=True)
+        X, Z = T[:, i, 0], T[:, i, 2]
+        assert np.abs(np.einsum("nq,nq->n", X, nj) - np.einsum("nq,nq->n", X, nk)).max() < 1e-15  # bisects
+        assert np.abs(np.einsum("nq,nq->n", Z, nj)).max() < 1e-15 and np.abs(np.einsum("nq,nq->n", Z, nk)).max() < 1e-15
+        alpha = np.arccos(np.clip(np.einsum("nq,nq->n", nj, nk), -1, 1))
+        np.testing.assert_allclose(tr["sat/breathing_angle"][:, i], alpha, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(tr["mosa/angle"][:, i, 0], alpha / 2, rtol=0, atol=1e-14)
+        np.testing.assert_array_equal(tr["mosa/angle"][:, i, 1], -tr["mosa/angle"][:, i, 0])
+
+
+def test_rates_agree_with_finite_differences(no_sg_run):
+    """omega from 5-point differences of T_S_I (50 s grid) and omega_dot from
+    5-point differences of omega, along one day of the propagated orbit.
+    Truncation h^4 w^5 / 30 ~ 1e-19 rad/s and h^4 n^4 |w_dot| / 30 < 1e-26
+    rad/s^2; rounding ~1e-16 / h ~ 3e-18 rad/s (frames) and 4 ulp(2e-5) / h
+    ~ 3e-22 rad/s^2 (omega): tolerances 1e-17 and 2e-21."""
+    _, tr, _ = no_sg_run
+    h = tr.attrs["step_s"]
+    T = tr["sat/T_S_I"]
+    d5 = lambda x: (x[:-4] - 8 * x[1:-3] + 8 * x[3:-1] - x[4:]) / (12 * h)  # noqa: E731
+    dT = d5(T)
+    # W[a, b] = e_a . de_b/dt with e = X_S, Y_S, Z_S (rows of T): omega_S =
+    # (Z . dY/dt, X . dZ/dt, Y . dX/dt) = (W[2, 1], W[0, 2], W[1, 0])
+    W = np.einsum("nsij,nskj->nsik", T[2:-2], dT)
+    w_fd = np.stack([W[..., 2, 1], W[..., 0, 2], W[..., 1, 0]], axis=-1)
+    err_w = np.abs(w_fd - tr["sat/omega"][2:-2]).max()
+    assert err_w < 1e-17, err_w
+    err_wd = np.abs(d5(tr["sat/omega"]) - tr["sat/omega_dot"][2:-2]).max()
+    assert err_wd < 2e-21, err_wd
+
+
+# ---------------------------------------------------------------------------
+# magnitudes (paper sec. V.B)
+
+
+def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_run):
+    _, tr0, _ = no_sg_run
+    A0 = np.abs(tr0["tm/a_suspension"]).max()
+    G0 = np.linalg.norm(tr0["sat/a_dragfree"], axis=-1).max()
+    al0 = np.abs(tr0["tm/alpha_suspension"]).max()
+    print(f"\nno self-gravity, 1 day: max |A| {A0:.2e} m/s^2, max |G| {G0:.2e} m/s^2, max |alpha| {al0:.2e} rad/s^2")
+    # paper: ~1e-13 m/s^2 and ~1e-13 rad/s^2 (Fig. 7); G ~ 1e-13 m/s^2
+    assert 1e-15 < A0 < 1e-12 and 1e-16 < G0 < 1e-12 and 1e-15 < al0 < 1e-12
+    _, tr1, _ = table_iv_run
+    A1 = np.abs(tr1["tm/a_suspension"]).max()
+    A_S = np.einsum("nslji,nslj->nsli", ctl.oa_rotation(2 * tr1["mosa/angle"][..., 0]), tr1["tm/a_suspension"])
+    dA = np.linalg.norm(A_S[:, :, 0] - A_S[:, :, 1], axis=-1).max()
+    print(f"Table IV self-gravity: max |A| {A1:.2e} m/s^2, max |A_1 - A_2| (S) {dA:.2e} m/s^2")
+    # paper (Fig. 8, sec. V.B.1): ~1e-10 m/s^2, "differential acceleration between the two TMs less
+    # than 1e-10": that is the differential-mode actuation of each TM, A_z = +/- dg_z / 2 (eq:E1/E2).
+    # The difference A_1 - A_2 itself exceeds 1e-10: Table IV alone gives z: 1.10e-10 + 5.72e-11.
+    assert 1e-11 < A1 < 1e-10
+    assert 1.67e-10 - 1e-12 < dA < 2e-10
+
+
+# ---------------------------------------------------------------------------
+# switches and verification modes
+
+
+def test_control_off_is_the_pure_gravity_constellation(tmp_path):
+    _, off, _ = _run(tmp_path, "off.h5", CHEAP + ["constellation.control=off"])
+    _, pure, _ = _run(tmp_path, "pure.h5", CHEAP + ["constellation.pointing=none", "constellation.control=off"])
+    _, on, _ = _run(tmp_path, "on.h5", CHEAP)
+    for x, y in zip(off.dd("sat/r"), pure.dd("sat/r")):
+        np.testing.assert_array_equal(x, y)
+    assert off.attrs["control"] == "off" and pure.attrs["pointing"] == "none" and on.attrs["control"] == "on"
+    assert "sat/T_S_I" in off and "sat/T_S_I" not in pure
+    # with control on, the orbits move by ~|G| t^2 / 2 (G ~ 5e-11 with Table IV: ~1 mm in 2 h)
+    d = np.linalg.norm(on["sat/r"][-1] - pure["sat/r"][-1], axis=-1)
+    G = np.linalg.norm(on["sat/a_dragfree"], axis=-1).max(axis=0)
+    assert np.all(d < G * 7200.0**2) and np.all(d > 1e-3 * G * 7200.0**2), (d, G)
+
+
+def test_free_tms_stay_at_their_housing_centers(tmp_path):
+    """Free-TM mode: the six TMs are integrated as bodies under gravity at
+    their own positions + self-gravity + suspension; the drift from the EH
+    centers after one day is the consistency of the control derivation (G
+    feedback included) and of the integration."""
+    _, tr, res = _run(tmp_path, "free.h5", CHEAP + ["constellation.free_tms=true"], duration="1d")
+    off = np.linalg.norm(tr["tm/housing_offset"], axis=-1)
+    print(f"\nfree TMs, 1 day: max |TM - EH center| = {off.max():.2e} m")
+    assert off.max() < 1e-14   # m; measured ~2e-16 m (the target for 10 days is 1e-12 m)
+    assert res.y_final.shape == (9, 6, 2)
+
+
+@pytest.mark.slow
+def test_free_tms_ten_days_full_model(tmp_path):
+    _, tr, _ = _run(tmp_path, "free10.h5", ["constellation.free_tms=true"], duration="10d")
+    off = np.linalg.norm(tr["tm/housing_offset"], axis=-1).max()
+    print(f"\nfree TMs, 10 days, full model, Table IV: max |TM - EH center| = {off:.2e} m")
+    assert off < 1e-12
+
+
+@pytest.mark.parametrize("override, words", [
+    ("spacecraft.d_tm=0", ["spacecraft.d_tm", "d_tm > 0"]),
+    ("spacecraft.d_tm=-0.4", ["spacecraft.d_tm", "d_tm > 0"]),
+    ("spacecraft.self_gravity=[[1e-10,0,0]]", ["spacecraft.self_gravity", "(2, 3)"]),
+    ("spacecraft.self_gravity_common=[1,2]", ["spacecraft.self_gravity_common", "(3,)"]),
+    ("constellation.pointing=local", ["constellation.pointing", "iterative"]),
+    ("constellation.control=maybe", ["constellation.control", "'on'"]),
+    ("spacecraft.tm_axis=w", ["spacecraft.tm_axis", "'y'"]),
+])
+def test_bad_configuration_is_one_clear_error(tmp_path, capsys, override, words):
+    out = tmp_path / "x.h5"
+    try:
+        status = cli.main(["run", "--duration", "1h", "-o", str(out), "--set", override])
+    except SystemExit as exc:
+        status = exc.code
+    err = capsys.readouterr().err
+    assert status == 2 and len(err.strip().splitlines()) == 1, err
+    for w in words:
+        assert w in err, err
+    assert not out.exists()
+
+
+def test_constellation_needs_three_satellites():
+    from tqdyn.scenario import ScenarioError, loads_scenario
+
+    with pytest.raises(ScenarioError, match="exactly 3 satellites"):
+        loads_scenario('[constellation]\npointing = "global"\n[[satellites]]\na_km = 1e5\n')
