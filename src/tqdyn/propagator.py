@@ -416,6 +416,7 @@ def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progre
     gw, fw, aux = _dyn.workspace(y)
     n_aux = _dyn.AUX_LEN if system.coupled else 0
     t_start = _time.perf_counter()
+    extremes: dict = {}
     # chunk boundaries (fixed by chunk and checkpoint_every, so a resumed run
     # takes the same steps); the time-only inputs of the next chunk are
     # computed in a second thread while the compiled loop (nogil) runs.
@@ -448,6 +449,8 @@ def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progre
                          coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, m, out_y, out_a, out_aux)
             if sink is not None:
                 sink(_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
+            if n_aux:
+                _update_extremes(extremes, out_aux, system)
             n = n0 + m
             if progress is not None:
                 progress(m)
@@ -465,7 +468,26 @@ def _propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progre
         sink(_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
     return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,
                      y_final=_to_dd(y, 2), n_steps=n_total, n_rejected=0,
-                     n_rhs=13 * n_total + 1, wall_s=wall)
+                     n_rhs=13 * n_total + 1, wall_s=wall, extra=_format_extremes(extremes))
+
+
+def _update_extremes(ext: dict, out_aux: np.ndarray, system: System) -> None:
+    """Running maxima of the control quantities over the steps of a chunk."""
+    v = _dyn.aux_views(out_aux)
+    vals = {"G": np.linalg.norm(v["a_dragfree"], axis=-1).max(),
+            "A": np.abs(v["tm_a_suspension"]).max(),
+            "alpha": np.abs(v["tm_alpha_suspension"]).max()}
+    if system.free_tms:
+        vals["drift"] = np.linalg.norm(v["tm_housing_offset"], axis=-1).max()
+    for key, val in vals.items():
+        ext[key] = max(ext.get(key, 0.0), float(val))
+
+
+def _format_extremes(ext: dict) -> dict:
+    names = {"G": ("max |G_i| (drag-free)", "m/s^2"), "A": ("max |A_c,l| component (suspension)", "m/s^2"),
+             "alpha": ("max |alpha_l| component (TM angular)", "rad/s^2"),
+             "drift": ("max |TM - EH center| (free TMs)", "m")}
+    return {names[k][0]: f"{v:.3e} {names[k][1]}" for k, v in ext.items()}
 
 
 def _dd_of(x: Fraction) -> tuple[float, float]:
