@@ -162,13 +162,18 @@ def test_frames_and_pointing_on_trajectory(table_iv_run):
         np.testing.assert_array_equal(tr["mosa/angle"][:, i, 1], -tr["mosa/angle"][:, i, 0])
 
 
-def test_rates_agree_with_finite_differences(no_sg_run):
+@pytest.mark.parametrize("law", ["global", "taylor2", "iterative"])
+def test_rates_agree_with_finite_differences(no_sg_run, tmp_path, law):
     """omega from 5-point differences of T_S_I (50 s grid) and omega_dot from
     5-point differences of omega, along one day of the propagated orbit.
     Truncation h^4 w^5 / 30 ~ 1e-19 rad/s and h^4 n^4 |w_dot| / 30 < 1e-26
     rad/s^2; rounding ~1e-16 / h ~ 3e-18 rad/s (frames) and 4 ulp(2e-5) / h
     ~ 3e-22 rad/s^2 (omega): tolerances 1e-17 and 2e-21."""
-    _, tr, _ = no_sg_run
+    if law == "global":
+        _, tr, _ = no_sg_run
+    else:  # local laws: the rates must be those of the attitude they produce
+        _, tr, _ = _run(tmp_path, "rates.h5", CHEAP + ["spacecraft.self_gravity=off",
+                                                       f"constellation.pointing={law}"], duration="1d")
     h = tr.attrs["step_s"]
     T = tr["sat/T_S_I"]
     d5 = lambda x: (x[:-4] - 8 * x[1:-3] + 8 * x[3:-1] - x[4:]) / (12 * h)  # noqa: E731
@@ -225,15 +230,22 @@ def test_control_off_is_the_pure_gravity_constellation(tmp_path):
     assert np.all(d < G * 7200.0**2) and np.all(d > 1e-3 * G * 7200.0**2), (d, G)
 
 
-def test_free_tms_stay_at_their_housing_centers(tmp_path):
+@pytest.mark.parametrize("law", ["global", "taylor2"])
+def test_free_tms_stay_at_their_housing_centers(tmp_path, law):
     """Free-TM mode: the six TMs are integrated as bodies under gravity at
     their own positions + self-gravity + suspension; the drift from the EH
     centers after one day is the consistency of the control derivation (G
-    feedback included) and of the integration."""
-    _, tr, res = _run(tmp_path, "free.h5", CHEAP + ["constellation.free_tms=true"], duration="1d")
+    feedback included), of the attitude rates (for the local laws: the jerk
+    model in omega_dot; with the monopole jerk alone the TMs drift 2e-9 m in
+    2 days) and of the integration."""
+    _, tr, res = _run(tmp_path, "free.h5", CHEAP + ["constellation.free_tms=true", f"constellation.pointing={law}"],
+                      duration="1d")
     off = np.linalg.norm(tr["tm/housing_offset"], axis=-1)
-    print(f"\nfree TMs, 1 day: max |TM - EH center| = {off.max():.2e} m")
-    assert off.max() < 1e-14   # m; measured ~2e-16 m (the target for 10 days is 1e-12 m)
+    print(f"\nfree TMs, {law}, 1 day: max |TM - EH center| = {off.max():.2e} m")
+    # m; the target for 10 days is 1e-12 m.  Measured: global 2.6e-16 m; taylor2 9.8e-14 m: its omega_dot
+    # contains the remote jerk / c, and the jerk model leaves out the Earth-rotation jerk of the sectorial
+    # degree-2 terms and the CIP tilt of J2 (~1e-13 m/s^3, ~4e-22 rad/s^2, ~7e-23 m/s^2 at the TM)
+    assert off.max() < (1e-14 if law == "global" else 3e-13)
     assert res.y_final.shape == (9, 6, 2)
 
 
@@ -288,3 +300,33 @@ def test_adaptive_mode_matches_fixed(tmp_path):
     assert np.abs(a["sat/a_dragfree"] - f["sat/a_dragfree"]).max() < 1e-23       # |G| ~ 1e-13 m/s^2
     assert np.abs(a["tm/a_suspension"] - f["tm/a_suspension"]).max() < 1e-23
     np.testing.assert_allclose(a["sat/T_S_I"], f["sat/T_S_I"], rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("law", ["taylor1", "taylor2", "iterative"])
+def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
+    """The attitude integrated with a local pointing law equals the frames
+    that constellation.pointing computes afterwards from the propagated
+    states (iterative: the light-travel-time equation solved to 1e-20 s on
+    the 4-node Hermite dense output of the trajectory, an implementation
+    independent of the compiled Taylor-model solver)."""
+    from tqdyn.constellation import pointing as P
+    from tqdyn.integrators.hermite import interpolate_states
+
+    _, tr, _ = _run(tmp_path, f"{law}.h5", CHEAP + [f"constellation.pointing={law}"], "2h")
+    assert tr.attrs["pointing"] == law
+    t, R, V = tr.dd("t"), tr.dd("sat/r"), tr.dd("sat/v")
+    A = tr["sat/a_gravity"] + tr["sat/a_dragfree"]
+    tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)
+
+    def position_at(sat, th, tl):
+        return interpolate_states(tn, Rd[:, sat.index], Vd[:, sat.index], A[:, sat.index],
+                                  np.stack([th, tl], -1), n_nodes=4)[0]
+
+    sl = slice(1, None)  # the first row has no emission time inside the trajectory
+    b = P.beam_directions(law, tuple(x[sl] for x in R), tuple(x[sl] for x in V), A[sl],
+                          t=tuple(x[sl] for x in t), position_at=position_at)
+    f = P.pointing_frames(b.n)
+    err_T = np.abs(f.T_S_I - tr["sat/T_S_I"][sl]).max()
+    err_th = np.abs(0.5 * f.theta - tr["mosa/angle"][sl][..., 0]).max()
+    print(f"\n{law}: in-loop vs post-processed attitude {err_T:.1e}, MOSA angle {err_th:.1e} rad")
+    assert err_T < 2e-15 and err_th < 1e-15

@@ -49,6 +49,7 @@ from tqdyn.elements import deg, kepler_state_at
 
 GM = 3.986004418e14      # m^3/s^2 (test orbit; any value works, the kernel gets the same one)
 C = 299792458.0          # m/s
+Z33 = np.zeros((3, 3))  # no jerk beyond the monopole: the test orbits are Keplerian
 # (a [m], e, i [deg], nu0 [deg]); RAAN 211.6 deg, argp 0 for all
 SATS = (("1e8", "0", "74.5", 60), ("1e8", "0.001", "74.5", 180), ("1.0001e8", "0", "74.501", 300))
 RAAN = "211.6"
@@ -93,7 +94,7 @@ def _run(law, t):
     """sat_kinematics at t: T (3, 3, 3), omega (3, 3), omega_dot (3, 3), theta (3, 3)."""
     r_hi, r_lo, v, a = _inputs(t)
     T, w, wd, th = np.zeros((3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3))
-    sat_kinematics(LAW_CODES[law], r_hi, r_lo, v, a, GM, C, T, w, wd, th)
+    sat_kinematics(LAW_CODES[law], r_hi, r_lo, v, a, Z33, GM, C, T, w, wd, th)
     return T, w, wd, th
 
 
@@ -352,12 +353,12 @@ def test_bad_inputs():
     r_hi, r_lo, v, a = _inputs(0.0)
     T, w, wd, th = np.zeros((3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3))
     with pytest.raises(ValueError, match="law = 4 is not allowed"):
-        sat_kinematics(4, r_hi, r_lo, v, a, GM, C, T, w, wd, th)
+        sat_kinematics(4, r_hi, r_lo, v, a, Z33, GM, C, T, w, wd, th)
     with pytest.raises(ValueError, match="shape"):
-        sat_kinematics(0, r_hi[:2], r_lo[:2], v[:2], a[:2], GM, C, T, w, wd, th)
+        sat_kinematics(0, r_hi[:2], r_lo[:2], v[:2], a[:2], Z33, GM, C, T, w, wd, th)
     with pytest.raises(ValueError, match="T_out"):
-        sat_kinematics(0, r_hi, r_lo, v, a, GM, C, T[:2], w, wd, th)
+        sat_kinematics(0, r_hi, r_lo, v, a, Z33, GM, C, T[:2], w, wd, th)
     bad = v.copy()
     bad[0, 0] = np.nan
     with pytest.raises(RuntimeError, match="light travel time"):
-        sat_kinematics(LAW_ITERATIVE, r_hi, r_lo, bad, a, GM, C, T, w, wd, th)
+        sat_kinematics(LAW_ITERATIVE, r_hi, r_lo, bad, a, Z33, GM, C, T, w, wd, th)

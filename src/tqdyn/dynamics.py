@@ -20,7 +20,9 @@ Two systems share one compiled entry point, :func:`system_rhs`, selected by
   1. gravity at the three satellites (dd);
   2. nominal attitude of the pointing law (:mod:`._kinematics_jit`): T_S_I,
      omega, omega_dot, MOSA angle theta and its rates, from the satellites'
-     positions, velocities and accelerations;
+     positions, velocities and accelerations (and, for the local laws, their
+     jerks: monopole + Moon and Sun tidal terms + J2, :func:`_jerk_perturbation`,
+     so that omega_dot is the derivative of omega to ~1e-22 rad/s^2);
   3. the EH centers r_i + T_I_S r_0,l (dd) and gravity there (dd); the
      differential gravity a(TM) - a(sat) is the difference of two dd
      accelerations, rounded to float64 only afterwards, so it has no
@@ -70,7 +72,12 @@ CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
 CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
 CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
 CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
-CP_LEN = 40
+CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_TD = 40, 41, 42, 43   # jerk model (see _jerk_perturbation)
+CP_LEN = 44
+#: time-only inputs of the coupled system, appended to the force model's:
+#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
+SYSTEM_TDAT_BODIES = ("moon", "sun")
+N_SYSTEM_TDAT = 12
 
 # aux layout per satellite (float64), AX_SAT values each
 AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
@@ -84,7 +91,7 @@ AUX_LEN = 3 * AX_SAT
 _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
               ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
               ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
-              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)))
+              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
 
 
 def n_bodies(mode: int) -> int:
@@ -93,7 +100,7 @@ def n_bodies(mode: int) -> int:
 
 
 def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
-              r0_nom=None, sg_oa=None, sg_s=None) -> np.ndarray:
+              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1) -> np.ndarray:
     """Pack the constellation parameters for :func:`system_rhs`.
 
     mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
@@ -102,6 +109,10 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_
     distance [m]; theta_nom : nominal MOSA angle [rad]; r0_nom : (2, 3) EH
     centers in S [m]; sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2];
     sg_s : (3, 3) common self-gravity in S [m/s^2].
+    gm_moon, gm_sun : [m^3/s^2], j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth:
+    the jerk model of the local pointing laws (0 = term absent);
+    tdat_offset : column of the system's time-only inputs (Moon, Sun states,
+    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none.
     """
     p = np.zeros(CP_LEN)
     p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
@@ -112,6 +123,7 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_
         p[CP_SG_OA:CP_SG_OA + 18] = np.asarray(sg_oa, np.float64).ravel()
     if sg_s is not None:
         p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
+    p[CP_GM_MOON], p[CP_GM_SUN], p[CP_J2K], p[CP_TD] = gm_moon, gm_sun, j2k, tdat_offset
     return p
 
 
@@ -185,13 +197,73 @@ def _breathing_angle(r_hi, r_lo, i):
     return np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), a0 * b0 + a1 * b1 + a2 * b2)
 
 
+@njit(cache=True, inline="always")
+def _tidal_jerk(gm, rx, ry, rz, vx, vy, vz, sx, sy, sz, ux, uy, uz):
+    """d/dt of gm [(s - r)/|s - r|^3 - s/|s|^3] for a body at s moving with u."""
+    dx, dy, dz = sx - rx, sy - ry, sz - rz
+    ex, ey, ez = ux - vx, uy - vy, uz - vz
+    d2 = dx * dx + dy * dy + dz * dz
+    id3 = 1.0 / (d2 * np.sqrt(d2))
+    q = 3.0 * (dx * ex + dy * ey + dz * ez) / d2
+    s2 = sx * sx + sy * sy + sz * sz
+    is3 = 1.0 / (s2 * np.sqrt(s2))
+    p = 3.0 * (sx * ux + sy * uy + sz * uz) / s2
+    return (gm * ((ex - q * dx) * id3 - (ux - p * sx) * is3),
+            gm * ((ey - q * dy) * id3 - (uy - p * sy) * is3),
+            gm * ((ez - q * dz) * id3 - (uz - p * sz) * is3))
+
+
+@njit(cache=True)
+def _jerk_perturbation(cpar, tdat, fw):
+    """Jerk of each satellite beyond the Earth monopole [m/s^3, GCRS] into fw[19].
+
+    The local pointing laws need the remote satellites' jerk for omega_dot
+    (it enters as jerk / c).  Modelled: the Moon and Sun tidal terms (with
+    the bodies' ephemeris velocities) and the Earth's J2 about the GCRS z
+    axis.  Left out, with their jerk: the Earth rotation of the sectorial
+    degree-2 terms (~1e-13 m/s^3), the CIP tilt from GCRS z in J2 (~2e-14),
+    degree >= 3 (~2e-14), planets, tides, relativity (< 1e-15), G (~1e-17):
+    omega_dot is the derivative of omega to ~4e-22 rad/s^2 (measured 1.5e-21
+    against 5-point differences, their own error included; the Moon's tidal
+    jerk alone is ~4e-10 m/s^3, 1.2e-18 rad/s^2).  Free TMs under a local
+    law stay within 3.4e-13 m of their EH centers over 10 days (2e-9 m in 2
+    days with the monopole jerk alone).
+    """
+    v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
+    o = int(cpar[CP_TD])
+    k = cpar[CP_J2K]
+    for i in range(3):
+        rx, ry, rz = r_hi[i, 0] + r_lo[i, 0], r_hi[i, 1] + r_lo[i, 1], r_hi[i, 2] + r_lo[i, 2]
+        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
+        jx = jy = jz = 0.0
+        if o >= 0:
+            for b, gm in ((0, cpar[CP_GM_MOON]), (1, cpar[CP_GM_SUN])):
+                if gm != 0.0:
+                    c = o + 6 * b
+                    tx, ty, tz = _tidal_jerk(gm, rx, ry, rz, vx, vy, vz, tdat[c], tdat[c + 1], tdat[c + 2],
+                                             tdat[c + 3], tdat[c + 4], tdat[c + 5])
+                    jx, jy, jz = jx + tx, jy + ty, jz + tz
+        if k != 0.0:
+            # a = -k / r^5 [(1 - 5 q) x, (1 - 5 q) y, (3 - 5 q) z], q = z^2 / r^2
+            r2 = rx * rx + ry * ry + rz * rz
+            f = -k / (r2 * r2 * np.sqrt(r2))
+            rv = rx * vx + ry * vy + rz * vz
+            fd = -5.0 * f * rv / r2
+            q = rz * rz / r2
+            qd = 2.0 * rz * vz / r2 - 2.0 * q * rv / r2
+            jx += fd * (1.0 - 5.0 * q) * rx + f * (-5.0 * qd * rx + (1.0 - 5.0 * q) * vx)
+            jy += fd * (1.0 - 5.0 * q) * ry + f * (-5.0 * qd * ry + (1.0 - 5.0 * q) * vy)
+            jz += fd * (3.0 - 5.0 * q) * rz + f * (-5.0 * qd * rz + (3.0 - 5.0 * q) * vz)
+        jp[i, 0], jp[i, 1], jp[i, 2] = jx, jy, jz
+
+
 @njit(cache=True)
 def _control_pass(cpar, fw):
     """Kinematics and EH geometry of the three satellites from the work
     arrays (positions, velocities, accelerations)."""
     r_hi, r_lo, v, a, T, om, omd, th, r0, rho, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], \
         fw[8], fw[9], fw[10]
-    sat_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, cpar[CP_GM], cpar[CP_C], T, om, omd, th)
+    sat_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, fw[19], cpar[CP_GM], cpar[CP_C], T, om, omd, th)
     r0_nom = cpar[CP_R0:CP_R0 + 6].reshape((2, 3))
     for i in range(3):
         housing_geometry(i, th[i, 0], th[i, 1], cpar[CP_DP], r0_nom, cpar[CP_THNOM], om, r0, rho, vel)
@@ -248,6 +320,8 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
             v[i, q] = to_f64(ld(y, i, q + 3))
             a[i, q] = to_f64(ld(gw, i, q))
     # 2. attitude and EH geometry
+    if cpar[CP_LAW] != 0:
+        _jerk_perturbation(cpar, tdat, fw)
     _control_pass(cpar, fw)
     # 3. gravity at the EH centers, differential gravity in dd
     for i in range(3):

@@ -31,7 +31,7 @@ from numba import njit
 
 from . import elements as _el
 from . import dynamics as _dyn
-from .constants import C_LIGHT
+from .constants import C_LIGHT, R_EARTH_EGM2008
 from .dynamics import system_rhs
 from .forces.model import ForceModel, build_force_model
 from .integrators import dp87, hermite
@@ -58,10 +58,48 @@ class System:
     cpar: np.ndarray
     coupled: bool
     free_tms: bool
+    ephemeris: object = None
 
     @property
     def mode(self) -> int:
         return int(self.cpar[_dyn.CP_MODE])
+
+    def with_inputs(self, model: ForceModel):
+        """The force model, extended by the system's own time-only inputs
+        (the Moon's and Sun's states for the jerk of the local pointing
+        laws) when it needs any; see :class:`_SystemInputs`."""
+        if self.ephemeris is None or isinstance(model, _SystemInputs):
+            return model
+        return _SystemInputs(model, self)
+
+
+class _SystemInputs:
+    """A force model whose time-only inputs are followed by the coupled
+    system's: geocentric GCRS position [m] and velocity [m/s] of the Moon and
+    the Sun (TDB), :data:`tqdyn.dynamics.N_SYSTEM_TDAT` columns starting at
+    the force model's ``n_tdat`` (= ``cpar[CP_TD]``).  Everything else is the
+    force model's."""
+
+    def __init__(self, model: ForceModel, system: System):
+        self._model = model
+        self._system = system
+        self.n_tdat = model.n_tdat + _dyn.N_SYSTEM_TDAT
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    @property
+    def time_dependent(self) -> bool:
+        return True
+
+    def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
+        from .timescales import tdb_jd
+
+        base = self._model.precompute(epoch, t_hi, t_lo)
+        jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
+        pos, vel = self._system.ephemeris.geocentric_states(_dyn.SYSTEM_TDAT_BODIES, jd1, jd2, velocity=True)
+        extra = np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (_dyn.N_SYSTEM_TDAT,))
+        return np.concatenate([base, extra], axis=-1)
 
 
 def self_gravity_oa(scenario) -> np.ndarray:
@@ -72,11 +110,14 @@ def self_gravity_oa(scenario) -> np.ndarray:
     return np.broadcast_to(TABLE_IV_SELF_GRAVITY, (3, 2, 3)).copy() if oa is None else oa
 
 
-def build_system(scenario) -> System:
+def build_system(scenario, model: ForceModel | None = None) -> System:
     """The :class:`System` of a scenario (point masses unless
-    ``constellation.pointing`` names a law)."""
+    ``constellation.pointing`` names a law).  ``model``: the scenario's force
+    model (built if None), whose time-only inputs the system's follow."""
     from .constellation._kinematics_jit import LAW_CODES
     from .constellation.spacecraft import Spacecraft
+    from .ephemeris import planetary_gm
+    from .forces.model import _ephemeris
 
     c = scenario.constellation
     if not c.coupled:
@@ -85,11 +126,27 @@ def build_system(scenario) -> System:
     craft = Spacecraft(d_tm=float(sc.d_tm_m), d_p=float(sc.d_p_m), tm_axis=sc.tm_axis)
     _, common = sc.self_gravity_values()
     mode = _dyn.MODE_FREE_TM if c.free_tms else _dyn.MODE_COUPLED
-    cpar = _dyn.make_cpar(mode, law=LAW_CODES[c.pointing], control=c.control == "on",
-                          gm=float(scenario.forces.gm_earth), c=C_LIGHT, d_p=craft.d_p,
+    # jerk model of the local laws: the Moon / Sun tidal terms and J2 that the force model has
+    f = scenario.forces
+    law = LAW_CODES[c.pointing]
+    bodies = [b for b in _dyn.SYSTEM_TDAT_BODIES if b in f.third_bodies] if law else []
+    eph = _ephemeris(f.ephemeris) if bodies else None
+    gms = planetary_gm() if bodies else {}
+    j2k = 1.5 * _J2_EGM2008 * float(f.gm_earth) * R_EARTH_EGM2008 ** 2 if law and f.earth_degree >= 2 else 0.0
+    if eph is not None and model is None:
+        model = build_force_model(f)
+    cpar = _dyn.make_cpar(mode, law=law, control=c.control == "on",
+                          gm=float(f.gm_earth), c=C_LIGHT, d_p=craft.d_p,
                           theta_nom=craft.theta_nominal, r0_nom=craft.nominal_housing_centers,
-                          sg_oa=self_gravity_oa(scenario), sg_s=common)
-    return System(cpar, True, c.free_tms)
+                          sg_oa=self_gravity_oa(scenario), sg_s=common,
+                          gm_moon=gms.get("moon", 0.0), gm_sun=gms.get("sun", 0.0), j2k=j2k,
+                          tdat_offset=model.n_tdat if eph is not None else -1)
+    return System(cpar, True, c.free_tms, eph)
+
+
+#: J2 = -sqrt(5) C20 of EGM2008 (tide-free), for the jerk model only (it enters
+#: omega_dot of the local laws at ~1e-19 rad/s^2: 5 digits are plenty).
+_J2_EGM2008 = 1.08263e-3
 
 
 def initial_state(scenario, model: ForceModel | None = None, system: System | None = None) -> np.ndarray:
@@ -105,10 +162,11 @@ def initial_state(scenario, model: ForceModel | None = None, system: System | No
                                      _el.deg(sat.argp_deg), _el.deg(sat.nu_deg), gm)
         rows.append(_el.state_to_dd(r, v))
     y = np.stack(rows)
-    system = build_system(scenario) if system is None else system
+    model = build_force_model(scenario.forces) if model is None else model
+    system = build_system(scenario, model) if system is None else system
     if not system.free_tms:
         return y
-    model = build_force_model(scenario.forces) if model is None else model
+    model = system.with_inputs(model)
     cpar = system.cpar.copy()
     cpar[_dyn.CP_MODE] = _dyn.MODE_COUPLED
     tdat = (model.precompute(Epoch.from_utc(scenario.epoch_utc), np.zeros(1), np.zeros(1))[0]
@@ -356,7 +414,8 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Mapping
     precision = precision or scenario.run.precision
     _check_precision(precision)
     model = build_force_model(scenario.forces) if model is None else model
-    system = build_system(scenario)
+    system = build_system(scenario, model)
+    model = system.with_inputs(model)
     epoch = Epoch.from_utc(scenario.epoch_utc)
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)

@@ -59,13 +59,15 @@ Arm vectors are formed from the double-double positions as
 
   Model error: the neglected 5th-derivative term ~ n^5 r tau^5/120 =
   3e-16 m/s^5 * 5e-4 s^5 ~ 1e-19 m, i.e. ~1e-27 rad (n = 2e-5 rad/s,
-  r = 1e8 m).  The jerk and snap are the monopole's (from ``gm``); the real
-  ones differ by the time derivatives of the perturbing accelerations,
-  < ~1e-5 n ~ 2e-10 m/s^3 (jerk, vs |J| ~ n^3 r ~ 8e-7 m/s^3) and ~1e-5 n^2
-  ~ 4e-15 m/s^4 (snap): the emission point moves by 2e-10 tau^3/6 ~ 6e-12 m
-  and 4e-15 tau^4/24 ~ 2e-17 m, i.e. < 4e-20 rad of beam direction.
-  (Taylor laws: the same jerk error enters omega_dot through 1/c,
-  < 1e-18 rad/s^2.)
+  r = 1e8 m).  The jerk is the monopole's (from ``gm``) plus the caller's
+  ``jerk_pert``; the snap is the monopole's.  Without ``jerk_pert`` the jerk
+  would miss the time derivatives of the perturbing accelerations, ~4e-10
+  m/s^3 (the Moon's tidal term; vs |J| ~ n^3 r ~ 8e-7 m/s^3); the snap misses
+  ~1e-5 n^2 ~ 4e-15 m/s^4: the emission point moves by 4e-15 tau^4/24 ~
+  2e-17 m, ~1e-25 rad.  The jerk enters omega_dot through 1/c: a missing
+  4e-10 m/s^3 is 1.2e-18 rad/s^2 of omega_dot that the attitude does not
+  have (measured), which is why :mod:`tqdyn.dynamics` passes the Moon, Sun
+  and J2 jerk.
 
   Time derivatives by implicit differentiation (checked numerically by
   ``tests/test_kinematics_jit.py`` against finite differences of tau and of
@@ -89,7 +91,7 @@ Jerk and snap
 -------------
 For the Taylor and iterative laws, the remote satellite's jerk and snap come
 from the monopole formula (as :func:`.attitude.central_jerk_snap`, with the
-*given* total acceleration a in the snap)::
+*given* total acceleration a in the snap), the jerk plus ``jerk_pert``::
 
     J = -gm [v/r^3 - 3 (r.v) r/r^5]
     S = -gm [a/r^3 - 6 (r.v) v/r^5 - 3 (v.v + r.a) r/r^5 + 15 (r.v)^2 r/r^7]
@@ -346,7 +348,7 @@ def _check(law, r_hi, r_lo, v, a, T_out, w_out, wd_out, th_out):
 # ------------------------------------------------------------------ kernel
 
 @njit(cache=True)
-def sat_kinematics(law, r_hi, r_lo, v, a, gm, c, T_out, w_out, wd_out, th_out):
+def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out):
     """Nominal attitude, angular velocity and acceleration of the three satellites.
 
     Parameters
@@ -360,8 +362,13 @@ def sat_kinematics(law, r_hi, r_lo, v, a, gm, c, T_out, w_out, wd_out, th_out):
     v : (3, 3) float64 -- velocities [m/s], GCRS.
     a : (3, 3) float64 -- total accelerations [m/s^2], GCRS (whatever the orbit
         follows, e.g. gravity + drag-free control).
-    gm : float -- Earth GM [m^3/s^2], used only for the remote satellites'
-        monopole jerk and snap (Taylor and iterative laws).
+    jerk_pert : (3, 3) float64 -- the part of each satellite's jerk d a/dt
+        [m/s^3, GCRS] beyond the Earth monopole (zeros for a Kepler orbit).
+        omega_dot of the local laws contains jerk / c: a jerk left out makes
+        omega_dot inconsistent with the attitude (the Moon's tidal jerk,
+        ~4e-10 m/s^3, would be 1.2e-18 rad/s^2).
+    gm : float -- Earth GM [m^3/s^2], for the remote satellites' monopole
+        jerk and snap (Taylor and iterative laws).
     c : float -- speed of light [m/s].
     T_out : (3, 3, 3) float64, written -- T_S_I per satellite (rows X_S, Y_S,
         Z_S in GCRS components).
@@ -383,10 +390,13 @@ def sat_kinematics(law, r_hi, r_lo, v, a, gm, c, T_out, w_out, wd_out, th_out):
     if law != 0:
         j0, s0 = _monopole_jerk_snap((r_hi[0, 0] + r_lo[0, 0], r_hi[0, 1] + r_lo[0, 1], r_hi[0, 2] + r_lo[0, 2]),
                                      _row(v, 0), _row(a, 0), gm)
+        j0 = _add(j0, _row(jerk_pert, 0))
         j1, s1 = _monopole_jerk_snap((r_hi[1, 0] + r_lo[1, 0], r_hi[1, 1] + r_lo[1, 1], r_hi[1, 2] + r_lo[1, 2]),
                                      _row(v, 1), _row(a, 1), gm)
+        j1 = _add(j1, _row(jerk_pert, 1))
         j2, s2 = _monopole_jerk_snap((r_hi[2, 0] + r_lo[2, 0], r_hi[2, 1] + r_lo[2, 1], r_hi[2, 2] + r_lo[2, 2]),
                                      _row(v, 2), _row(a, 2), gm)
+        j2 = _add(j2, _row(jerk_pert, 2))
     for i in range(3):
         j = (i + 1) % 3
         k = (i + 2) % 3
