@@ -743,7 +743,7 @@ def _client(scheduler, n_workers: int | None, n_tasks: int):
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise _err("workers", n_workers, "is not a positive integer", "an integer >= 1")
     n = min(n, max(n_tasks, 1))
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         yield client
 
