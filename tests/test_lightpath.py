@@ -257,7 +257,7 @@ def test_shapiro():
     assert np.max(np.abs(fd - on.tau_rate[3:-2])) < 1e-16
 
 
-@pytest.mark.slow  # ~20 s of propagator compilation on a cold kernel cache (0.2 s when warm)
+# (shares the propagator kernels compiled for the other tests; ~0.2 s when they are cached)
 def test_propagator_dense_output_vs_direct_propagation():
     # reference (5): propagate the built-in Kepler scenario directly to the emission
     # instant t_k - tau and compare with the dense-output emitter position
