@@ -229,6 +229,15 @@ def info():
     for entry in sorted(p.name for p in data.iterdir() if p.name != "SOURCES.md"):
         lines.append(f"  {entry}")
     lines.append("ephemeris: DE421 from the skyfield-data package (any JPL DE file by path: forces.ephemeris)")
+    lines += [
+        "constellation (coupled dynamics, [constellation] / [spacecraft] in a scenario):",
+        "  pointing laws: global (instantaneous plane) | taylor1, taylor2 (light-time Taylor expansion) |"
+        " iterative (light-time equation solved exactly); none = independent point masses",
+        "  control: on (drag-free G_i in the orbits, suspension A_c,l from eq. E1/E2, G from the three"
+        " conditions: tan/cot of theta/2) | off (pure-gravity orbits); free_tms: TMs as free bodies (verification)",
+        "  spacecraft: TMs +/-d_tm/2 along tm_axis of S (default y), pivots d_p; DC self-gravity per TM in"
+        " OA_l (Table IV of the paper by default) + a common part fixed in S",
+    ]
     click.echo("\n".join(lines))
 
 
