@@ -23,23 +23,30 @@ from tqdyn.constellation.indices import Sat
 from tqdyn.precision import mp_from_pair
 
 
-def _load(scenario):
-    """1-day trajectory of a built-in scenario on its 50 s grid, with a dd
-    Hermite (degree 11) position interpolator."""
+def _raw(scenario):
+    """1-day pure-gravity trajectory of a built-in scenario on its 50 s grid:
+    t, R, V as (hi, lo) pairs and A (float64)."""
     from tqdyn import propagator
-    from tqdyn.integrators.hermite import interpolate_states
     from tqdyn.scenario import load_scenario
 
     rows = []
     propagator.propagate(load_scenario(scenario, ["run.duration=1d", "constellation.pointing=none",
-                                                            "constellation.control=off"]), sink=rows.append)
+                                                  "constellation.control=off"]), sink=rows.append)
 
     def cat(k):
         if isinstance(rows[0][k], tuple):
             return tuple(np.concatenate([r[k][q] for r in rows]) for q in (0, 1))
         return np.concatenate([r[k] for r in rows])
 
-    t, R, V, A = cat("t"), cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+    return cat("t"), cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+
+
+def _load(raw):
+    """The trajectory from its second row on, with a dd Hermite (degree 11)
+    position interpolator over the whole grid."""
+    from tqdyn.integrators.hermite import interpolate_states
+
+    t, R, V, A = raw
     tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)
 
     def position_at(sat, th, tl):
@@ -52,8 +59,13 @@ def _load(scenario):
 
 
 @pytest.fixture(scope="module")
-def trajectory():
-    return _load("tianqin-kepler")
+def raw():
+    return _raw("tianqin-kepler")
+
+
+@pytest.fixture(scope="module")
+def trajectory(raw):
+    return _load(raw)
 
 
 def _all_laws(trajectory):
@@ -163,40 +175,37 @@ def test_iterative_vs_exact_root_rigid_triangle():
     assert worst < 1e-20
 
 
-def test_laws_vs_iterative_real_trajectory(trajectory, beams):
+def test_laws_vs_iterative_real_trajectory(raw):
     # reference: the iterative law (LTT solved to < 1e-20 s, dense output of the trajectory)
-    _compare_laws(beams)
+    _compare_laws(raw)
 
 
 @pytest.mark.slow
 def test_laws_vs_iterative_full_force_model():
     # same comparison on the full-force-model scenario "tianqin" (accelerations
     # include all perturbations, so taylor2 uses the real a_j)
-    _compare_laws(_all_laws(_load("tianqin")))
+    _compare_laws(_raw("tianqin"))
 
 
-def _compare_laws(beams):
-    it = beams["iterative"]
-    fi = P.pointing_frames(it.n)
-    res = {}
-    for law in ("global", "taylor1", "taylor2"):
-        f = P.pointing_frames(beams[law].n)
-        per_beam = P.angle_between(beams[law].n, it.n).max(axis=0)  # (3, 2)
-        xs = P.angle_between(f.X_S, fi.X_S).max(axis=0)
-        th = np.abs(f.theta - fi.theta).max(axis=0)
-        res[law] = per_beam.max(), xs.max(), th.max()
+def _compare_laws(raw):
+    from tqdyn.analysis.pointing_study import compare_pointing_laws
+
+    study = compare_pointing_laws(*raw)
+    res = study.maxima()
+    for law, c in study.laws.items():
         print(f"{law:8s} vs iterative, max over 1 day [rad]: per beam (sat, MOSA1<-k, MOSA2<-j) "
-              f"{np.array2string(per_beam, precision=2)}; X_S {np.array2string(xs, precision=2)}; "
-              f"theta {np.array2string(th, precision=2)}")
-    dtau = np.abs(beams["global"].tau - it.tau).max(axis=0)
+              f"{np.array2string(c.per_beam.max(axis=0), precision=2)}; X_S "
+              f"{np.array2string(c.x_s.max(axis=0), precision=2)}; theta {np.array2string(c.theta.max(axis=0), precision=2)}")
+    dtau = study.tau_error.max(axis=0)
     print(f"tau = L/c vs iterative tau: max {np.array2string(dtau, precision=3)} s")
     # the paper's Fig. 5: ~1e-6 rad (global) and ~1e-11 rad (Taylor); orders of magnitude only
-    assert 1e-7 < res["global"][0] < 1e-4
+    assert 1e-7 < res["global"]["per_beam"] < 1e-4
     for law in ("taylor1", "taylor2"):
-        assert 1e-13 < res[law][0] < 1e-10
-        assert res[law][1] < 1e-13  # the two beams' errors cancel in X_S ...
-        assert res[law][2] > res[law][0]  # ... and add up in theta
+        assert 1e-13 < res[law]["per_beam"] < 1e-10
+        assert res[law]["x_s"] < 1e-13  # the two beams' errors cancel in X_S ...
+        assert res[law]["theta"] > res[law]["per_beam"]  # ... and add up in theta
     assert 1e-7 < dtau.max() < 1e-5  # not the paper's 1e-7 s
+    assert study.ltt_residual < 1e-20
 
 
 def test_normalisation_matters(trajectory, beams):

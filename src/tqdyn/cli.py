@@ -1,4 +1,4 @@
-"""Command line: ``tqdyn run | info | forces | bench | export | sweep``.
+"""Command line: ``tqdyn run | info | forces | bench | export | sweep | report``.
 
 The CLI only composes library calls: it resolves the scenario, checks the
 output path, runs the propagator with a progress bar, streams the rows into
@@ -9,21 +9,13 @@ and one line on stderr (no traceback, no partial output file).
 from __future__ import annotations
 
 import sys
-import time
 
 import click
 
 from . import __version__
+from ._cli_common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["main"]
-
-_EXIT_BAD_INPUT = 2
-_EXIT_INTERRUPTED = 130
-
-
-def _fail(message: str, status: int = _EXIT_BAD_INPUT):
-    click.echo(f"tqdyn: error: {message}", err=True)
-    sys.exit(status)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -271,10 +263,12 @@ def bench(duration, step, no_heyoka, which):
 
 
 from .cli_export import export as _export_command  # noqa: E402  (commands in their own modules)
+from .cli_report import report as _report_command  # noqa: E402
 from .cli_sweep import sweep as _sweep_command  # noqa: E402
 
 cli.add_command(_export_command)
 cli.add_command(_sweep_command)
+cli.add_command(_report_command)
 
 
 def main(argv=None):

@@ -8,23 +8,15 @@ everywhere in the CLI, bad input exits with status 2 and one line
 
 from __future__ import annotations
 
-import sys
 
 import click
+
+from ._cli_common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["FORMATS", "export"]
 
 FORMATS = ("lisa",)
 """Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x)."""
-
-_EXIT_BAD_INPUT = 2
-_EXIT_INTERRUPTED = 130
-
-
-def _fail(message: str, status: int = _EXIT_BAD_INPUT):
-    """One line on stderr and exit (same convention as :func:`tqdyn.cli._fail`)."""
-    click.echo(f"tqdyn: error: {message}", err=True)
-    sys.exit(status)
 
 
 @click.command("export")

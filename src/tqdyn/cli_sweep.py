@@ -17,17 +17,10 @@ import sys
 import click
 
 from . import __version__
+from ._cli_common import EXIT_FAILED as _EXIT_MEMBER_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
+from ._cli_common import fail as _fail
 
 __all__ = ["sweep"]
-
-_EXIT_MEMBER_FAILED = 1
-_EXIT_BAD_INPUT = 2
-_EXIT_INTERRUPTED = 130
-
-
-def _fail(message: str, status: int = _EXIT_BAD_INPUT):
-    click.echo(f"tqdyn: error: {message}", err=True)
-    sys.exit(status)
 
 
 def _describe(spec) -> str:

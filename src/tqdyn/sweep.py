@@ -88,6 +88,7 @@ __all__ = [
     "SweepResult",
     "SweepSpec",
     "default_workers",
+    "dask_client",
     "gather",
     "load_sweep",
     "loads_sweep",
@@ -720,9 +721,11 @@ def default_workers() -> int:
 
 
 @contextlib.contextmanager
-def _client(scheduler, n_workers: int | None, n_tasks: int):
+def dask_client(scheduler, n_workers: int | None, n_tasks: int):
     """A distributed.Client: the given one, one connected to ``scheduler`` (an
-    address), or one on a new LocalCluster (processes, 1 thread each)."""
+    address), or one on a new LocalCluster (processes, 1 thread each, at most
+    ``n_workers`` (default: the usable cores) and at most ``n_tasks``
+    workers).  Also used by :mod:`tqdyn.studies`."""
     from distributed import Client, LocalCluster
 
     if isinstance(scheduler, Client):
@@ -752,7 +755,7 @@ def _execute(pending: Sequence[Member], scheduler, n_workers, progress) -> list[
     from distributed import as_completed
 
     outcomes: list[MemberOutcome] = []
-    with _client(scheduler, n_workers, len(pending)) as client:
+    with dask_client(scheduler, n_workers, len(pending)) as client:
         token = secrets.token_hex(4)
         futures = {client.submit(_run_member, m.scenario_toml, key=f"tqdyn-member-{m.digest}-{token}", pure=False): m
                    for m in pending}

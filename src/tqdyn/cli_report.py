@@ -1,0 +1,153 @@
+"""Command line: ``tqdyn report RUN.h5 [RUN.h5 ...]`` and ``tqdyn report --studies``.
+
+Registered in :mod:`tqdyn.cli` with ``cli.add_command(report)``.  It only
+composes :mod:`tqdyn.analysis.report` and :mod:`tqdyn.studies`:
+
+* ``tqdyn report RUN.h5 [...] [--out DIR]``: figures (PNG and PDF) of what
+  the runs contain and ``DIR/summary.md``;
+* ``tqdyn report --studies [--runs-dir DIR] [--out DIR] [--quick |
+  --duration-scale X] [--study NAME ...] [--set KEY=VALUE ...] [--workers N]``:
+  runs (or reuses) the study runs of the paper's section V and regenerates
+  its figures and the summary table (paper value vs tqdyn value).
+
+Bad input (a missing file, a file that is not a tqdyn trajectory, an unknown
+study, bad overrides, conflicting options) exits with status 2 and one line
+``tqdyn: error: ...`` on stderr, before anything is run or written.
+Progress goes to stderr, the summary table to stdout.  Exit status 1 if a
+study run failed (the report of the others is still written).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from . import __version__
+from ._cli_common import EXIT_FAILED as _EXIT_RUN_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
+from ._cli_common import fail as _fail
+
+__all__ = ["report"]
+
+
+@click.command("report", context_settings={"help_option_names": ["-h", "--help"]})
+@click.argument("runs", nargs=-1, metavar="[RUN.h5 ...]")
+@click.option("--out", "-o", "out", metavar="DIR",
+              help="Output directory of the figures and summary.md (default: tqdyn-report; with --studies: "
+                   "tqdyn-studies).")
+@click.option("--studies", is_flag=True,
+              help="Run (or reuse) the study runs of the paper's section V and regenerate its figures and table.")
+@click.option("--runs-dir", metavar="DIR", help="With --studies: directory of the study runs (default: OUT/runs).")
+@click.option("--quick", is_flag=True, help="With --studies: durations scaled by 1/90 (90 d -> 1 d, 30 d -> 8 h).")
+@click.option("--duration-scale", type=float, metavar="X",
+              help="With --studies: factor on the paper's spans (default 1: 90 d and 30 d).")
+@click.option("--study", "only", multiple=True, metavar="NAME",
+              help="With --studies: only this study (repeatable); default all.")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+              help="With --studies: override applied to every study run (repeatable), e.g. forces.earth_degree=2.")
+@click.option("--workers", type=int, metavar="N",
+              help="With --studies: worker processes for the runs (default: the CPU cores; 1 = in this process).")
+@click.option("--quiet", "-q", is_flag=True, help="No progress on stderr.")
+def report(runs, out, studies, runs_dir, quick, duration_scale, only, sets, workers, quiet):
+    """Figures and a summary table of trajectory files RUN.h5, or (--studies)
+    of the paper's section V: pointing laws (Fig. 5), range ASDs (Figs. 6,
+    10, 11), electrostatic control (Figs. 7, 8), drag-free and self-gravity
+    orbit deviations and breathing angles (Fig. 9)."""
+    def say(msg):
+        if not quiet:
+            click.echo(msg, err=True)
+
+    if studies:
+        if runs:
+            _fail(f"RUN.h5: {runs[0]!r} given with --studies; allowed: either trajectory files or --studies")
+        _run_studies(out or "tqdyn-studies", runs_dir, quick, duration_scale, only, sets, workers, quiet, say)
+        return
+    for name, given in (("--runs-dir", runs_dir is not None), ("--quick", quick),
+                        ("--duration-scale", duration_scale is not None), ("--study", bool(only)),
+                        ("--set", bool(sets)), ("--workers", workers is not None)):
+        if given:
+            _fail(f"{name}: only applies with --studies")
+    if not runs:
+        _fail("RUN.h5: no trajectory file given; allowed: one or more tqdyn trajectory files, or --studies")
+    from . import io
+    from .analysis import report as rp
+
+    try:
+        rep = rp.report_runs(runs, out or "tqdyn-report", progress=say)
+    except (FileNotFoundError, io.TrajectoryFormatError, ValueError, ImportError) as exc:
+        _fail(str(exc))
+    except KeyboardInterrupt:
+        _fail("interrupted", _EXIT_INTERRUPTED)
+    _print_report(rep)
+
+
+def _print_report(rep) -> None:
+    click.echo(rep.summary_path.read_text(encoding="utf-8").rstrip())
+    pngs = sorted(p.name for p in rep.figures if p.suffix == ".png")
+    click.echo(f"\nfigures ({len(rep.figures)} files, PNG and PDF) in {rep.out_dir}: " + ", ".join(pngs))
+    click.echo(f"summary: {rep.summary_path}")
+
+
+def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quiet, say):
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from . import studies as st
+    from .analysis import report as rp
+    from .sweep import default_workers
+
+    if quick and duration_scale is not None:
+        _fail("--quick: conflicts with --duration-scale; allowed: one of them")
+    if workers is not None and workers < 1:
+        _fail(f"--workers: {workers} is not a number of workers; allowed: an integer >= 1")
+    scale = st.QUICK_SCALE if quick else (1.0 if duration_scale is None else duration_scale)
+    runs_dir = runs_dir or str(Path(out) / "runs")
+    names = tuple(only) or None
+    try:
+        if duration_scale is not None:
+            st.scaled_duration_s(1.0, duration_scale, 50.0)  # validates the scale
+        plan = st.plan_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets)
+        rp.check_out_dir(out)
+    except (ValueError, FileNotFoundError) as exc:
+        _fail(str(exc))
+    pending = [p for p in plan if not p.done]
+    n = min(workers or default_workers(), max(len(pending), 1))
+    say(f"tqdyn {__version__}: {len(plan)} study runs (duration scale {scale:g}) in {Path(runs_dir).resolve()}: "
+        f"{len(plan) - len(pending)} reused, {len(pending)} to run"
+        + (f" on {n} worker process{'es' if n != 1 else ''}" if pending else ""))
+    bar = tqdm(total=len(pending), disable=True if quiet or not pending else None, unit="run", file=sys.stderr,
+               dynamic_ncols=True, desc="study runs")
+
+    def progress(o):
+        if o.status == "reused":
+            return
+        bar.update(1)
+        if o.status == "failed":
+            bar.write(f"tqdyn: study run {o.run.name} failed: {o.error}", file=sys.stderr)
+        elif not quiet:
+            bar.write(f"  {o.run.name}: {o.rows} rows in {o.wall_s:.1f} s", file=sys.stderr)
+
+    try:
+        result = st.run_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets,
+                                workers=workers, progress=progress, plan=plan)
+    except KeyboardInterrupt:
+        bar.close()
+        _fail("interrupted; finished runs are kept and reused next time", _EXIT_INTERRUPTED)
+    except (ValueError, FileNotFoundError) as exc:
+        bar.close()
+        _fail(str(exc))
+    bar.close()
+    paths = {name: result.path(name) for name in result.outcomes}
+    title = "tqdyn: the paper's section V reproduced" + ("" if scale == 1.0 else f" (durations x {scale:.4g})")
+    try:
+        rep = rp.report_studies(paths, out, studies=names, progress=say, title=title)
+    except ImportError as exc:  # matplotlib missing: the runs are kept
+        _fail(str(exc))
+    except KeyboardInterrupt:
+        _fail("interrupted", _EXIT_INTERRUPTED)
+    _print_report(rep)
+    if result.failures:
+        for o in result.failures:
+            click.echo(f"tqdyn: study run {o.run.name} failed: {o.error}", err=True)
+        sys.exit(_EXIT_RUN_FAILED)
