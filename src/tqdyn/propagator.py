@@ -162,11 +162,10 @@ def initial_state(scenario, model: ForceModel | None = None, system: System | No
                                      _el.deg(sat.argp_deg), _el.deg(sat.nu_deg), gm)
         rows.append(_el.state_to_dd(r, v))
     y = np.stack(rows)
-    model = build_force_model(scenario.forces) if model is None else model
     system = build_system(scenario, model) if system is None else system
     if not system.free_tms:
         return y
-    model = system.with_inputs(model)
+    model = system.with_inputs(build_force_model(scenario.forces) if model is None else model)
     cpar = system.cpar.copy()
     cpar[_dyn.CP_MODE] = _dyn.MODE_COUPLED
     tdat = (model.precompute(Epoch.from_utc(scenario.epoch_utc), np.zeros(1), np.zeros(1))[0]
