@@ -330,3 +330,34 @@ def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
     err_th = np.abs(0.5 * f.theta - tr["mosa/angle"][sl][..., 0]).max()
     print(f"\n{law}: in-loop vs post-processed attitude {err_T:.1e}, MOSA angle {err_th:.1e} rad")
     assert err_T < 2e-15 and err_th < 1e-15
+
+
+@pytest.mark.slow
+def test_ninety_day_acceptance(tmp_path):
+    """Issue acceptance over 90 days (full model, ~3 min): the drag-free orbits
+    without self-gravity against the pure-gravity orbits, and a common 1e-9
+    m/s^2 self-gravity along the flight direction (-Y_S).  References: the
+    first-order (Hill) secular along-track drift computed from the stored G
+    (report.secular_along_track_drift) and 3/2 f T^2 for a constant
+    along-track push.  The paper's "< 1 m" is reported, not asserted: tqdyn
+    gives 1.47 m for Sat1 (README, docs/report.md)."""
+    from tqdyn.analysis.report import orbit_deviation, secular_along_track_drift
+
+    every = ["run.output_every=12", "forces.earth_degree=12"]
+    _, grav, _ = _run(tmp_path, "g.h5", every + ["constellation.pointing=none", "constellation.control=off"], "90d")
+    _, df, _ = _run(tmp_path, "d.h5", every + ["spacecraft.self_gravity=off"], "90d")
+    _, fl, _ = _run(tmp_path, "f.h5", every + ["spacecraft.self_gravity=off",
+                                               "spacecraft.self_gravity_common=[0,-1e-9,0]"], "90d")
+    # the flight direction is -Y_S: check it on the run rather than assume it
+    vS = np.einsum("nsij,nsj->nsi", df["sat/T_S_I"], df["sat/v"]) / np.linalg.norm(df["sat/v"], axis=-1)[..., None]
+    assert np.all(vS[..., 1] < -0.9999)
+    d = orbit_deviation(df, grav)
+    pred = secular_along_track_drift(d.t, df["sat/r"], df["sat/v"], df["sat/a_dragfree"])
+    print(f"\ndrag-free vs gravity, 90 d: max |dr| {d.norm.max(axis=0)} m; along-track at 90 d {d.along[-1]} m, "
+          f"secular prediction {pred[-1]} m")
+    assert np.all(d.norm.max(axis=0) < 2.0)
+    np.testing.assert_allclose(d.along[-1], pred[-1], rtol=0.2, atol=0.05)
+    T = d.t[-1]
+    f = orbit_deviation(fl, grav)
+    print(f"+flight 1e-9 m/s^2, 90 d: |dr| {f.norm[-1] / 1e3} km; 3/2 f T^2 = {1.5e-9 * T**2 / 1e3:.2f} km")
+    np.testing.assert_allclose(f.norm[-1], 1.5e-9 * T**2, rtol=0.01)
