@@ -37,17 +37,22 @@ CHEAP = ["forces.earth_degree=2", "forces.third_bodies=sun,moon", "forces.solid_
          "forces.relativity=false", "forces.earth_field_indirect=false"]
 
 
-def _run(path, overrides, duration="6h"):
-    scen = load_scenario("tianqin", [f"run.duration={duration}", f"run.output={path}", *CHEAP, *overrides])
+def _run(path, overrides, duration="6h", scenario="tianqin"):
+    scen = load_scenario(scenario, [f"run.duration={duration}", f"run.output={path}", *CHEAP, *overrides])
     return runner.run_to_file(scen).path
+
+
+def _study_run(path, name):
+    spec = studies.RUNS[name]
+    return _run(path, list(spec.overrides), scenario=spec.scenario)
 
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     d = tmp_path_factory.mktemp("runs")
-    return {"gravity": _run(d / "gravity.h5", list(studies.RUNS["gravity-90d"].overrides)),
+    return {"gravity": _study_run(d / "gravity.h5", "gravity-90d"),
             "dragfree": _run(d / "dragfree.h5", ["spacecraft.self_gravity=off"]),
-            "flight": _run(d / "flight.h5", list(studies.RUNS["sg-y-90d"].overrides))}
+            "flight": _study_run(d / "flight.h5", "sg-y-90d")}
 
 
 def _cli(args, capsys):
@@ -154,8 +159,10 @@ def test_flight_push_moves_the_orbit_along_track(runs):
 def test_catalogue():
     for s in studies.STUDIES.values():
         assert s.runs and all(r in studies.RUNS for r in s.runs)
-    ex = studies.RUNS["sg-extreme-90d"].overrides[-1]
-    assert ex == "spacecraft.self_gravity_common=[[0, -1e-9, 0], [0, 1e-9, 0], [0, -1e-9, 0]]"
+    # the extreme case (built-in scenario tianqin-extreme): Sat1 +flight, Sat2 -flight, Sat3 +flight
+    ex = studies.RUNS["sg-extreme-90d"].scenario_for().spacecraft.self_gravity_values()[1]
+    flight = np.array(studies.FLIGHT_DIRECTION_S)
+    np.testing.assert_array_equal(ex, 1e-9 * np.array([flight, -flight, flight]))
     assert studies.scaled_duration_s(90, studies.QUICK_SCALE, 600.0) == 86400
     assert studies.scaled_duration_s(30, studies.QUICK_SCALE, 50.0) == 28800
     with pytest.raises(ValueError, match="duration scale"):

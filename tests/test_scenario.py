@@ -323,3 +323,19 @@ def test_direct_construction_validates():
     assert sat.i_deg == Decimal("97.5") and isinstance(sat.e, Decimal)
     s = Scenario("x", "", "2004-06-06 00:00", satellites=[sat])
     assert s.epoch_utc == "2004-06-06T00:00:00" and s.satellites == (sat,)
+
+
+def test_extends_a_builtin_scenario():
+    # a file that extends "tianqin" changes only what it names
+    s = loads_scenario('[scenario]\nname = "mine"\nextends = "tianqin"\n[forces]\nearth_degree = 4\n'
+                       '[constellation]\ncontrol = "off"\n')
+    base = load_scenario("tianqin")
+    assert s.name == "mine" and s.forces.earth_degree == 4 and s.constellation.control == "off"
+    assert s.satellites == base.satellites and s.forces.third_bodies == base.forces.third_bodies
+    assert s.constellation.pointing == base.constellation.pointing and s.run == base.run
+    assert loads_scenario(s.to_toml()) == s      # the resolved TOML stands alone
+    # the study scenarios chain: tianqin-dragfree-local -> tianqin-dragfree -> tianqin
+    local = load_scenario("tianqin-dragfree-local")
+    assert local.constellation.pointing == "taylor2" and local.spacecraft.self_gravity == "off"
+    with pytest.raises(ScenarioError, match="scenario.extends: 'nope' is not a built-in scenario; allowed: .*tianqin"):
+        loads_scenario('[scenario]\nextends = "nope"\n')

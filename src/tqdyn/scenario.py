@@ -20,7 +20,8 @@ Conventions
 TOML layout (every section and key optional except at least one
 ``[[satellites]]`` entry with ``a_km``)::
 
-    [scenario]      name, description, epoch_utc
+    [scenario]      name, description, epoch_utc, extends (a built-in scenario
+                    whose tables this file updates key by key)
     [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
                     precision ("dd" | "float64"), output, output_every
     [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
@@ -637,7 +638,7 @@ _STRLIST = "list of strings"
 _ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
-    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH},
+    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "extends": _STR},
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
     "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
@@ -853,10 +854,40 @@ def loads_scenario(text: str, overrides: Sequence[str] = (), *, source: str = "<
         raw = tomllib.loads(text, parse_float=Decimal)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(source, problem=f"invalid TOML: {exc}", allowed="a TOML document (https://toml.io)") from None
+    raw = _resolve_extends(raw, source, ())
     if isinstance(overrides, str):
         overrides = (overrides,)
     _apply_overrides(raw, overrides)
     return _scenario_from_raw(raw, default_name)
+
+
+def _resolve_extends(raw: dict, source: str, chain: tuple[str, ...]) -> dict:
+    """``[scenario] extends = "<built-in>"``: the built-in scenario's tables,
+    each updated key by key with this file's (``[[satellites]]``, if given,
+    replaces the base's list); ``name`` and ``description`` are this file's."""
+    meta = raw.get("scenario", {})
+    if not isinstance(meta, dict) or "extends" not in meta:
+        return raw
+    base_name = meta["extends"]
+    builtins = builtin_scenarios()
+    _require(isinstance(base_name, str) and base_name in builtins, "scenario.extends", base_name,
+             "is not a built-in scenario", ", ".join(builtins))
+    _require(base_name not in chain, "scenario.extends", base_name, f"extends itself ({' -> '.join(chain)})",
+             "a chain of built-in scenarios without cycles")
+    text = (_builtin_dir() / f"{base_name}.toml").read_text(encoding="utf-8")
+    base = _resolve_extends(tomllib.loads(text, parse_float=Decimal), base_name, chain + (base_name,))
+    merged = {k: (dict(v) if isinstance(v, dict) else v) for k, v in base.items()}
+    for key, value in raw.items():
+        if isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key].update(value)
+        else:
+            merged[key] = value
+    merged["scenario"] = {k: v for k, v in merged["scenario"].items() if k != "extends"}
+    merged["scenario"].setdefault("description", "")
+    for k in ("name", "description"):
+        if k not in meta:
+            merged["scenario"].pop(k, None)
+    return merged
 
 
 def load_scenario(name_or_path: str | os.PathLike | None = None, overrides: Sequence[str] = ()) -> Scenario:

@@ -84,8 +84,6 @@ COMMON_SG = 1e-9
 
 _PLACEHOLDER = "study-run.h5"
 _DIGEST_CHARS = 12
-_NO_SG = "spacecraft.self_gravity=off"
-_GRAVITY = ("constellation.pointing=none", "constellation.control=off", _NO_SG)
 
 
 @dataclass(frozen=True)
@@ -146,8 +144,6 @@ def _common(direction: Sequence[float]) -> str:
 
 
 _FLIGHT = FLIGHT_DIRECTION_S
-_EXTREME = ("spacecraft.self_gravity_common=["
-            + ", ".join(_vec([COMMON_SG * s * c for c in _FLIGHT]) for s in (+1, -1, +1)) + "]")
 
 #: The six directions of the common self-gravity runs (axes of S) and their unit vectors.
 SG_DIRECTIONS = {"+x": (1.0, 0.0, 0.0), "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0),
@@ -155,28 +151,33 @@ SG_DIRECTIONS = {"+x": (1.0, 0.0, 0.0), "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0,
 
 
 def _runs() -> dict[str, RunSpec]:
+    # the physical set-ups are built-in scenarios (tqdyn run tianqin-gravity ...);
+    # a study run adds only its span and output sampling (and the direction
+    # of the common self-gravity)
+    g, df, loc = "tianqin-gravity", "tianqin-dragfree", "tianqin-dragfree-local"
     runs = [
-        RunSpec("gravity-90d", "pure-gravity orbits (no attitude, no control), 90 d, 600 s rows", _GRAVITY, 90,
-                COARSE_EVERY),
-        RunSpec("gravity-30d-50s", "pure-gravity orbits, 30 d at 50 s", _GRAVITY, 30, 1),
+        RunSpec("gravity-90d", "pure-gravity orbits (no attitude, no control), 90 d, 600 s rows", (), 90,
+                COARSE_EVERY, g),
+        RunSpec("gravity-30d-50s", "pure-gravity orbits, 30 d at 50 s", (), 30, 1, g),
         RunSpec("dragfree-global-90d", "drag-free orbits, global pointing, no self-gravity, 90 d, 600 s rows",
-                (_NO_SG,), 90, COARSE_EVERY),
+                (), 90, COARSE_EVERY, df),
         RunSpec("dragfree-global-30d-50s", "drag-free orbits, global pointing, no self-gravity, 30 d at 50 s",
-                (_NO_SG,), 30, 1),
+                (), 30, 1, df),
         RunSpec("dragfree-local-90d", "drag-free orbits, local pointing (taylor2), no self-gravity, 90 d, 600 s rows",
-                (_NO_SG, "constellation.pointing=taylor2"), 90, COARSE_EVERY),
+                (), 90, COARSE_EVERY, loc),
         RunSpec("dragfree-local-30d-50s", "drag-free orbits, local pointing (taylor2), no self-gravity, 30 d at 50 s",
-                (_NO_SG, "constellation.pointing=taylor2"), 30, 1),
+                (), 30, 1, loc),
         RunSpec("table-iv-30d-50s", "drag-free orbits, global pointing, Table IV self-gravity, 30 d at 50 s",
-                ("spacecraft.self_gravity=table-iv",), 30, 1),
+                ("spacecraft.self_gravity=table-iv",), 30, 1, BASE_SCENARIO),
     ]
     for label, d in SG_DIRECTIONS.items():
         flight = sum(a * b for a, b in zip(d, _FLIGHT))
         what = " (+flight)" if flight > 0 else " (-flight)" if flight < 0 else ""
         runs.append(RunSpec(f"sg{label}-90d", f"common self-gravity 1e-9 m/s^2 along {label} of S{what}, "
-                            "Table IV off, 90 d, 600 s rows", (_NO_SG, _common(d)), 90, COARSE_EVERY))
+                            "Table IV off, 90 d, 600 s rows", (_common(d),), 90, COARSE_EVERY, df))
     runs.append(RunSpec("sg-extreme-90d", "extreme case: common self-gravity 1e-9 m/s^2 Sat1 +flight, Sat2 -flight, "
-                        "Sat3 +flight, 90 d, 600 s rows", (_NO_SG, _EXTREME), 90, COARSE_EVERY))
+                        "Sat3 +flight, 90 d, 600 s rows (built-in scenario tianqin-extreme)", (), 90, COARSE_EVERY,
+                        "tianqin-extreme"))
     return {r.name: r for r in runs}
 
 
