@@ -60,7 +60,7 @@ from .constellation._kinematics_jit import sat_kinematics
 from .forces.model import gravity
 from .precision import add, ld, lo_part, st, sub, to_f64
 
-__all__ = ["system_rhs", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
+__all__ = ["system_rhs", "point_masses", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
            "make_cpar", "aux_views", "n_bodies", "workspace"]
 
 MODE_POINT_MASS = 0
@@ -164,7 +164,9 @@ def aux_views(aux: np.ndarray) -> dict:
 
 
 @njit(cache=True)
-def _point_masses(y, tdat, params, layout, k):
+def point_masses(y, tdat, params, layout, k):
+    """dy/dt of independent bodies under the force model (MODE_POINT_MASS);
+    arguments as :func:`system_rhs`."""
     for b in range(y.shape[0]):
         ax, ay, az = gravity(ld(y, b, 0), ld(y, b, 1), ld(y, b, 2), ld(y, b, 3), ld(y, b, 4), ld(y, b, 5),
                              tdat, params, layout)
@@ -419,6 +421,6 @@ def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
     (:func:`workspace`).
     """
     if cpar[CP_MODE] == MODE_POINT_MASS:
-        _point_masses(y, tdat, params, layout, k)
+        point_masses(y, tdat, params, layout, k)
     else:
         _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw)
