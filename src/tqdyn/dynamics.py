@@ -61,7 +61,7 @@ from .forces.model import gravity
 from .precision import add, ld, lo_part, st, sub, to_f64
 
 __all__ = ["system_rhs", "point_masses", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
-           "make_cpar", "aux_views", "n_bodies", "workspace"]
+           "make_cpar", "aux_views", "workspace"]
 
 MODE_POINT_MASS = 0
 MODE_COUPLED = 1
@@ -92,11 +92,6 @@ _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), 
               ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
               ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
               ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
-
-
-def n_bodies(mode: int) -> int:
-    """Bodies in the state of a 3-satellite run of ``mode`` (9 with free TMs)."""
-    return 9 if mode == MODE_FREE_TM else 3
 
 
 def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,

@@ -60,10 +60,6 @@ class System:
     free_tms: bool
     ephemeris: object = None
 
-    @property
-    def mode(self) -> int:
-        return int(self.cpar[_dyn.CP_MODE])
-
     def with_inputs(self, model: ForceModel):
         """The force model, extended by the system's own time-only inputs
         (the Moon's and Sun's states for the jerk of the local pointing
@@ -277,11 +273,11 @@ def _rhs_at(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
     system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)
 
 
-def warm_up(precision: str = "dd", scenario=None) -> None:
+def warm_up(precision: str = "dd") -> None:
     """Compile the fixed-step kernels for ``precision`` (numba JIT, a few
     seconds on first use in a process, then cached on disk) so that later
-    timings measure the propagation alone.  (One compiled kernel serves all
-    systems; ``scenario`` is accepted for symmetry and not needed.)"""
+    timings measure the propagation alone.  One compiled kernel serves the
+    point-mass and the coupled systems."""
     _check_precision(precision)
     tail = (2,) if precision == "dd" else ()
     y = np.zeros((1, 6) + tail)

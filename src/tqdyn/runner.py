@@ -117,7 +117,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         start = None
         writer_factory = None
     t0 = time.perf_counter()
-    propagator.warm_up(scen.run.precision, scen)
+    propagator.warm_up(scen.run.precision)
     compile_s = time.perf_counter() - t0
     if writer_factory is not None:
         writer = writer_factory()
