@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from tqdyn.bench import format_report, kepler_benchmark
+from tqdyn.workflows.bench import format_report, kepler_benchmark
 
 
 def main():

@@ -21,8 +21,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from mp_reference import DPS, GM, mp_dp87  # noqa: E402
 
 from tqdyn import propagator  # noqa: E402
-from tqdyn.integrators import dp87  # noqa: E402
-from tqdyn.precision import mp_from_dd  # noqa: E402
+from tqdyn.numerics import dp87  # noqa: E402
+from tqdyn.numerics.dd import mp_from_dd  # noqa: E402
 from tqdyn.scenario import loads_scenario  # noqa: E402
 
 SCENARIO = """

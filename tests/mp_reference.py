@@ -13,7 +13,7 @@ from fractions import Fraction
 import mpmath
 from mpmath import mpf
 
-from tqdyn.integrators import _dp87_tableau as tab
+from tqdyn.numerics import _dp87_tableau as tab
 
 GM = "3.986004415e14"  # m^3/s^2
 DPS = 50  # mpmath digits

@@ -24,7 +24,7 @@ from mpmath import mp, mpf
 
 from tqdyn.constellation.attitude import attitude, central_jerk_snap, beam_vectors
 from tqdyn.constellation.indices import Mosa, Sat
-from tqdyn.elements import deg, kepler_state_at
+from tqdyn.astro.elements import deg, kepler_state_at
 
 GM = 3.986004415e14
 C = 299792458.0
@@ -166,7 +166,7 @@ def test_rigid_equilateral_circular(law, method):
 
 @pytest.fixture(scope="module")
 def real_orbit():
-    from tqdyn import propagator
+    from tqdyn.dynamics import propagate as propagator
     from tqdyn.scenario import load_scenario
 
     rows = []

@@ -13,8 +13,11 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn import cli, elements, io, propagator
-from tqdyn.precision import mp_from_dd
+from tqdyn import cli
+from tqdyn.astro import elements
+from tqdyn.formats import trajectory as io
+from tqdyn.dynamics import propagate as propagator
+from tqdyn.numerics.dd import mp_from_dd
 from tqdyn.scenario import load_scenario, loads_scenario
 
 

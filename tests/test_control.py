@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from mpmath import matrix, mp, mpf
 
-from tqdyn.constants import GM_EARTH_EGM2008
+from tqdyn.astro.constants import GM_EARTH_EGM2008
 from tqdyn.constellation.control import (
     dragfree_acceleration,
     dragfree_as_printed,
@@ -36,7 +36,7 @@ from tqdyn.constellation.control import (
     tm_relative_acceleration,
 )
 from tqdyn.constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
-from tqdyn.elements import deg, kepler_state_at
+from tqdyn.astro.elements import deg, kepler_state_at
 
 GM = mpf(GM_EARTH_EGM2008)
 TABLE_I = [("100000.0e3", "30"), ("100009.5e3", "150"), ("99995.0e3", "270")]

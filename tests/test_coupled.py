@@ -16,13 +16,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tqdyn import cli, io, propagator, runner
+from tqdyn import cli
+from tqdyn.formats import trajectory as io
+from tqdyn.dynamics import propagate as propagator
+from tqdyn.workflows import run as runner
 from tqdyn.constellation import attitude as att
 from tqdyn.constellation import control as ctl
 from tqdyn.constellation._control_jit import housing_geometry, satellite_control
 from tqdyn.constellation.spacecraft import Spacecraft
 from tqdyn.scenario import load_scenario
-from tqdyn.timescales import Epoch
+from tqdyn.astro.timescales import Epoch
 
 #: a cheap force model with the same structure (monopole, Moon and Sun in dd,
 #: degree-2 Earth field) for the short checks; the full model is the default
@@ -310,7 +313,7 @@ def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
     the 4-node Hermite dense output of the trajectory, an implementation
     independent of the compiled Taylor-model solver)."""
     from tqdyn.constellation import pointing as P
-    from tqdyn.integrators.hermite import interpolate_states
+    from tqdyn.numerics.hermite import interpolate_states
 
     _, tr, _ = _run(tmp_path, f"{law}.h5", CHEAP + [f"constellation.pointing={law}"], "2h")
     assert tr.attrs["pointing"] == law

@@ -20,7 +20,7 @@ import mpmath
 import pytest
 from mpmath import mp, mpf
 
-from tqdyn.integrators import _dp87_tableau as tab
+from tqdyn.numerics import _dp87_tableau as tab
 
 DPS = 60
 MAX_ORDER = 8

@@ -31,7 +31,7 @@ from tqdyn.forces.earth import (
     earth_field_static_accel,
     earth_tides_accel,
 )
-from tqdyn.forces.gravity_models import (
+from tqdyn.readers.gravity_fields import (
     EGM2008_C20_ZERO_TIDE,
     GravityModel,
     egm2008,
@@ -40,7 +40,7 @@ from tqdyn.forces.gravity_models import (
     read_shadr,
 )
 from tqdyn.forces.spherical_harmonics import sh_accel, sh_accel_corrections, sh_accel_delta
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
 
@@ -330,7 +330,7 @@ def test_default_rotation_is_frames():
     Against erfa.c2t06a with the EOP of the epoch day held constant: < 1e-8
     at the epoch (dX, dY ~ 1e-9 rad are the difference); 5 days later the
     held UT1-UTC is off by ~1.2 ms of LOD (~9e-8 rad), bound 3e-7."""
-    frames = pytest.importorskip("tqdyn.frames")
+    frames = pytest.importorskip("tqdyn.astro.earth_orientation")
     if not hasattr(frames, "earth_orientation"):
         pytest.skip("tqdyn.frames.earth_orientation not available yet")
     f = EarthField()

@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 from mpmath import mp, mpf
 
-from tqdyn.constants import GM_EARTH_EGM2008
-from tqdyn.elements import (
+from tqdyn.astro.constants import GM_EARTH_EGM2008
+from tqdyn.astro.elements import (
     deg,
     elements_to_state,
     from_dd,

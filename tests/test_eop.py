@@ -32,7 +32,7 @@ import erfa
 import numpy as np
 import pytest
 
-from tqdyn.eop import (
+from tqdyn.astro.eop import (
     ARCSEC,
     EOP,
     load_eop,

@@ -24,11 +24,11 @@ import numpy as np
 import pytest
 from jplephem.spk import SPK
 
-from tqdyn.ephemeris import (BODIES, Ephemeris, default_ephemeris, default_ephemeris_path, parse_gm_tpc,
+from tqdyn.astro.ephemeris import (BODIES, Ephemeris, default_ephemeris, default_ephemeris_path, parse_gm_tpc,
                              planetary_gm)
 from tqdyn.forces.third_body import ThirdBodies, third_body_accel
 from tqdyn.forces.third_body_ephemeris import third_bodies
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 JD_EPOCH = 2453162.5  # 2004-06-06 00:00 (TDB here)
 BARY = {"mercury": 1, "venus": 2, "mars": 4, "jupiter": 5, "saturn": 6, "uranus": 7, "neptune": 8}
@@ -186,7 +186,7 @@ def test_split_segments_are_stitched(eph, kernel):
     different times.  Emulate it with two copies of DE421's Moon segment
     restricted to the two halves of the span: every instant is evaluated
     in one of them and the result is unchanged."""
-    from tqdyn import ephemeris as mod
+    from tqdyn.astro import ephemeris as mod
 
     split = Ephemeris(eph.path)
     pair = split._pairs[(3, 301)]

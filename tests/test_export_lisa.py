@@ -27,12 +27,12 @@ import h5py
 import numpy as np
 import pytest
 
-from tqdyn import io
-from tqdyn import lightpath as LP
-from tqdyn.cli_export import export
-from tqdyn.constants import C_LIGHT
+from tqdyn.formats import trajectory as io
+from tqdyn.lightpath import light_time as LP
+from tqdyn.cli.export import export
+from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation.indices import LINKS, Link
-from tqdyn.export_lisa import LISA_LINK_ORDER, export_lisa, write_lisa_orbits
+from tqdyn.formats.lisa import LISA_LINK_ORDER, export_lisa, write_lisa_orbits
 
 GM = 3.986004415e14  # m^3/s^2 (written into the scenario attribute, read back by the export)
 A_M = 1e8

@@ -18,11 +18,11 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn import propagator
+from tqdyn.dynamics import propagate as propagator
 from tqdyn.forces.central import EarthMonopole
 from tqdyn.forces.model import ForceModel, gravity
 from tqdyn.forces.third_body import ThirdBodies, third_body_accel
-from tqdyn.precision import mp_from_dd
+from tqdyn.numerics.dd import mp_from_dd
 from tqdyn.scenario import load_scenario
 
 from mp_reference import third_body_literal

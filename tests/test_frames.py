@@ -29,10 +29,10 @@ import erfa
 import numpy as np
 import pytest
 
-from tqdyn import frames
-from tqdyn.eop import ARCSEC, EOP, load_eop, load_tidal_eop_terms, tidal_arguments, tidal_eop_corrections
-from tqdyn.frames import earth_orientation, gcrs_to_itrs, itrs_to_gcrs
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro import earth_orientation as frames
+from tqdyn.astro.eop import ARCSEC, EOP, load_eop, load_tidal_eop_terms, tidal_arguments, tidal_eop_corrections
+from tqdyn.astro.earth_orientation import earth_orientation, gcrs_to_itrs, itrs_to_gcrs
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 DAY = 86400.0
 

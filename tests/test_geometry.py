@@ -56,7 +56,7 @@ def test_indices_even_permutations_and_links():
 
 @pytest.fixture(scope="module")
 def trajectory():
-    from tqdyn import propagator
+    from tqdyn.dynamics import propagate as propagator
     from tqdyn.scenario import load_scenario
 
     rows = []

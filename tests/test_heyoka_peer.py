@@ -6,7 +6,7 @@ import pytest
 hy = pytest.importorskip("heyoka")
 mpmath = pytest.importorskip("mpmath")
 
-from tqdyn._heyoka_peer import (  # noqa: E402
+from tqdyn.workflows.heyoka_peer import (  # noqa: E402
     propagate_kepler_grid,
     real128_to_dd,
     to_real128,
@@ -200,11 +200,11 @@ def _third_body_acc(r, s, gm):
 
 
 def test_reduced_model_vs_tqdyn_one_day():
-    from tqdyn import propagator
-    from tqdyn._heyoka_peer import _epoch_days, _reduced_system, propagate_reduced_grid
-    from tqdyn.ephemeris import default_ephemeris, planetary_gm
+    from tqdyn.dynamics import propagate as propagator
+    from tqdyn.workflows.heyoka_peer import _epoch_days, _reduced_system, propagate_reduced_grid
+    from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
     from tqdyn.scenario import load_scenario
-    from tqdyn.timescales import tdb_jd
+    from tqdyn.astro.timescales import tdb_jd
 
     scen = load_scenario("tianqin", ["run.duration=1d", *REDUCED])
     assert scen.n_steps == N_DAY

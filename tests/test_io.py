@@ -7,8 +7,8 @@ import h5py
 import numpy as np
 import pytest
 
-from tqdyn import io
-from tqdyn.io import (
+from tqdyn.formats import trajectory as io
+from tqdyn.formats.trajectory import (
     FIELDS,
     FORMAT,
     FORMAT_VERSION,

@@ -45,7 +45,7 @@ from tqdyn.constellation._kinematics_jit import (
 )
 from tqdyn.constellation.attitude import attitude, central_jerk_snap
 from tqdyn.constellation.indices import Sat
-from tqdyn.elements import deg, kepler_state_at
+from tqdyn.astro.elements import deg, kepler_state_at
 
 GM = 3.986004418e14      # m^3/s^2 (test orbit; any value works, the kernel gets the same one)
 C = 299792458.0          # m/s

@@ -18,12 +18,12 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn import propagator
+from tqdyn.dynamics import propagate as propagator
 from tqdyn.forces.earth import EarthField, degree2_accel_ext, earth_field_accel
 from tqdyn.forces.third_body import third_body_accel_ext
-from tqdyn.precision import mp_from_dd
+from tqdyn.numerics.dd import mp_from_dd
 from tqdyn.scenario import load_scenario
-from tqdyn.timescales import Epoch
+from tqdyn.astro.timescales import Epoch
 
 from mp_reference import third_body_literal
 

@@ -33,11 +33,12 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.ephemeris import default_ephemeris
-from tqdyn.forces import moon, sun
-from tqdyn.forces._naif import parse_text_kernel, read_text_kernel
+from tqdyn.astro.ephemeris import default_ephemeris
+from tqdyn.forces import moon
+from tqdyn.forces import sun
+from tqdyn.readers.naif import parse_text_kernel, read_text_kernel
 from tqdyn.forces.spherical_harmonics import sh_accel
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
 AS = math.pi / 648000.0  # one arcsecond [rad]

@@ -26,8 +26,8 @@ from tqdyn.forces.ocean_tides import (
     parse_fes2004,
     read_fes2004,
 )
-from tqdyn.forces.tidal_arguments import delaunay_arguments, doodson_arguments, tidal_phase
-from tqdyn.timescales import Epoch
+from tqdyn.astro.tidal_arguments import delaunay_arguments, doodson_arguments, tidal_phase
+from tqdyn.astro.timescales import Epoch
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
 
@@ -111,7 +111,7 @@ def test_provider_with_standin():
 
 
 def test_provider_with_real_earth_orientation():
-    frames = pytest.importorskip("tqdyn.frames")
+    frames = pytest.importorskip("tqdyn.astro.earth_orientation")
     if not hasattr(frames, "earth_orientation"):
         pytest.skip("tqdyn.frames.earth_orientation not available yet")
     t = np.linspace(0.0, 86400.0, 5)

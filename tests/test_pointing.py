@@ -16,17 +16,17 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.constants import C_LIGHT
+from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation import geometry as G
 from tqdyn.constellation import pointing as P
 from tqdyn.constellation.indices import Sat
-from tqdyn.precision import mp_from_pair
+from tqdyn.numerics.dd import mp_from_pair
 
 
 def _raw(scenario):
     """1-day pure-gravity trajectory of a built-in scenario on its 50 s grid:
     t, R, V as (hi, lo) pairs and A (float64)."""
-    from tqdyn import propagator
+    from tqdyn.dynamics import propagate as propagator
     from tqdyn.scenario import load_scenario
 
     rows = []
@@ -44,7 +44,7 @@ def _raw(scenario):
 def _load(raw):
     """The trajectory from its second row on, with a dd Hermite (degree 11)
     position interpolator over the whole grid."""
-    from tqdyn.integrators.hermite import interpolate_states
+    from tqdyn.numerics.hermite import interpolate_states
 
     t, R, V, A = raw
     tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)

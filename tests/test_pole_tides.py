@@ -27,7 +27,7 @@ from tqdyn.forces.pole_tides import (
     solid_pole_tide,
     wobble,
 )
-from tqdyn.timescales import Epoch
+from tqdyn.astro.timescales import Epoch
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
 MAS = ARCSEC / 1000.0
@@ -103,7 +103,7 @@ def test_providers_with_standin():
 
 
 def test_providers_with_real_earth_orientation():
-    frames = pytest.importorskip("tqdyn.frames")
+    frames = pytest.importorskip("tqdyn.astro.earth_orientation")
     if not hasattr(frames, "earth_orientation"):
         pytest.skip("tqdyn.frames.earth_orientation not available yet")
     t = np.linspace(0.0, 86400.0 * 90, 10)

@@ -22,8 +22,8 @@ import numpy as np
 from mpmath import mpf
 from numba import njit
 
-from tqdyn import precision as P
-from tqdyn.precision import add, div, fast_two_sum, ld, mul, sqrt, st, sub, two_prod, two_sum
+from tqdyn.numerics import dd as P
+from tqdyn.numerics.dd import add, div, fast_two_sum, ld, mul, sqrt, st, sub, two_prod, two_sum
 
 U = 2.0 ** -53
 SLACK = 1 + 2.0 ** -40

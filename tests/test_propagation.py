@@ -27,12 +27,13 @@ import numpy as np
 import pytest
 from mpmath import mpf
 
-from tqdyn import elements as el
-from tqdyn import precision as P
-from tqdyn import propagator as prop
+from tqdyn.astro import elements as el
+from tqdyn.numerics import dd as P
+from tqdyn.dynamics import propagate as prop
 from tqdyn import scenario as sc
 from tqdyn.forces.model import build_force_model
-from tqdyn.integrators import dp87, hermite
+from tqdyn.numerics import dp87
+from tqdyn.numerics import hermite
 
 from mp_reference import mp_dp87
 

@@ -35,10 +35,10 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.ephemeris import default_ephemeris, planetary_gm
+from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
 from tqdyn.forces.relativity import (N_TDAT, Relativity, cip_direction, de_sitter_accel, lense_thirring_accel,
                                      relativity_accel, schwarzschild_accel)
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 GM = 3.986004415e14  # m^3/s^2, EGM2008
 C = 299792458.0  # m/s

@@ -21,11 +21,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tqdyn import cli, io, runner, studies
+from tqdyn import cli
+from tqdyn.formats import trajectory as io
+from tqdyn.workflows import run as runner
+from tqdyn.workflows import studies
 from tqdyn.analysis import report as rp
 from tqdyn.analysis.pointing_study import compare_pointing_laws, pointing_study_of
-from tqdyn.cli_report import report as report_command
-from tqdyn.constants import C_LIGHT
+from tqdyn.cli.report import report as report_command
+from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation import geometry
 from tqdyn.constellation.indices import Sat
 from tqdyn.scenario import load_scenario

@@ -48,8 +48,8 @@ from tqdyn.forces.solid_tides import (
     step1_coefficients,
     step2_coefficients,
 )
-from tqdyn.forces.tidal_arguments import delaunay_arguments, doodson_arguments, doodson_multipliers
-from tqdyn.timescales import Epoch, tdb_jd
+from tqdyn.astro.tidal_arguments import delaunay_arguments, doodson_arguments, doodson_multipliers
+from tqdyn.astro.timescales import Epoch, tdb_jd
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
 RATIO = np.array([GM_MOON, GM_SUN]) / GM_EARTH
@@ -306,7 +306,7 @@ def test_provider_with_standins_matches_pure_functions():
 
 
 def test_provider_with_tqdyn_ephemeris_agrees_with_direct_de421():
-    pytest.importorskip("tqdyn.ephemeris")
+    pytest.importorskip("tqdyn.astro.ephemeris")
     t = np.linspace(0.0, 86400.0 * 90, 7)
     a = SolidTides(orientation=standin_orientation)(EPOCH, t)
     b = _provider_standins()(EPOCH, t)
@@ -315,7 +315,7 @@ def test_provider_with_tqdyn_ephemeris_agrees_with_direct_de421():
 
 
 def test_provider_with_real_earth_orientation():
-    frames = pytest.importorskip("tqdyn.frames")
+    frames = pytest.importorskip("tqdyn.astro.earth_orientation")
     if not hasattr(frames, "earth_orientation"):
         pytest.skip("tqdyn.frames.earth_orientation not available yet")
     t = np.linspace(0.0, 86400.0, 5)

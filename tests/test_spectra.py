@@ -17,7 +17,7 @@ import pytest
 from scipy import signal
 
 from tqdyn.analysis import spectra as sp
-from tqdyn.precision import mp_from_pair, np_dd_add, np_fast_two_sum, np_two_prod
+from tqdyn.numerics.dd import mp_from_pair, np_dd_add, np_fast_two_sum, np_two_prod
 
 DT = 50.0  # s
 FS = 1.0 / DT  # Hz

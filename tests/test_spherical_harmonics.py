@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from tqdyn.forces.gravity_models import egm2008
+from tqdyn.readers.gravity_fields import egm2008
 from tqdyn.forces.spherical_harmonics import (
     NMAX_SH,
     sh_accel,

@@ -32,8 +32,8 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
-from tqdyn import sweep as sw
-from tqdyn.cli_sweep import sweep as sweep_command
+from tqdyn.workflows import sweep as sw
+from tqdyn.cli.sweep import sweep as sweep_command
 from tqdyn.scenario import loads_scenario
 
 # the paper's full force model switched off but for the Earth monopole (cheap, 1 h)

@@ -22,7 +22,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.forces.tidal_arguments import (
+from tqdyn.astro.tidal_arguments import (
     delaunay_arguments,
     delaunay_multipliers,
     doodson_arguments,
@@ -198,7 +198,7 @@ def test_vectorised_shapes():
 def test_compiled_cos_sin_and_sums_match_numpy():
     """tidal_cos_sin / tidal_harmonic_sum (products of powers of exp(i beta_k))
     against numpy's cos/sin of the explicit phases."""
-    from tqdyn.forces.tidal_arguments import tidal_cos_sin, tidal_harmonic_sum
+    from tqdyn.astro.tidal_arguments import tidal_cos_sin, tidal_harmonic_sum
 
     rng = np.random.default_rng(11)
     beta = rng.uniform(-15, 15, size=(2, 50, 6))

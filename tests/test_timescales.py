@@ -25,7 +25,7 @@ import erfa
 import numpy as np
 import pytest
 
-from tqdyn.timescales import Epoch, parse_utc, tdb_jd
+from tqdyn.astro.timescales import Epoch, parse_utc, tdb_jd
 
 DAY = 86400
 EPOCH_ISO = "2004-06-06T00:00:00"

@@ -24,7 +24,7 @@ import erfa
 import numpy as np
 from scipy.special import lpmv
 
-from tqdyn.timescales import tdb_jd
+from tqdyn.astro.timescales import tdb_jd
 
 ARCSEC = math.pi / 648000.0
 XP_2004 = -0.074487 * ARCSEC

@@ -52,8 +52,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from .constants import GM_EARTH_EGM2008
-from .timescales import Epoch
+from .astro.constants import GM_EARTH_EGM2008
+from .astro.timescales import Epoch
 
 __all__ = [
     "SatelliteConfig",

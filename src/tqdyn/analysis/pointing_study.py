@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constellation import pointing as _pointing
-from ..integrators.hermite import interpolate_states
+from ..numerics.hermite import interpolate_states
 
 __all__ = ["APPROXIMATE_LAWS", "LawComparison", "PointingStudy", "compare_pointing_laws", "pointing_study_of"]
 

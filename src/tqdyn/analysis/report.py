@@ -52,11 +52,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import io
-from ..constants import GM_EARTH_EGM2008
+from ..formats import trajectory as io
+from ..astro.constants import GM_EARTH_EGM2008
 from ..constellation import geometry
 from ..constellation.indices import LINKS, Link, Sat
-from ..lightpath import instantaneous_ranges, light_travel_times, light_travel_times_of
+from ..lightpath.light_time import instantaneous_ranges, light_travel_times, light_travel_times_of
 from . import spectra
 from .figures import _pyplot
 from .pointing_study import PointingStudy, pointing_study_of
@@ -313,7 +313,7 @@ def _link_dd(pair, link: Link):
 
 
 def _diff_dd(a, b):
-    from ..precision import np_dd_add
+    from ..numerics.dd import np_dd_add
 
     return np_dd_add(a[0], a[1], -b[0], -b[1])
 
@@ -774,7 +774,7 @@ def report_studies(run_paths: Mapping[str, str | os.PathLike | None], out_dir: s
     ``fig10-lightpath-vs-instantaneous``, ``fig11-sat-vs-tm``; .png and
     .pdf) and ``summary.md`` into ``out_dir``.  Returns :class:`Report`.
     """
-    from ..studies import STUDIES
+    from ..workflows.studies import STUDIES
 
     say = progress or (lambda msg: None)
     names = tuple(STUDIES) if studies is None else tuple(studies)
@@ -991,7 +991,7 @@ def _local_vs_global(rep, glob, loc):
 
 
 def _study_common_sg(rep, runs):
-    from ..studies import FLIGHT_DIRECTION_S, SG_DIRECTIONS
+    from ..workflows.studies import FLIGHT_DIRECTION_S, SG_DIRECTIONS
 
     grav = runs.get("gravity-90d")
     a_grav = breathing_angles_of(grav)

@@ -85,7 +85,7 @@ from numpy.polynomial import legendre as _legendre
 from scipy import signal as _signal
 from scipy import special as _special
 
-from ..precision import np_dd_add, np_fast_two_sum, np_two_prod, np_two_sum
+from ..numerics.dd import np_dd_add, np_fast_two_sum, np_two_prod, np_two_sum
 
 __all__ = [
     "DEFAULT_KAISER_BETA",

@@ -118,7 +118,7 @@ from math import atan2, sqrt
 
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 
 __all__ = [
     "LAW_CODES",

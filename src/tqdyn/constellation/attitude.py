@@ -99,7 +99,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import C_LIGHT
+from ..astro.constants import C_LIGHT
 from .indices import Mosa, Sat
 
 __all__ = [

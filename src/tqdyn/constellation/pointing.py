@@ -41,8 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import C_LIGHT
-from ..precision import np_dd_add, np_dd_div_d, np_dd_sqr, np_dd_sqrt
+from ..astro.constants import C_LIGHT
+from ..numerics.dd import np_dd_add, np_dd_div_d, np_dd_sqr, np_dd_sqrt
 from .geometry import _f64, _split_positions, arms, by_mosa
 from .indices import LINK_OF_MOSA, LINKS
 

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 
-from ..constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
+from ..astro.constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
 
 __all__ = [
     "DESCRIPTION",

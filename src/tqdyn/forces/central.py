@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from ..precision import add, dd_from_mp, div, mul, neg, sqrt
+from ..numerics.dd import add, dd_from_mp, div, mul, neg, sqrt
 
 __all__ = ["monopole", "EarthMonopole"]
 

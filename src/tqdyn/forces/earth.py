@@ -43,9 +43,9 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache)
-from ..precision import add, const, div, mul, sqrt, sub
-from .gravity_models import GravityModel, egm2008
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache)
+from ..numerics.dd import add, const, div, mul, sqrt, sub
+from ..readers.gravity_fields import GravityModel, egm2008
 from .spherical_harmonics import NMAX_SH, sh_accel_flat
 
 __all__ = [
@@ -67,7 +67,7 @@ N_ROT = 9
 def _frames_rotation(epoch, t_hi, t_lo):
     """T_ITRS_GCRS (..., 3, 3) from :func:`tqdyn.frames.earth_orientation`."""
     try:
-        from ..frames import earth_orientation
+        from ..astro.earth_orientation import earth_orientation
     except ImportError as exc:
         raise ImportError("EarthField: tqdyn.frames.earth_orientation is not available; "
                           "pass a rotation provider (rotation=...)") from exc

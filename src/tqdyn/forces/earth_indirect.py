@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from ..timescales import tdb_jd
+from ..astro.timescales import tdb_jd
 from .earth import EarthField, earth_field_accel_batch
 
 __all__ = ["EarthFieldIndirect", "earth_field_indirect_accel"]

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..precision import add, const, mul, to_f64
+from ..numerics.dd import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import EarthField, degree2_accel_ext, earth_field_accel
@@ -113,14 +113,14 @@ def describe_terms() -> list[tuple[str, str, str]]:
 
 def _ephemeris(name_or_path: str):
     """The JPL ephemeris of a scenario: "de421" (shipped) or a .bsp path."""
-    from ..ephemeris import Ephemeris, default_ephemeris
+    from ..astro.ephemeris import Ephemeris, default_ephemeris
 
     return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
 
 
 def _no_eop_rotation(epoch, t_hi, t_lo):
     """T_ITRS_GCRS without EOP (no polar motion, UT1 = UTC, no pole offsets)."""
-    from ..frames import earth_orientation
+    from ..astro.earth_orientation import earth_orientation
 
     return earth_orientation(epoch, t_hi, t_lo, use_eop=False).T_ITRS_GCRS
 
@@ -130,7 +130,7 @@ def _tide_models(forces, eph, rotation) -> tuple:
     summed into the Earth field)."""
     orientation = None
     if rotation is not None:
-        from ..frames import earth_orientation
+        from ..astro.earth_orientation import earth_orientation
 
         def orientation(epoch, t_hi, t_lo):
             return earth_orientation(epoch, t_hi, t_lo, use_eop=False)
@@ -163,7 +163,7 @@ def build_force_model(forces) -> ForceModel:
         terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, rotation),
                                 rotation=rotation, extended_degree2=forces.earth_degree2_extended))
     if forces.earth_field_indirect:
-        from ..ephemeris import planetary_gm
+        from ..astro.ephemeris import planetary_gm
 
         gm = planetary_gm()
         bodies = tuple(b for b in ("moon", "sun") if b in forces.third_bodies)

@@ -75,10 +75,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..constants import J2000_JD
-from ..timescales import tdb_jd
-from ._naif import read_text_kernel
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..astro.constants import J2000_JD
+from ..astro.timescales import tdb_jd
+from ..readers.naif import read_text_kernel
 from .spherical_harmonics import sh_accel
 
 __all__ = [
@@ -461,13 +461,13 @@ def _earth_terms(tdat, params):
 
 @functools.lru_cache(maxsize=8)
 def _gl0660b(degree: int):
-    from .gravity_models import gl0660b
+    from ..readers.gravity_fields import gl0660b
 
     return gl0660b(nmax=degree)
 
 
 def _default_ephemeris():
-    from ..ephemeris import default_ephemeris
+    from ..astro.ephemeris import default_ephemeris
 
     return default_ephemeris()
 

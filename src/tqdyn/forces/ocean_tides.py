@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .tidal_arguments import delaunay_arguments, doodson_arguments, doodson_multipliers, tidal_cos_sin
+from ..astro.tidal_arguments import delaunay_arguments, doodson_arguments, doodson_multipliers, tidal_cos_sin
 
 __all__ = [
     "FES2004_FILE",

@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import J2000_JD
+from ..astro.constants import J2000_JD
 
 __all__ = [
     "ARCSEC",

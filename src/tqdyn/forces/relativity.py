@@ -58,9 +58,9 @@ import erfa
 import numpy as np
 from numba import njit
 
-from ..constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J_EARTH_IERS2010
-from ..ephemeris import Ephemeris, default_ephemeris, planetary_gm
-from ..timescales import tdb_jd
+from ..astro.constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J_EARTH_IERS2010
+from ..astro.ephemeris import Ephemeris, default_ephemeris, planetary_gm
+from ..astro.timescales import tdb_jd
 
 __all__ = [
     "Relativity",

@@ -73,10 +73,10 @@ import numpy as np
 
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from .._data import read_iers_table
-from ..constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
-from .tidal_arguments import (
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..readers.files import read_iers_table
+from ..astro.constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
+from ..astro.tidal_arguments import (
     delaunay_arguments,
     delaunay_multipliers,
     doodson_arguments,
@@ -395,7 +395,7 @@ def _resolve_orientation(orientation):
     if orientation is not None:
         return orientation
     try:
-        from ..frames import earth_orientation
+        from ..astro.earth_orientation import earth_orientation
     except ImportError as exc:
         raise ImportError("tides: tqdyn.frames.earth_orientation is not available "
                           f"({exc}); pass orientation=callable(epoch, t_hi, t_lo)") from None
@@ -405,7 +405,7 @@ def _resolve_orientation(orientation):
 def _resolve_ephemeris(ephemeris):
     if ephemeris is not None:
         return ephemeris
-    from ..ephemeris import default_ephemeris
+    from ..astro.ephemeris import default_ephemeris
 
     return default_ephemeris()
 
@@ -485,7 +485,7 @@ class SolidTides:
     def _gm_ratio(self) -> np.ndarray:
         gm_moon, gm_sun = self.gm_moon, self.gm_sun
         if gm_moon is None or gm_sun is None:
-            from ..ephemeris import planetary_gm
+            from ..astro.ephemeris import planetary_gm
 
             gm = planetary_gm()
             gm_moon = gm["moon"] if gm_moon is None else gm_moon
@@ -514,7 +514,7 @@ class SolidTides:
     def __call__(self, epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
         """(dC, dS), float64 S + (5, 5) [n, m], at t = t_hi + t_lo [s TDB since
         epoch] (S = broadcast shape of t_hi, t_lo)."""
-        from ..timescales import tdb_jd
+        from ..astro.timescales import tdb_jd
 
         t_hi, t_lo = np.broadcast_arrays(np.asarray(t_hi, np.float64), np.asarray(t_lo, np.float64))
         eo = _resolve_orientation(self.orientation)(epoch, t_hi, t_lo)

@@ -66,7 +66,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache)
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache)
 
 __all__ = [
     "NMAX_SH",

@@ -49,10 +49,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..constants import J2000_JD
-from ..timescales import tdb_jd
-from ._naif import read_text_kernel
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..astro.constants import J2000_JD
+from ..astro.timescales import tdb_jd
+from ..readers.naif import read_text_kernel
 
 __all__ = [
     "GM_SUN_DE430",
@@ -184,7 +184,7 @@ def sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat, params):
 def _sun_gm() -> float:
     """GM of the Sun [m^3/s^2]: ``tqdyn.ephemeris.planetary_gm()["sun"]``
     (the DE430/DE431 value, which GM_SUN_DE430 repeats)."""
-    from ..ephemeris import planetary_gm
+    from ..astro.ephemeris import planetary_gm
 
     return float(planetary_gm()["sun"])
 
@@ -198,7 +198,7 @@ def _positions(eph, body, jd1, jd2) -> np.ndarray:
 
 
 def _default_ephemeris():
-    from ..ephemeris import default_ephemeris
+    from ..astro.ephemeris import default_ephemeris
 
     return default_ephemeris()
 

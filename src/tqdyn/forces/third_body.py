@@ -33,7 +33,7 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from ..precision import add, const, div, mul, neg, sqrt, sub
+from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
 
 __all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel", "third_body_accel_ext"]
 

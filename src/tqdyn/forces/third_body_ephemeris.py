@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ephemeris import BODIES, Ephemeris, default_ephemeris, planetary_gm
-from ..timescales import tdb_jd
+from ..astro.ephemeris import BODIES, Ephemeris, default_ephemeris, planetary_gm
+from ..astro.timescales import tdb_jd
 from .third_body import ThirdBodies
 
 __all__ = ["EphemerisPositions", "third_bodies"]

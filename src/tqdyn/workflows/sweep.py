@@ -69,8 +69,8 @@ from typing import Any
 
 import numpy as np
 
-from . import io
-from .scenario import (
+from ..formats import trajectory as io
+from ..scenario import (
     DEFAULT_SCENARIO,
     ScenarioError,
     builtin_scenarios,
@@ -701,7 +701,7 @@ def _one_line(exc: BaseException) -> str:
 def _run_member(scenario_toml: str) -> dict:
     """Dask task: run one member (its resolved scenario TOML) to its file.
     Never raises: returns a dict with ``ok`` and the run's numbers or the error."""
-    from . import runner
+    from . import run as runner
 
     try:
         scen = loads_scenario(scenario_toml, source="sweep member")

@@ -35,7 +35,7 @@ import erfa
 import numpy as np
 
 from .constants import DAY_S
-from .precision import np_two_prod, np_two_sum
+from ..numerics.dd import np_two_prod, np_two_sum
 
 __all__ = ["Epoch", "UTCFields", "parse_utc", "tdb_jd"]
 

@@ -38,8 +38,8 @@ from typing import Any, Mapping, Sequence
 import h5py
 import numpy as np
 
-from . import __version__ as _TQDYN_VERSION
-from .precision import np_two_sum
+from .. import __version__ as _TQDYN_VERSION
+from ..numerics.dd import np_two_sum
 
 __all__ = [
     "FORMAT",

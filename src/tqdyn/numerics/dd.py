@@ -45,7 +45,7 @@ from fractions import Fraction
 import numpy as np
 from numba import njit, types
 
-from . import _jit  # noqa: F401  (registers the package-wide kernel cache before any @njit)
+from . import jit as _jit  # noqa: F401  (registers the package-wide kernel cache before any @njit)
 from numba.extending import intrinsic, overload
 
 __all__ = [

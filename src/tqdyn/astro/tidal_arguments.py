@@ -51,8 +51,8 @@ import erfa
 import numpy as np
 from numba import njit
 
-from .. import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..constants import J2000_JD
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from .constants import J2000_JD
 
 __all__ = [
     "DAYS_PER_JULIAN_CENTURY",

@@ -23,9 +23,9 @@ import sys
 
 import click
 
-from . import __version__
-from ._cli_common import EXIT_FAILED as _EXIT_RUN_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
-from ._cli_common import fail as _fail
+from .. import __version__
+from ._common import EXIT_FAILED as _EXIT_RUN_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
+from ._common import fail as _fail
 
 __all__ = ["report"]
 
@@ -69,8 +69,8 @@ def report(runs, out, studies, runs_dir, quick, duration_scale, only, sets, work
             _fail(f"{name}: only applies with --studies")
     if not runs:
         _fail("RUN.h5: no trajectory file given; allowed: one or more tqdyn trajectory files, or --studies")
-    from . import io
-    from .analysis import report as rp
+    from ..formats import trajectory as io
+    from ..analysis import report as rp
 
     try:
         rep = rp.report_runs(runs, out or "tqdyn-report", progress=say)
@@ -93,9 +93,9 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
 
     from tqdm import tqdm
 
-    from . import studies as st
-    from .analysis import report as rp
-    from .sweep import default_workers
+    from ..workflows import studies as st
+    from ..analysis import report as rp
+    from ..workflows.sweep import default_workers
 
     if quick and duration_scale is not None:
         _fail("--quick: conflicts with --duration-scale; allowed: one of them")

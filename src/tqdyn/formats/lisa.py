@@ -90,11 +90,11 @@ import h5py
 import numpy as np
 from numba import njit
 
-from . import __version__ as _TQDYN_VERSION
-from . import io as _io
-from .constants import C_LIGHT, GM_EARTH_EGM2008
-from .constellation.indices import LINKS
-from .lightpath import LightTravelTimes, light_travel_times_of
+from .. import __version__ as _TQDYN_VERSION
+from . import trajectory as _io
+from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
+from ..constellation.indices import LINKS
+from ..lightpath.light_time import LightTravelTimes, light_travel_times_of
 
 __all__ = [
     "LISA_LINK_ORDER",
@@ -468,7 +468,7 @@ def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None
     endpoints = ("test masses (TM of satellite i facing j <- TM of satellite j facing i)" if lp.source == "tm"
                  else "satellite centres of mass (the trajectory has no test-mass fields)")
     meta = {
-        "generator": "tqdyn.export_lisa",
+        "generator": "tqdyn.formats.lisa",
         "tqdyn_version": _TQDYN_VERSION,
         "frame": _FRAME,
         "time_scale": _TIME,

@@ -60,7 +60,7 @@ import erfa
 import numpy as np
 from numba import njit
 
-from . import _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
 from .eop import EOP, load_eop, load_tidal_eop_terms, tidal_arguments, tidal_eop_corrections
 from .timescales import Epoch, tdb_jd
 

@@ -24,8 +24,9 @@ from typing import Callable
 
 import numpy as np
 
-from . import io, propagator
-from .propagator import Checkpoint, RunResult
+from ..formats import trajectory as io
+from ..dynamics import propagate as propagator
+from ..dynamics.propagate import Checkpoint, RunResult
 
 __all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
 

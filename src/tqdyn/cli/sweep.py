@@ -16,9 +16,9 @@ import sys
 
 import click
 
-from . import __version__
-from ._cli_common import EXIT_FAILED as _EXIT_MEMBER_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
-from ._cli_common import fail as _fail
+from .. import __version__
+from ._common import EXIT_FAILED as _EXIT_MEMBER_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
+from ._common import fail as _fail
 
 __all__ = ["sweep"]
 
@@ -68,7 +68,7 @@ def sweep(sweep_file, scheduler, workers, dry_run, quiet):
     a member failed (the others are kept), 2 on bad input."""
     from tqdm import tqdm
 
-    from . import sweep as sw
+    from ..workflows import sweep as sw
 
     if workers is not None and workers < 1:
         _fail(f"--workers: {workers} is not a number of workers; allowed: an integer >= 1")

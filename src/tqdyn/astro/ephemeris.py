@@ -55,7 +55,7 @@ import erfa
 import numpy as np
 from numba import njit
 
-from . import _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from .constants import DAY_S, J2000_JD
 
 __all__ = [

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import click
 
-from ._cli_common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["FORMATS", "export"]
 
@@ -38,8 +38,8 @@ def export(run_file, out_file, fmt, shapiro):
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")
     if fmt not in FORMATS:
         _fail(f"--format: {fmt!r} is not allowed; allowed: {', '.join(FORMATS)}")
-    from . import io
-    from .export_lisa import export_lisa
+    from ..formats import trajectory as io
+    from ..formats.lisa import export_lisa
 
     try:
         summary = export_lisa(run_file, out_file, shapiro=shapiro)

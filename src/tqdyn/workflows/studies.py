@@ -108,7 +108,7 @@ class RunSpec:
         tests).  output : ``run.output`` (default: the placeholder name).
         Raises :class:`tqdyn.scenario.ScenarioError`.
         """
-        from .scenario import load_scenario
+        from ..scenario import load_scenario
 
         base = load_scenario(self.scenario, [*self.overrides, *extra])
         step = float(base.integrator.step_s)
@@ -248,8 +248,8 @@ def run_complete(path, canonical_toml: str) -> bool:
     time row is the scenario's duration."""
     import h5py
 
-    from . import io
-    from .scenario import ScenarioError, loads_scenario
+    from ..formats import trajectory as io
+    from ..scenario import ScenarioError, loads_scenario
 
     try:
         with h5py.File(path, "r") as h5:
@@ -292,7 +292,7 @@ def plan_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_sca
     FileNotFoundError.  Runs shared by several studies appear once; longest
     first.  Nothing is written.
     """
-    from . import propagator
+    from ..dynamics import propagate as propagator
 
     names = _check_names(studies)
     runs_dir = Path(os.path.abspath(os.path.expanduser(os.fspath(runs_dir))))
@@ -366,8 +366,8 @@ def _one_line(exc: BaseException) -> str:
 
 def _run_one(scenario_toml: str) -> dict:
     """Task: run one resolved scenario to its file; never raises."""
-    from . import runner
-    from .scenario import loads_scenario
+    from . import run as runner
+    from ..scenario import loads_scenario
 
     t0 = time.perf_counter()
     try:

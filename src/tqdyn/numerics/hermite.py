@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..precision import add, div, ld, mul, st, sub
+from .dd import add, div, ld, mul, st, sub
 
 __all__ = ["hermite_eval", "interpolate_states"]
 

@@ -68,8 +68,8 @@ import numpy as np
 
 from numba import njit
 
-from . import _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
-from ._data import read_iers_table
+from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ..readers.files import read_iers_table
 
 __all__ = [
     "ARCSEC",

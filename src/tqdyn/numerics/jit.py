@@ -24,7 +24,7 @@ import numba
 
 __all__ = ["cache_dir", "install_cache_locator"]
 
-_PACKAGE = pathlib.Path(__file__).resolve().parent
+_PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
 
 def cache_dir() -> pathlib.Path:

@@ -29,14 +29,15 @@ import mpmath
 import numpy as np
 from numba import njit
 
-from . import elements as _el
-from . import dynamics as _dyn
-from .constants import C_LIGHT, R_EARTH_EGM2008
-from .dynamics import point_masses, system_rhs
-from .forces.model import ForceModel, build_force_model
-from .integrators import dp87, hermite
-from .precision import add, ld, mul, mp_from_dd, st
-from .timescales import Epoch
+from ..astro import elements as _el
+from . import rhs as _dyn
+from ..astro.constants import C_LIGHT, R_EARTH_EGM2008
+from .rhs import point_masses, system_rhs
+from ..forces.model import ForceModel, build_force_model
+from ..numerics import dp87
+from ..numerics import hermite
+from ..numerics.dd import add, ld, mul, mp_from_dd, st
+from ..astro.timescales import Epoch
 
 __all__ = ["initial_state", "propagate", "RunResult", "PRECISIONS", "evaluate_rhs", "warm_up",
            "two_body_energy", "check_inputs", "Checkpoint", "System", "build_system", "self_gravity_oa"]
@@ -89,7 +90,7 @@ class _SystemInputs:
         return True
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        from .timescales import tdb_jd
+        from ..astro.timescales import tdb_jd
 
         base = self._model.precompute(epoch, t_hi, t_lo)
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
@@ -100,7 +101,7 @@ class _SystemInputs:
 
 def self_gravity_oa(scenario) -> np.ndarray:
     """DC self-gravity of the scenario's TMs, (3, 2, 3) [m/s^2] in OA_l."""
-    from .constellation.spacecraft import TABLE_IV_SELF_GRAVITY
+    from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY
 
     oa, _ = scenario.spacecraft.self_gravity_values()
     return np.broadcast_to(TABLE_IV_SELF_GRAVITY, (3, 2, 3)).copy() if oa is None else oa
@@ -110,10 +111,10 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     """The :class:`System` of a scenario (point masses unless
     ``constellation.pointing`` names a law).  ``model``: the scenario's force
     model (built if None), whose time-only inputs the system's follow."""
-    from .constellation._kinematics_jit import LAW_CODES
-    from .constellation.spacecraft import Spacecraft
-    from .ephemeris import planetary_gm
-    from .forces.model import _ephemeris
+    from ..constellation._kinematics_jit import LAW_CODES
+    from ..constellation.spacecraft import Spacecraft
+    from ..astro.ephemeris import planetary_gm
+    from ..forces.model import _ephemeris
 
     c = scenario.constellation
     if not c.coupled:

@@ -26,8 +26,8 @@ import mpmath
 import numpy as np
 from mpmath import mp, mpf
 
-from .precision import dd_from_mp as to_dd
-from .precision import mp_from_pair as from_dd
+from ..numerics.dd import dd_from_mp as to_dd
+from ..numerics.dd import mp_from_pair as from_dd
 
 __all__ = [
     "deg",

@@ -55,10 +55,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .constellation._control_jit import housing_geometry, satellite_control
-from .constellation._kinematics_jit import sat_kinematics
-from .forces.model import gravity
-from .precision import add, ld, lo_part, st, sub, to_f64
+from ..constellation._control_jit import housing_geometry, satellite_control
+from ..constellation._kinematics_jit import sat_kinematics
+from ..forces.model import gravity
+from ..numerics.dd import add, ld, lo_part, st, sub, to_f64
 
 __all__ = ["system_rhs", "point_masses", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
            "make_cpar", "aux_views", "workspace"]

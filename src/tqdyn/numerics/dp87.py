@@ -33,7 +33,7 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
-from ..precision import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
+from .dd import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
 
 __all__ = [

@@ -66,10 +66,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .constants import C_LIGHT, GM_EARTH_EGM2008
-from .constellation.indices import LINKS
-from .integrators.hermite import hermite_eval
-from .precision import (
+from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
+from ..constellation.indices import LINKS
+from ..numerics.hermite import hermite_eval
+from ..numerics.dd import (
     add,
     div,
     ld,

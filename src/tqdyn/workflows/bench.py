@@ -25,10 +25,10 @@ import time
 import mpmath
 import numpy as np
 
-from . import elements as _el
-from . import propagator
-from .precision import mp_from_dd
-from .scenario import load_scenario
+from ..astro import elements as _el
+from ..dynamics import propagate as propagator
+from ..numerics.dd import mp_from_dd
+from ..scenario import load_scenario
 
 __all__ = ["kepler_benchmark", "format_report", "force_model_benchmark", "format_force_report",
            "coupled_benchmark", "format_coupled_report"]
@@ -90,7 +90,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
         }
     if heyoka:
         try:
-            from . import _heyoka_peer
+            from . import heyoka_peer as _heyoka_peer
             y0 = propagator.initial_state(scen)
             out = _heyoka_peer.propagate_kepler_grid(
                 (y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]), str(scen.forces.gm_earth),
@@ -168,12 +168,12 @@ def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
             report["reduced_final"] = res.y_final
     if heyoka:
         try:
-            from . import _heyoka_peer
+            from . import heyoka_peer as _heyoka_peer
             peer = getattr(_heyoka_peer, "propagate_reduced_grid")
         except (ImportError, AttributeError) as exc:
             report["heyoka"] = f"skipped: {exc}"
         else:
-            from .timescales import Epoch
+            from ..astro.timescales import Epoch
 
             y0 = propagator.initial_state(reduced)
             out = peer((y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]),

@@ -12,8 +12,8 @@ import sys
 
 import click
 
-from . import __version__
-from ._cli_common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from .. import __version__
+from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["main"]
 
@@ -65,8 +65,10 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     their last checkpoint; `--resume` continues them to a bit-identical file."""
     from tqdm import tqdm
 
-    from . import io, propagator, runner
-    from .scenario import ScenarioError, load_scenario
+    from ..formats import trajectory as io
+    from ..dynamics import propagate as propagator
+    from ..workflows import run as runner
+    from ..scenario import ScenarioError, load_scenario
 
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
@@ -138,11 +140,11 @@ def forces(scenario, duration, every, plot_path, sets):
     RMS of |a| of each force term [m/s^2]."""
     from decimal import Decimal, InvalidOperation
 
-    from . import propagator
-    from .analysis.budget import force_budget
-    from .forces import atmospheric_tides
-    from .scenario import ScenarioError, load_scenario
-    from .timescales import Epoch
+    from ..dynamics import propagate as propagator
+    from ..analysis.budget import force_budget
+    from ..forces import atmospheric_tides
+    from ..scenario import ScenarioError, load_scenario
+    from ..astro.timescales import Epoch
 
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, None, None, None))
@@ -175,7 +177,7 @@ def forces(scenario, duration, every, plot_path, sets):
                  f"{'':>10}  NOT modelled: {atmospheric_tides.SOURCE}")
     click.echo("\n".join(lines))
     if plot_path:
-        from .analysis.figures import plot_force_budget
+        from ..analysis.figures import plot_force_budget
 
         try:
             plot_force_budget(budget, t_hi + t_lo, plot_path, title=f"force budget, {scen.name}")
@@ -191,10 +193,10 @@ def info():
     import platform
     from importlib import resources
 
-    from .forces import atmospheric_tides
-    from .forces.model import describe_terms
-    from .integrators import _dp87_tableau
-    from .scenario import builtin_scenarios
+    from ..forces import atmospheric_tides
+    from ..forces.model import describe_terms
+    from ..numerics import _dp87_tableau
+    from ..scenario import builtin_scenarios
 
     def version(mod):
         try:
@@ -246,8 +248,8 @@ def bench(duration, step, no_heyoka, which):
     float64 vs heyoka real128 on the same grid), the force model (full
     model dd / float64, reduced model dd vs heyoka real128) and the coupled
     constellation (dd / float64)."""
-    from . import bench as _bench
-    from .scenario import ScenarioError
+    from ..workflows import bench as _bench
+    from ..scenario import ScenarioError
 
     try:
         if which in ("kepler", "all"):
@@ -262,9 +264,9 @@ def bench(duration, step, no_heyoka, which):
         _fail(str(exc))
 
 
-from .cli_export import export as _export_command  # noqa: E402  (commands in their own modules)
-from .cli_report import report as _report_command  # noqa: E402
-from .cli_sweep import sweep as _sweep_command  # noqa: E402
+from .export import export as _export_command  # noqa: E402  (commands in their own modules)
+from .report import report as _report_command  # noqa: E402
+from .sweep import sweep as _sweep_command  # noqa: E402
 
 cli.add_command(_export_command)
 cli.add_command(_sweep_command)
