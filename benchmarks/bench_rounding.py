@@ -20,7 +20,7 @@ import mpmath
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from mp_reference import DPS, GM, mp_dp87  # noqa: E402
 
-from tqdyn import propagator  # noqa: E402
+from tqdyn import dynamics  # noqa: E402
 from tqdyn.numerics import dp87  # noqa: E402
 from tqdyn.numerics.dd import mp_from_dd  # noqa: E402
 from tqdyn.scenario import loads_scenario  # noqa: E402
@@ -47,7 +47,7 @@ def main():
     days = ap.parse_args().days
     scen = loads_scenario(SCENARIO.format(days=days, gm=GM))
     coef = dp87.step_coefficients(dp87.load_tableau(), scen.integrator.step_s, "dd")
-    res = propagator.propagate(scen, precision="dd")
+    res = dynamics.propagate(scen, precision="dd")
     y0 = list(mp_from_dd(res.y0)[0])
     t0 = time.perf_counter()
     ref = mp_dp87(y0, "50", scen.n_steps, coef=coef)

@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 from mpmath import mp, mpf
 
-from tqdyn.constellation.attitude import attitude, central_jerk_snap, beam_vectors
+from tqdyn.constellation.attitude import attitude, beam_vectors
+from tqdyn.forces.central import central_jerk_snap
 from tqdyn.constellation.indices import Mosa, Sat
 from tqdyn.astro.elements import deg, kepler_state_at
 
@@ -166,18 +167,14 @@ def test_rigid_equilateral_circular(law, method):
 
 @pytest.fixture(scope="module")
 def real_orbit():
-    from tqdyn.dynamics import propagate as propagator
+    from tqdyn import dynamics
     from tqdyn.scenario import load_scenario
 
-    rows = []
-    propagator.propagate(load_scenario("tianqin", ["run.duration=1d", "constellation.pointing=none",
-                                                                "constellation.control=off"]), sink=rows.append)
-    cat = lambda k, p: np.concatenate([x[k][p] for x in rows])  # noqa: E731
-    t = cat("t", 0) + cat("t", 1)
-    r = (cat("sat/r", 0), cat("sat/r", 1))
-    v = (cat("sat/v", 0), cat("sat/v", 1))
-    a = np.concatenate([x["sat/a_gravity"] for x in rows])
-    return t, r, v, a
+    blocks = []
+    dynamics.propagate(load_scenario("tianqin", ["run.duration=1d", "constellation.pointing=none",
+                                                                "constellation.control=off"]), sink=blocks.append)
+    rows = dynamics.Rows.concatenate(blocks)
+    return rows.t[0] + rows.t[1], rows.sat_r, rows.sat_v, rows.sat_a_gravity
 
 
 def _fd_omega(T, h):

@@ -16,7 +16,7 @@ import pytest
 from tqdyn import cli
 from tqdyn.astro import elements
 from tqdyn.formats import trajectory as io
-from tqdyn.dynamics import propagate as propagator
+from tqdyn import dynamics
 from tqdyn.numerics.dd import mp_from_dd
 from tqdyn.scenario import load_scenario, loads_scenario
 
@@ -159,7 +159,7 @@ def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch):
     an existing output file untouched."""
     out_file = tmp_path / "run.h5"
     out_file.write_bytes(b"previous")
-    real = propagator.propagate
+    real = dynamics.propagate
 
     def interrupted(scen, sink=None, progress=None, **kw):
         def sink_then_stop(rows):
@@ -167,7 +167,7 @@ def test_interrupt_leaves_no_file(tmp_path, capsys, monkeypatch):
             raise KeyboardInterrupt
         return real(scen, sink=sink_then_stop, progress=progress, chunk=64, **kw)
 
-    monkeypatch.setattr(propagator, "propagate", interrupted)
+    monkeypatch.setattr(dynamics, "propagate", interrupted)
     status, _, err = _run(["run", "tianqin-kepler", "--duration", "1d", "-o", str(out_file), "-q"], capsys)
     assert status == 130 and "interrupted" in err
     assert _no_files(tmp_path) == ["run.h5"] and out_file.read_bytes() == b"previous"
@@ -236,7 +236,7 @@ def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch, extra):
     assert not (tmp_path / "ref.h5.checkpoint").exists()
 
     out = tmp_path / "run.h5"
-    real = propagator.propagate
+    real = dynamics.propagate
     calls = {"n": 0}
 
     def interrupted(scen, sink=None, **kw):
@@ -247,11 +247,11 @@ def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch, extra):
                 raise KeyboardInterrupt
         return real(scen, sink=sink_then_stop, **kw)
 
-    monkeypatch.setattr(propagator, "propagate", interrupted)
+    monkeypatch.setattr(dynamics, "propagate", interrupted)
     status, _, err = _run(args + ["-o", str(out)], capsys)
     assert status == 130 and "--resume" in err
     assert not out.exists() and (tmp_path / "run.h5.checkpoint").exists()
-    monkeypatch.setattr(propagator, "propagate", real)
+    monkeypatch.setattr(dynamics, "propagate", real)
     status, _, err = _run(args + ["-o", str(out)], capsys)  # without --resume: refused, nothing lost
     assert status == 2 and "--resume" in err
     status, _, err = _run(args + ["-o", str(out), "--resume"], capsys)

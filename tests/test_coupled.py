@@ -18,7 +18,7 @@ import pytest
 
 from tqdyn import cli
 from tqdyn.formats import trajectory as io
-from tqdyn.dynamics import propagate as propagator
+from tqdyn import dynamics
 from tqdyn.workflows import run as runner
 from tqdyn.constellation import attitude as att
 from tqdyn.constellation import control as ctl
@@ -55,12 +55,12 @@ def _gravity_at(scen, t_pair, positions_dd, velocities):
     """Total gravity [m/s^2] of the scenario's model at dd positions (n, 3, 2)
     at time t (dd pair): the point-mass right-hand side of tqdyn, evaluated
     separately from the coupled kernel."""
-    model = propagator.check_inputs(scen)
+    model = dynamics.check_inputs(scen)
     tdat = model.precompute(Epoch.from_utc(scen.epoch_utc), np.array([t_pair[0]]), np.array([t_pair[1]]))[0]
     y = np.zeros((positions_dd.shape[0], 6, 2))
     y[:, 0:3] = positions_dd
     y[:, 3:6, 0] = velocities
-    return propagator.evaluate_rhs(y, tdat, model)[:, 3:6]
+    return dynamics.evaluate_rhs(y, tdat, model)[:, 3:6]
 
 
 # ---------------------------------------------------------------------------
@@ -128,12 +128,12 @@ def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
     np.testing.assert_allclose(tr["sat/a_gravity"][row], acc[:3, :, 0] + acc[:3, :, 1], rtol=0, atol=1e-18)
     wm, wmd = ctl.mosa_angular_rates(ref.theta_dot, ref.theta_ddot)
     nc = ctl.nominal_control(ref.T_S_I, ref.omega, ref.omega_dot, ref.theta, wm, wmd, dg,
-                             Spacecraft(self_gravity=propagator.self_gravity_oa(scen)))
+                             Spacecraft(self_gravity=dynamics.self_gravity_oa(scen)))
     # m/s^2; suspension ~1e-10, G ~ 1e-11: agreement at ~1e-16 relative
     np.testing.assert_allclose(tr["tm/a_suspension"][row], nc.a_suspension, rtol=0, atol=2e-25)
     np.testing.assert_allclose(tr["sat/a_dragfree"][row], nc.a_dragfree, rtol=0, atol=2e-25)
     np.testing.assert_allclose(tr["tm/alpha_suspension"][row], nc.alpha_suspension, rtol=0, atol=1e-24)  # as omega_dot
-    np.testing.assert_array_equal(tr["tm/self_gravity"], propagator.self_gravity_oa(scen))
+    np.testing.assert_array_equal(tr["tm/self_gravity"], dynamics.self_gravity_oa(scen))
 
     # the three control conditions, with the compiled A and G and the reference g
     A_S = np.einsum("slji,slj->sli", ctl.oa_rotation(ref.theta), tr["tm/a_suspension"][row])  # T_S_OA A

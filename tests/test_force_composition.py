@@ -18,7 +18,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.dynamics import propagate as propagator
+from tqdyn import dynamics
 from tqdyn.forces.central import EarthMonopole
 from tqdyn.forces.model import ForceModel, gravity
 from tqdyn.forces.third_body import ThirdBodies, third_body_accel
@@ -125,7 +125,7 @@ def test_composition_sums_terms():
 
 
 def _final(scen, model, **kw):
-    res = propagator.propagate(scen, model=model, **kw)
+    res = dynamics.propagate(scen, model=model, **kw)
     return mp_from_dd(res.y_final[:, 0:3, :]), res
 
 

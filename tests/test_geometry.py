@@ -56,20 +56,14 @@ def test_indices_even_permutations_and_links():
 
 @pytest.fixture(scope="module")
 def trajectory():
-    from tqdyn.dynamics import propagate as propagator
+    from tqdyn import dynamics
     from tqdyn.scenario import load_scenario
 
-    rows = []
-    propagator.propagate(load_scenario("tianqin-kepler", ["run.duration=1d"]), sink=rows.append)
-
-    def cat(k):
-        if isinstance(rows[0][k], tuple):
-            return tuple(np.concatenate([r[k][q] for r in rows]) for q in (0, 1))
-        return np.concatenate([r[k] for r in rows])
-
-    t = cat("t")
-    assert np.all(np.diff(t[0]) == H)
-    return t, cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+    blocks = []
+    dynamics.propagate(load_scenario("tianqin-kepler", ["run.duration=1d"]), sink=blocks.append)
+    rows = dynamics.Rows.concatenate(blocks)
+    assert np.all(np.diff(rows.t[0]) == H)
+    return rows.t, rows.sat_r, rows.sat_v, rows.sat_a_gravity
 
 
 def _fd1(f):

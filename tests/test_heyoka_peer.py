@@ -200,7 +200,7 @@ def _third_body_acc(r, s, gm):
 
 
 def test_reduced_model_vs_tqdyn_one_day():
-    from tqdyn.dynamics import propagate as propagator
+    from tqdyn import dynamics
     from tqdyn.workflows.heyoka_peer import _epoch_days, _reduced_system, propagate_reduced_grid
     from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
     from tqdyn.scenario import load_scenario
@@ -209,7 +209,7 @@ def test_reduced_model_vs_tqdyn_one_day():
     scen = load_scenario("tianqin", ["run.duration=1d", *REDUCED])
     assert scen.n_steps == N_DAY
     epoch = scen.epoch
-    y0 = propagator.initial_state(scen)
+    y0 = dynamics.initial_state(scen)
     out = propagate_reduced_grid((y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]),
                                  epoch.tdb, STEP, N_DAY, gm=str(scen.forces.gm_earth))
     assert out["fp_type"] == "real128"
@@ -218,10 +218,9 @@ def test_reduced_model_vs_tqdyn_one_day():
     assert np.array_equal(out["r_hi"][0], y0[:, 0:3, 0])
     assert np.array_equal(out["r_lo"][0], y0[:, 0:3, 1])
 
-    rows = []
-    res = propagator.propagate(scen, sink=rows.append)
-    r_hi = np.concatenate([np.asarray(x["sat/r"][0]) for x in rows])
-    r_lo = np.concatenate([np.asarray(x["sat/r"][1]) for x in rows])
+    blocks = []
+    res = dynamics.propagate(scen, sink=blocks.append)
+    r_hi, r_lo = dynamics.Rows.concatenate(blocks).sat_r
     assert r_hi.shape == out["r_hi"].shape
     dist = np.linalg.norm((out["r_hi"] - r_hi) + (out["r_lo"] - r_lo), axis=-1)
 

@@ -43,7 +43,8 @@ from tqdyn.constellation._kinematics_jit import (
     law_code,
     sat_kinematics,
 )
-from tqdyn.constellation.attitude import attitude, central_jerk_snap
+from tqdyn.constellation.attitude import attitude
+from tqdyn.forces.central import central_jerk_snap
 from tqdyn.constellation.indices import Sat
 from tqdyn.astro.elements import deg, kepler_state_at
 

@@ -261,18 +261,13 @@ def test_shapiro():
 def test_propagator_dense_output_vs_direct_propagation():
     # reference (5): propagate the built-in Kepler scenario directly to the emission
     # instant t_k - tau and compare with the dense-output emitter position
-    from tqdyn.dynamics.propagate import propagate
+    from tqdyn.dynamics import Rows, propagate
     from tqdyn.scenario import load_scenario
 
-    rows = []
-    propagate(load_scenario("tianqin-kepler", ["run.duration=2h"]), sink=rows.append)
-
-    def cat(name):
-        if isinstance(rows[0][name], tuple):
-            return tuple(np.concatenate([r[name][q] for r in rows]) for q in (0, 1))
-        return np.concatenate([r[name] for r in rows])
-
-    t, R, V, A = cat("t"), cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+    blocks = []
+    propagate(load_scenario("tianqin-kepler", ["run.duration=2h"]), sink=blocks.append)
+    rows = Rows.concatenate(blocks)
+    t, R, V, A = rows.t, rows.sat_r, rows.sat_v, rows.sat_a_gravity
     res = LP.light_travel_times(t, R, V, A)
     assert res.source == "sat" and np.nanmax(np.abs(res.residual)) < 1e-20
     k, ln, m = 72, Link.L12, 72  # t_k = 3600 s; emitter = satellite 2

@@ -18,7 +18,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.dynamics import propagate as propagator
+from tqdyn import dynamics
 from tqdyn.forces.earth import EarthField, degree2_accel_ext, earth_field_accel
 from tqdyn.forces.third_body import third_body_accel_ext
 from tqdyn.numerics.dd import mp_from_dd
@@ -74,7 +74,7 @@ def test_third_body_dd_vs_mpmath(gm, s):
 def _final(overrides):
     scen = load_scenario("tianqin", ["run.duration=1d", "constellation.pointing=none", "constellation.control=off"]
                          + overrides)
-    return mp_from_dd(propagator.propagate(scen).y_final[:, 0:3])
+    return mp_from_dd(dynamics.propagate(scen).y_final[:, 0:3])
 
 
 def _dist(a, b) -> float:

@@ -26,19 +26,14 @@ from tqdyn.numerics.dd import mp_from_pair
 def _raw(scenario):
     """1-day pure-gravity trajectory of a built-in scenario on its 50 s grid:
     t, R, V as (hi, lo) pairs and A (float64)."""
-    from tqdyn.dynamics import propagate as propagator
+    from tqdyn import dynamics
     from tqdyn.scenario import load_scenario
 
-    rows = []
-    propagator.propagate(load_scenario(scenario, ["run.duration=1d", "constellation.pointing=none",
-                                                  "constellation.control=off"]), sink=rows.append)
-
-    def cat(k):
-        if isinstance(rows[0][k], tuple):
-            return tuple(np.concatenate([r[k][q] for r in rows]) for q in (0, 1))
-        return np.concatenate([r[k] for r in rows])
-
-    return cat("t"), cat("sat/r"), cat("sat/v"), cat("sat/a_gravity")
+    blocks = []
+    dynamics.propagate(load_scenario(scenario, ["run.duration=1d", "constellation.pointing=none",
+                                                  "constellation.control=off"]), sink=blocks.append)
+    rows = dynamics.Rows.concatenate(blocks)
+    return rows.t, rows.sat_r, rows.sat_v, rows.sat_a_gravity
 
 
 def _load(raw):

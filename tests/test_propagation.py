@@ -29,7 +29,7 @@ from mpmath import mpf
 
 from tqdyn.astro import elements as el
 from tqdyn.numerics import dd as P
-from tqdyn.dynamics import propagate as prop
+from tqdyn import dynamics as prop
 from tqdyn import scenario as sc
 from tqdyn.forces.model import build_force_model
 from tqdyn.numerics import dp87
@@ -108,22 +108,18 @@ class RowCollector:
         self.chunks = []
 
     def __call__(self, rows):
-        m = rows["t"][0].shape[0]
-        n_sat = rows["sat/r"][0].shape[1]
-        for key in ("sat/r", "sat/v"):
-            for part in rows[key]:
+        m = len(rows)
+        n_sat = rows.sat_r[0].shape[1]
+        for key in ("sat_r", "sat_v"):
+            for part in getattr(rows, key):
                 assert part.shape == (m, n_sat, 3), (key, part.shape)
-        assert rows["sat/a_gravity"].shape == (m, n_sat, 3)
+        assert rows.sat_a_gravity.shape == (m, n_sat, 3)
         self.chunks.append(rows)
 
     def arrays(self):
         """t (N, 2) dd [s]; r, v (N, n_sat, 3, 2) dd [m, m/s]; a (N, n_sat, 3) float64 [m/s^2]."""
-        cat = lambda key, part: np.concatenate([c[key][part] for c in self.chunks])  # noqa: E731
-        t = P.join_dd(cat("t", 0), cat("t", 1))
-        r = P.join_dd(cat("sat/r", 0), cat("sat/r", 1))
-        v = P.join_dd(cat("sat/v", 0), cat("sat/v", 1))
-        a = np.concatenate([c["sat/a_gravity"] for c in self.chunks])
-        return t, r, v, a
+        rows = prop.Rows.concatenate(self.chunks)
+        return P.join_dd(*rows.t), P.join_dd(*rows.sat_r), P.join_dd(*rows.sat_v), rows.sat_a_gravity
 
 
 def rows_max_error(t, r, sat, b: int = 0) -> tuple[float, float]:

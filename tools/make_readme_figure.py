@@ -16,7 +16,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mpmath  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tqdyn import elements, propagator  # noqa: E402
+from tqdyn import dynamics  # noqa: E402
+from tqdyn.astro import elements  # noqa: E402
 from tqdyn.scenario import load_scenario  # noqa: E402
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "docs" / "figures" / "kepler-error.png"
@@ -24,11 +25,11 @@ EVERY = 864  # one output row every 12 h
 
 
 def errors(scen, precision):
-    rows = []
-    propagator.propagate(scen, precision=precision, sink=rows.append)
-    t = np.concatenate([r["t"][0] + r["t"][1] for r in rows])
-    r_hi = np.concatenate([r["sat/r"][0] for r in rows])
-    r_lo = np.concatenate([r["sat/r"][1] for r in rows])
+    blocks = []
+    dynamics.propagate(scen, precision=precision, sink=blocks.append)
+    rows = dynamics.Rows.concatenate(blocks)
+    t = rows.t[0] + rows.t[1]
+    r_hi, r_lo = rows.sat_r
     err = np.zeros((t.size, len(scen.satellites)))
     with mpmath.workdps(50):
         for k in range(t.size):

@@ -66,14 +66,14 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     from tqdm import tqdm
 
     from ..formats import trajectory as io
-    from ..dynamics import propagate as propagator
+    from .. import dynamics
     from ..workflows import run as runner
     from ..scenario import ScenarioError, load_scenario
 
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
         io.check_writable(scen.run.output)
-        model = propagator.check_inputs(scen)
+        model = dynamics.check_inputs(scen)
     except (ScenarioError, io.OutputError, ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
     integ = scen.integrator
@@ -140,7 +140,7 @@ def forces(scenario, duration, every, plot_path, sets):
     RMS of |a| of each force term [m/s^2]."""
     from decimal import Decimal, InvalidOperation
 
-    from ..dynamics import propagate as propagator
+    from .. import dynamics
     from ..analysis.budget import force_budget
     from ..forces import atmospheric_tides
     from ..scenario import ScenarioError, load_scenario
@@ -155,18 +155,16 @@ def forces(scenario, duration, every, plot_path, sets):
         if ratio <= 0 or ratio != ratio.to_integral_value():
             raise ValueError(f"--every: {every} s is not a positive multiple of the step {scen.integrator.step_s} s")
         scen = load_scenario(scenario, _overrides(sets, duration, None, None, None) + [f"run.output_every={int(ratio)}"])
-        model = propagator.check_inputs(scen)
+        model = dynamics.check_inputs(scen)
     except (ScenarioError, ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
-    import numpy as np
-
-    rows = []
+    blocks = []
     click.echo(f"propagating {scen.name!r} for {scen.run.duration_s} s and sampling every {every} s ...", err=True)
-    propagator.propagate(scen, sink=rows.append, model=model)
-    t_hi = np.concatenate([r["t"][0] for r in rows])
-    t_lo = np.concatenate([r["t"][1] for r in rows])
-    r = np.concatenate([r["sat/r"][0] + r["sat/r"][1] for r in rows])
-    v = np.concatenate([r["sat/v"][0] + r["sat/v"][1] for r in rows])
+    dynamics.propagate(scen, sink=blocks.append, model=model)
+    rows = dynamics.Rows.concatenate(blocks)
+    t_hi, t_lo = rows.t
+    r = rows.sat_r[0] + rows.sat_r[1]
+    v = rows.sat_v[0] + rows.sat_v[1]
     budget = force_budget(model, Epoch.from_utc(scen.epoch_utc), t_hi, t_lo, r, v)
     lines = [f"force budget along {scen.name!r} ({len(scen.satellites)} satellites, {t_hi.size} samples over "
              f"{float(scen.run.duration_s) / 86400:g} days), |a| in m/s^2:",

@@ -18,12 +18,10 @@ import math
 
 from numba import njit
 
+from ..numerics.vec3 import cross
+from .indices import MOSA_SIGN
+
 __all__ = ["housing_geometry", "satellite_control"]
-
-
-@njit(cache=True, inline="always")
-def _cross(ax, ay, az, bx, by, bz):
-    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
 @njit(cache=True)
@@ -41,7 +39,7 @@ def housing_geometry(i, theta, theta_dot, d_p, r0_nom, theta_nom, w, r0, rho, ve
     not sliced, so the hot path creates no array views.)
     """
     for l in range(2):
-        s = 1.0 if l == 0 else -1.0
+        s = MOSA_SIGN[l]
         ang_nom = s * 0.5 * theta_nom
         ang = s * 0.5 * theta
         rx, ry = d_p * math.cos(ang), d_p * math.sin(ang)
@@ -49,7 +47,7 @@ def housing_geometry(i, theta, theta_dot, d_p, r0_nom, theta_nom, w, r0, rho, ve
         r0[i, l, 0] = r0_nom[l, 0] - d_p * math.cos(ang_nom) + rx
         r0[i, l, 1] = r0_nom[l, 1] - d_p * math.sin(ang_nom) + ry
         r0[i, l, 2] = r0_nom[l, 2]
-        cx, cy, cz = _cross(w[i, 0], w[i, 1], w[i, 2], r0[i, l, 0], r0[i, l, 1], r0[i, l, 2])
+        cx, cy, cz = cross((w[i, 0], w[i, 1], w[i, 2]), (r0[i, l, 0], r0[i, l, 1], r0[i, l, 2]))
         wm = s * 0.5 * theta_dot
         vel[i, l, 0] = cx - wm * ry
         vel[i, l, 1] = cy + wm * rx
@@ -71,7 +69,7 @@ def satellite_control(i, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rh
     gravity-gradient torque).
     """
     for l in range(2):
-        s = 1.0 if l == 0 else -1.0
+        s = MOSA_SIGN[l]
         wm = s * 0.5 * theta_dot
         wmd = s * 0.5 * theta_ddot
         px, py = rho[i, l, 0], rho[i, l, 1]
@@ -80,10 +78,10 @@ def satellite_control(i, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rh
         mx, my = -wm * py, wm * px
         mmx, mmy = -wm * my, wm * mx
         mdx, mdy = -wmd * py, wmd * px
-        c1 = _cross(w[i, 0], w[i, 1], w[i, 2], mx, my, 0.0)
-        wr = _cross(w[i, 0], w[i, 1], w[i, 2], qx, qy, qz)
-        c2 = _cross(w[i, 0], w[i, 1], w[i, 2], wr[0], wr[1], wr[2])
-        c3 = _cross(wd[i, 0], wd[i, 1], wd[i, 2], qx, qy, qz)
+        c1 = cross((w[i, 0], w[i, 1], w[i, 2]), (mx, my, 0.0))
+        wr = cross((w[i, 0], w[i, 1], w[i, 2]), (qx, qy, qz))
+        c2 = cross((w[i, 0], w[i, 1], w[i, 2]), wr)
+        c3 = cross((wd[i, 0], wd[i, 1], wd[i, 2]), (qx, qy, qz))
         g[i, l, 0] = dg_S[i, l, 0] + sg_S[i, l, 0] - 2.0 * c1[0] - mdx - mmx - c2[0] - c3[0]
         g[i, l, 1] = dg_S[i, l, 1] + sg_S[i, l, 1] - 2.0 * c1[1] - mdy - mmy - c2[1] - c3[1]
         g[i, l, 2] = dg_S[i, l, 2] + sg_S[i, l, 2] - 2.0 * c1[2] - c2[2] - c3[2]
@@ -102,7 +100,7 @@ def satellite_control(i, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rh
     G_S[i, 2] = 0.5 * (g[i, 0, 2] + g[i, 1, 2])
     # TM angular acceleration: T_OA_S (w' + w_oa' + w x w_oa)
     for l in range(2):
-        s = 1.0 if l == 0 else -1.0
+        s = MOSA_SIGN[l]
         wm = s * 0.5 * theta_dot
         ax = wd[i, 0] + w[i, 1] * wm
         ay = wd[i, 1] - w[i, 0] * wm

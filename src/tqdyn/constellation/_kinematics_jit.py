@@ -90,7 +90,7 @@ Arm vectors are formed from the double-double positions as
 Jerk and snap
 -------------
 For the Taylor and iterative laws, the remote satellite's jerk and snap come
-from the monopole formula (as :func:`.attitude.central_jerk_snap`, with the
+from the monopole formula (:mod:`tqdyn.forces.central`, with the
 *given* total acceleration a in the snap), the jerk plus ``jerk_pert``::
 
     J = -gm [v/r^3 - 3 (r.v) r/r^5]
@@ -119,6 +119,9 @@ from math import atan2, sqrt
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..numerics.vec3 import add as _add, axpy as _axpy, cross as _cross, dot as _dot
+from ..numerics.vec3 import row as _row, scale as _scale, sub as _sub
+from ..forces.central import monopole_jerk_snap as _monopole_jerk_snap
 
 __all__ = [
     "LAW_CODES",
@@ -153,44 +156,6 @@ def law_code(name: str) -> int:
         raise ValueError(f"pointing law {name!r} is not allowed; allowed: {', '.join(LAW_CODES)}") from None
 
 
-# ------------------------------------------------------------------ 3-vector helpers (tuples)
-
-@njit(cache=True)
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-@njit(cache=True)
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-@njit(cache=True)
-def _scale(s, a):
-    return (s * a[0], s * a[1], s * a[2])
-
-
-@njit(cache=True)
-def _axpy(s, a, b):
-    """s * a + b."""
-    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
-
-
-@njit(cache=True)
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-@njit(cache=True)
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-@njit(cache=True)
-def _row(x, m):
-    return (x[m, 0], x[m, 1], x[m, 2])
-
-
 # ------------------------------------------------------------------ jets
 
 @njit(cache=True)
@@ -214,21 +179,6 @@ def _cross_jet(a0, a1, a2, b0, b1, b2):
     c1 = _add(_cross(a1, b0), _cross(a0, b1))
     c2 = _add(_add(_cross(a2, b0), _scale(2.0, _cross(a1, b1))), _cross(a0, b2))
     return c0, c1, c2
-
-
-@njit(cache=True)
-def _monopole_jerk_snap(r, v, a, gm):
-    """Jerk [m/s^3] and snap [m/s^4] of -gm r/|r|^3 (snap with the given a)."""
-    r2 = _dot(r, r)
-    rn = sqrt(r2)
-    ir3 = 1.0 / (r2 * rn)
-    ir5 = ir3 / r2
-    ir7 = ir5 / r2
-    rv = _dot(r, v)
-    jerk = _scale(-gm, _axpy(-3.0 * rv * ir5, r, _scale(ir3, v)))
-    cr = -3.0 * (_dot(v, v) + _dot(r, a)) * ir5 + 15.0 * rv * rv * ir7
-    snap = _scale(-gm, _axpy(cr, r, _axpy(-6.0 * rv * ir5, v, _scale(ir3, a))))
-    return jerk, snap
 
 
 # ------------------------------------------------------------------ beams

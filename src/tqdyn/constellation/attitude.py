@@ -36,7 +36,7 @@ omega_dot their second derivatives: for the global law the velocities and
 accelerations of the three satellites (no jerk); for the Taylor laws the beam
 contains -v_j/c, so omega_dot needs the remote satellite's *jerk* (and taylor2
 its snap, whose contribution is <= |a| L n^2 / (2 c^2) ~ 2e-20 rad/s^2; it is
-optional).  :func:`central_jerk_snap` gives the monopole jerk/snap; the
+optional).  :func:`tqdyn.forces.central.central_jerk_snap` gives the monopole jerk/snap; the
 perturbations (< 1e-5 m/s^2) change the jerk by < 1e-5 n ~ 2e-10 m/s^3, i.e.
 omega_dot by < 1e-18 rad/s^2 through the 1/c factor.
 
@@ -100,7 +100,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..astro.constants import C_LIGHT
-from .indices import Mosa, Sat
+from .indices import MOSA_SIGN, PARTNERS, Mosa, Sat
 
 __all__ = [
     "LAWS",
@@ -108,7 +108,6 @@ __all__ = [
     "Attitude",
     "attitude",
     "beam_vectors",
-    "central_jerk_snap",
     "T_OA_S_of",
     "Sat",
     "Mosa",
@@ -119,9 +118,9 @@ LAWS = ("global", "taylor1", "taylor2")
 #: Methods for omega / omega_dot understood by :func:`attitude`.
 METHODS = ("direct", "p-frame")
 
-_I = np.array([0, 1, 2])
-_J = np.array([1, 2, 0])
-_K = np.array([2, 0, 1])
+_I = np.arange(3)
+_J = PARTNERS[:, 0]   # j of the even permutation (i, j, k)
+_K = PARTNERS[:, 1]   # k
 
 
 # --------------------------------------------------------------------------
@@ -223,44 +222,6 @@ def _scale_jet(s, a):
 
 # --------------------------------------------------------------------------
 # public helpers
-
-
-def central_jerk_snap(r, v, gm, a=None):
-    """Jerk and snap of the point-mass (monopole) acceleration a = -gm r / |r|^3.
-
-    Parameters
-    ----------
-    r : (..., 3) m, v : (..., 3) m/s -- geocentric GCRS state (float64 or a
-        (hi, lo) pair); gm : float, m^3/s^2.
-    a : (..., 3) m/s^2, optional -- the actual acceleration to use in the snap
-        (default: the monopole's); the snap is linear in it.
-
-    Returns
-    -------
-    jerk (..., 3) m/s^3 and snap (..., 3) m/s^4, GCRS, same epochs (TDB)::
-
-        j = -gm [v/r^3 - 3 (r.v) r/r^5]
-        s = -gm [a/r^3 - 6 (r.v) v/r^5 - 3 (v.v + r.a) r/r^5 + 15 (r.v)^2 r/r^7]
-    """
-    r = _pick_plain(r)
-    v = _pick_plain(v)
-    gm = float(gm)
-    rn = np.sqrt(_dot(r, r))[..., None]
-    rv = _dot(r, v)[..., None]
-    if a is None:
-        a = -gm * r / rn**3
-    else:
-        a = _pick_plain(a)
-    jerk = -gm * (v / rn**3 - 3.0 * rv * r / rn**5)
-    vv = _dot(v, v)[..., None]
-    ra = _dot(r, a)[..., None]
-    snap = -gm * (a / rn**3 - 6.0 * rv * v / rn**5 - 3.0 * (vv + ra) * r / rn**5 + 15.0 * rv**2 * r / rn**7)
-    return jerk, snap
-
-
-def _pick_plain(x):
-    hi, lo = _as_f64_parts(x)
-    return hi if lo is None else hi + lo
 
 
 def _arm_jet(r, v, a, idx_to):
@@ -486,7 +447,7 @@ def attitude(r, v=None, a=None, *, law="global", method="direct", jerk=None, sna
     method : "direct" (Poisson relation, analytic frame derivatives; all laws)
         or "p-frame" (the appendix method; global law only).
     jerk : (..., 3, 3) m/s^3, GCRS, optional -- d a / dt of each satellite; needed
-        for omega_dot under the Taylor laws (see :func:`central_jerk_snap`).
+        for omega_dot under the Taylor laws (see :func:`tqdyn.forces.central.central_jerk_snap`).
     snap : (..., 3, 3) m/s^4, optional -- taylor2 only, zero if None.
     c : m/s.
 
@@ -512,8 +473,7 @@ def attitude(r, v=None, a=None, *, law="global", method="direct", jerk=None, sna
             raise ValueError("method 'p-frame' needs velocities and accelerations")
         omega, omega_dot, T_S_I = _p_frame_omega(r, v, a, Z)
 
-    sign = np.array([1.0, -1.0])   # OA_1: +theta/2 (faces k), OA_2: -theta/2 (faces j)
-    half = lambda x: None if x is None else 0.5 * x[..., None] * sign  # noqa: E731
+    half = lambda x: None if x is None else 0.5 * x[..., None] * MOSA_SIGN  # noqa: E731  (OA_1 +theta/2, OA_2 -theta/2)
     phi, phi1, phi2 = half(th[0]), half(th[1]), half(th[2])
     T_OA_S = T_OA_S_of(phi)
     omega_oa = omega_dot_oa = None

@@ -72,6 +72,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .attitude import T_OA_S_of
+from .indices import MOSA_SIGN
 from .spacecraft import Spacecraft
 
 __all__ = [
@@ -102,7 +103,7 @@ def oa_rotation(theta) -> np.ndarray:
     X_S rotated by +theta/2 about Z_S, OA_2 by -theta/2.
     """
     half = 0.5 * np.asarray(theta, dtype=np.float64)
-    return T_OA_S_of(np.stack([half, -half], axis=-1))
+    return T_OA_S_of(half[..., None] * MOSA_SIGN)
 
 
 def mosa_angular_rates(alpha_dot, alpha_ddot) -> tuple[np.ndarray, np.ndarray]:
@@ -115,11 +116,10 @@ def mosa_angular_rates(alpha_dot, alpha_ddot) -> tuple[np.ndarray, np.ndarray]:
     """
     ad = np.asarray(alpha_dot, dtype=np.float64)
     add = np.asarray(alpha_ddot, dtype=np.float64)
-    sign = np.array([1.0, -1.0])
     w = np.zeros(np.broadcast_shapes(ad.shape, add.shape) + (2, 3))
     wd = np.zeros_like(w)
-    w[..., 2] = 0.5 * ad[..., None] * sign
-    wd[..., 2] = 0.5 * add[..., None] * sign
+    w[..., 2] = 0.5 * ad[..., None] * MOSA_SIGN
+    wd[..., 2] = 0.5 * add[..., None] * MOSA_SIGN
     return w, wd
 
 

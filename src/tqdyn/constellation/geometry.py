@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .indices import LINK_OF_MOSA, LINKS, SATS, Link
+from .indices import LINK_EMITTER, LINK_IJ, LINK_IK, LINK_OF_MOSA, LINK_RECEIVER
 
 __all__ = [
     "Arms",
@@ -57,11 +57,9 @@ __all__ = [
     "link_pairs",
 ]
 
-_RECV = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
-_EMIT = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
+_RECV, _EMIT = LINK_RECEIVER, LINK_EMITTER
 # per satellite i: link index of (i -> j) and (i -> k)
-_IJ = np.array([Link(10 * int(s) + int(s.j)).index for s in SATS], dtype=np.intp)
-_IK = np.array([Link(10 * int(s) + int(s.k)).index for s in SATS], dtype=np.intp)
+_IJ, _IK = LINK_IJ, LINK_IK
 
 
 def link_pairs() -> tuple[np.ndarray, np.ndarray]:

@@ -10,6 +10,11 @@ which brings it onto n_ik: it faces satellite k; MOSA 2 is X_S rotated by
 -theta/2 and faces satellite j (theta = angle between the two beams).
 ``tests/test_pointing.py`` checks this rotation sense numerically.
 
+The tables at the end of this module are the single source of these
+conventions for array code: numpy modules index with them and the compiled
+kernels read them as constants (numba freezes global arrays at compile time),
+so a sign or an order is written once.
+
 Links are the six one-way laser links in the LISA order 12, 23, 31, 13, 32,
 21; link ``ab`` is received on satellite a (receiver) and emitted by
 satellite b (emitter).  Array layouts used by :mod:`tqdyn.constellation`:
@@ -26,10 +31,19 @@ from enum import IntEnum
 import numpy as np
 
 __all__ = [
+    "EMITTER_OF_MOSA",
     "LINKS",
+    "LINK_EMITTER",
+    "LINK_EMITTER_MOSA",
+    "LINK_IJ",
+    "LINK_IK",
     "LINK_OF_MOSA",
+    "LINK_RECEIVER",
+    "LINK_RECEIVER_MOSA",
     "MOSAS",
     "MOSA_OF_LINK",
+    "MOSA_SIGN",
+    "PARTNERS",
     "SATS",
     "Link",
     "Mosa",
@@ -174,3 +188,27 @@ LINKS: tuple[Link, ...] = tuple(Link)
 LINK_OF_MOSA = np.array([[m.link(s).index for m in MOSAS] for s in SATS], dtype=np.intp)
 #: (6, 2) int array: MOSA_OF_LINK[link.index] = (satellite index, MOSA index) receiving it.
 MOSA_OF_LINK = np.array([[ln.receiver.index, ln.mosa.index] for ln in LINKS], dtype=np.intp)
+
+#: (2,) float64: rotation sense of X_OA_l from X_S about Z_S, MOSA_SIGN[l-1] =
+#: ``Mosa.sign``: the MOSA angle of OA_l is MOSA_SIGN[l-1] * theta / 2, its rates
+#: MOSA_SIGN[l-1] * theta_dot / 2 and MOSA_SIGN[l-1] * theta_ddot / 2.
+MOSA_SIGN = np.array([float(m.sign) for m in MOSAS])
+#: (3, 2) int array: PARTNERS[i-1] = 0-based indices of (j, k), the even permutation of satellite i.
+PARTNERS = np.array([[s.j.index, s.k.index] for s in SATS], dtype=np.intp)
+#: (3, 2) int array: EMITTER_OF_MOSA[i-1, l-1] = 0-based index of the satellite MOSA l of satellite i faces.
+EMITTER_OF_MOSA = np.array([[m.remote(s).index for m in MOSAS] for s in SATS], dtype=np.intp)
+#: (6,) int arrays over the links (LISA order): 0-based receiver / emitter satellite indices.
+LINK_RECEIVER = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
+LINK_EMITTER = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
+#: (6,) int arrays over the links: 0-based MOSA of the receiver that faces the emitter, and of the
+#: emitter that faces the receiver (the TMs at the two ends of the link).
+LINK_RECEIVER_MOSA = np.array([ln.receiver.mosa_facing(ln.emitter).index for ln in LINKS], dtype=np.intp)
+LINK_EMITTER_MOSA = np.array([ln.emitter.mosa_facing(ln.receiver).index for ln in LINKS], dtype=np.intp)
+#: (3,) int arrays: link index of i -> j and i -> k for each satellite i (links 12, 23, 31 and 13, 21, 32).
+LINK_IJ = np.array([Link(10 * int(s) + int(s.j)).index for s in SATS], dtype=np.intp)
+LINK_IK = np.array([Link(10 * int(s) + int(s.k)).index for s in SATS], dtype=np.intp)
+
+for _table in (LINK_OF_MOSA, MOSA_OF_LINK, MOSA_SIGN, PARTNERS, EMITTER_OF_MOSA, LINK_RECEIVER, LINK_EMITTER,
+               LINK_RECEIVER_MOSA, LINK_EMITTER_MOSA, LINK_IJ, LINK_IK):
+    _table.setflags(write=False)
+del _table

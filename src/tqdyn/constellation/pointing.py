@@ -44,7 +44,7 @@ import numpy as np
 from ..astro.constants import C_LIGHT
 from ..numerics.dd import np_dd_add, np_dd_div_d, np_dd_sqr, np_dd_sqrt
 from .geometry import _f64, _split_positions, arms, by_mosa
-from .indices import LINK_OF_MOSA, LINKS
+from .indices import EMITTER_OF_MOSA
 
 __all__ = [
     "LAWS",
@@ -59,8 +59,7 @@ __all__ = [
 LAWS = ("global", "taylor1", "taylor2", "iterative")
 
 # per (sat, mosa): 0-based index of the emitter (MOSA 1 <- k, MOSA 2 <- j)
-_EMITTER = np.array([[LINKS[LINK_OF_MOSA[s, m]].emitter.index for m in range(2)] for s in range(3)],
-                    dtype=np.intp)
+_EMITTER = EMITTER_OF_MOSA
 _RECEIVER = np.array([[s, s] for s in range(3)], dtype=np.intp)
 
 

@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .indices import MOSA_SIGN
+
 __all__ = [
     "TABLE_IV_SELF_GRAVITY",
     "Spacecraft",
@@ -170,7 +172,7 @@ class Spacecraft:
         d = 0.5 * (theta - self.theta_nominal)
         h = 0.5 * self.theta_nominal
         out = np.zeros(theta.shape + (2, 3))
-        for l, s in ((0, 1.0), (1, -1.0)):
+        for l, s in enumerate(MOSA_SIGN):
             ang = s * (h + d)
             out[..., l, 0] = self.d_p * np.cos(ang)
             out[..., l, 1] = self.d_p * np.sin(ang)

@@ -57,105 +57,17 @@ from numba import njit
 
 from ..constellation._control_jit import housing_geometry, satellite_control
 from ..constellation._kinematics_jit import sat_kinematics
-from ..forces.model import gravity
+from ..constellation.indices import MOSA_SIGN
+from ..forces.earth import j2_jerk_gcrs_z
+from ..forces.model import ForceModel, gravity
+from ..forces.third_body import third_body_jerk
 from ..numerics.dd import add, ld, lo_part, st, sub, to_f64
+from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX_TMLEN, AX_W, AX_WD, CP_CONTROL,
+                     CP_C, CP_DP, CP_GM, CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_LAW, CP_MODE, CP_R0, CP_SG_OA, CP_SG_S,
+                     CP_TD, CP_THNOM, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
+                     TM_SUSP, TM_VHI, TM_VLO, make_cpar, workspace)
 
-__all__ = ["system_rhs", "point_masses", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
-           "make_cpar", "aux_views", "workspace"]
-
-MODE_POINT_MASS = 0
-MODE_COUPLED = 1
-MODE_FREE_TM = 2
-
-# cpar layout (float64)
-CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
-CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
-CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
-CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
-CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_TD = 40, 41, 42, 43   # jerk model (see _jerk_perturbation)
-CP_LEN = 44
-#: time-only inputs of the coupled system, appended to the force model's:
-#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
-SYSTEM_TDAT_BODIES = ("moon", "sun")
-N_SYSTEM_TDAT = 12
-
-# aux layout per satellite (float64), AX_SAT values each
-AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
-AX_TM = 23         # then per TM l: AX_TM + l * AX_TMLEN
-TM_RHI, TM_RLO, TM_VHI, TM_VLO, TM_A, TM_SUSP, TM_ALPHA, TM_OFF = 0, 3, 6, 9, 12, 15, 18, 21
-AX_TMLEN = 24
-AX_SAT = AX_TM + 2 * AX_TMLEN
-AUX_LEN = 3 * AX_SAT
-
-# float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
-_FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
-              ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
-              ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
-              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
-
-
-def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
-              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1) -> np.ndarray:
-    """Pack the constellation parameters for :func:`system_rhs`.
-
-    mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
-    control : apply G_i to the orbits; gm : Earth GM [m^3/s^2] (jerk/snap of
-    the remote satellite in the local pointing laws); c : m/s; d_p : pivot
-    distance [m]; theta_nom : nominal MOSA angle [rad]; r0_nom : (2, 3) EH
-    centers in S [m]; sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2];
-    sg_s : (3, 3) common self-gravity in S [m/s^2].
-    gm_moon, gm_sun : [m^3/s^2], j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth:
-    the jerk model of the local pointing laws (0 = term absent);
-    tdat_offset : column of the system's time-only inputs (Moon, Sun states,
-    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none.
-    """
-    p = np.zeros(CP_LEN)
-    p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
-    p[CP_GM], p[CP_C], p[CP_DP], p[CP_THNOM] = gm, c, d_p, theta_nom
-    if r0_nom is not None:
-        p[CP_R0:CP_R0 + 6] = np.asarray(r0_nom, np.float64).ravel()
-    if sg_oa is not None:
-        p[CP_SG_OA:CP_SG_OA + 18] = np.asarray(sg_oa, np.float64).ravel()
-    if sg_s is not None:
-        p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
-    p[CP_GM_MOON], p[CP_GM_SUN], p[CP_J2K], p[CP_TD] = gm_moon, gm_sun, j2k, tdat_offset
-    return p
-
-
-def workspace(y: np.ndarray):
-    """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
-    (15, 3[, 2]) accelerations in the working precision, fw a tuple of
-    float64 arrays, aux (AUX_LEN,)."""
-    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
-            np.zeros(AUX_LEN))
-
-
-def aux_views(aux: np.ndarray) -> dict:
-    """Named views of aux rows (..., AUX_LEN) -> arrays with (..., 3[, 2], k) shapes (float64).
-
-    Keys: T_S_I (..., 3, 3, 3); omega, omega_dot (..., 3, 3) [S];
-    breathing_angle, theta (..., 3); a_dragfree, a_gravity (..., 3, 3) [GCRS];
-    tm_r_hi, tm_r_lo, tm_v_hi, tm_v_lo, tm_a (..., 3, 2, 3) [GCRS];
-    tm_a_suspension, tm_alpha_suspension (..., 3, 2, 3) [OA_l];
-    tm_housing_offset (..., 3, 2, 3) [GCRS, m].
-    """
-    a = np.asarray(aux)
-    s = a.reshape(a.shape[:-1] + (3, AX_SAT))
-    tm = s[..., AX_TM:].reshape(a.shape[:-1] + (3, 2, AX_TMLEN))
-
-    def v(x, lo, n):
-        return x[..., lo:lo + n]
-
-    return {
-        "T_S_I": v(s, AX_T, 9).reshape(a.shape[:-1] + (3, 3, 3)),
-        "omega": v(s, AX_W, 3), "omega_dot": v(s, AX_WD, 3),
-        "breathing_angle": s[..., AX_ALPHA], "theta": s[..., AX_THETA],
-        "a_dragfree": v(s, AX_G, 3), "a_gravity": v(s, AX_AGRAV, 3),
-        "tm_r_hi": v(tm, TM_RHI, 3), "tm_r_lo": v(tm, TM_RLO, 3),
-        "tm_v_hi": v(tm, TM_VHI, 3), "tm_v_lo": v(tm, TM_VLO, 3), "tm_a": v(tm, TM_A, 3),
-        "tm_a_suspension": v(tm, TM_SUSP, 3), "tm_alpha_suspension": v(tm, TM_ALPHA, 3),
-        "tm_housing_offset": v(tm, TM_OFF, 3),
-    }
+__all__ = ["system_rhs", "point_masses", "evaluate_rhs"]
 
 
 @njit(cache=True)
@@ -194,22 +106,6 @@ def _breathing_angle(r_hi, r_lo, i):
     return np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), a0 * b0 + a1 * b1 + a2 * b2)
 
 
-@njit(cache=True, inline="always")
-def _tidal_jerk(gm, rx, ry, rz, vx, vy, vz, sx, sy, sz, ux, uy, uz):
-    """d/dt of gm [(s - r)/|s - r|^3 - s/|s|^3] for a body at s moving with u."""
-    dx, dy, dz = sx - rx, sy - ry, sz - rz
-    ex, ey, ez = ux - vx, uy - vy, uz - vz
-    d2 = dx * dx + dy * dy + dz * dz
-    id3 = 1.0 / (d2 * np.sqrt(d2))
-    q = 3.0 * (dx * ex + dy * ey + dz * ez) / d2
-    s2 = sx * sx + sy * sy + sz * sz
-    is3 = 1.0 / (s2 * np.sqrt(s2))
-    p = 3.0 * (sx * ux + sy * uy + sz * uz) / s2
-    return (gm * ((ex - q * dx) * id3 - (ux - p * sx) * is3),
-            gm * ((ey - q * dy) * id3 - (uy - p * sy) * is3),
-            gm * ((ez - q * dz) * id3 - (uz - p * sz) * is3))
-
-
 @njit(cache=True)
 def _jerk_perturbation(cpar, tdat, fw):
     """Jerk of each satellite beyond the Earth monopole [m/s^3, GCRS] into fw[19].
@@ -237,20 +133,14 @@ def _jerk_perturbation(cpar, tdat, fw):
             for b, gm in ((0, cpar[CP_GM_MOON]), (1, cpar[CP_GM_SUN])):
                 if gm != 0.0:
                     c = o + 6 * b
-                    tx, ty, tz = _tidal_jerk(gm, rx, ry, rz, vx, vy, vz, tdat[c], tdat[c + 1], tdat[c + 2],
-                                             tdat[c + 3], tdat[c + 4], tdat[c + 5])
+                    tx, ty, tz = third_body_jerk(gm, rx, ry, rz, vx, vy, vz, tdat[c], tdat[c + 1], tdat[c + 2],
+                                                 tdat[c + 3], tdat[c + 4], tdat[c + 5])
                     jx, jy, jz = jx + tx, jy + ty, jz + tz
         if k != 0.0:
-            # a = -k / r^5 [(1 - 5 q) x, (1 - 5 q) y, (3 - 5 q) z], q = z^2 / r^2
-            r2 = rx * rx + ry * ry + rz * rz
-            f = -k / (r2 * r2 * np.sqrt(r2))
-            rv = rx * vx + ry * vy + rz * vz
-            fd = -5.0 * f * rv / r2
-            q = rz * rz / r2
-            qd = 2.0 * rz * vz / r2 - 2.0 * q * rv / r2
-            jx += fd * (1.0 - 5.0 * q) * rx + f * (-5.0 * qd * rx + (1.0 - 5.0 * q) * vx)
-            jy += fd * (1.0 - 5.0 * q) * ry + f * (-5.0 * qd * ry + (1.0 - 5.0 * q) * vy)
-            jz += fd * (3.0 - 5.0 * q) * rz + f * (-5.0 * qd * rz + (3.0 - 5.0 * q) * vz)
+            tx, ty, tz = j2_jerk_gcrs_z(k, rx, ry, rz, vx, vy, vz)
+            jx += tx
+            jy += ty
+            jz += tz
         jp[i, 0], jp[i, 1], jp[i, 2] = jx, jy, jz
 
 
@@ -274,7 +164,7 @@ def _control_laws(cpar, fw):
     for i in range(3):
         h = 0.5 * th[i, 0]
         for l in range(2):
-            s = 1.0 if l == 0 else -1.0
+            s = MOSA_SIGN[l]
             c, sp = np.cos(s * h), np.sin(s * h)
             o = CP_SG_OA + 6 * i + 3 * l
             sx, sy, sz = cpar[o], cpar[o + 1], cpar[o + 2]
@@ -292,7 +182,7 @@ def _control_laws(cpar, fw):
 @njit(cache=True)
 def _oa_to_inertial(T, i, theta, l, x, y, z):
     """OA_l vector of satellite i -> GCRS (T_I_S T_S_OA); T: (3, 3, 3)."""
-    s = 1.0 if l == 0 else -1.0
+    s = MOSA_SIGN[l]
     c, sp = np.cos(s * 0.5 * theta), np.sin(s * 0.5 * theta)
     ux, uy, uz = c * x - sp * y, sp * x + c * y, z
     return (T[i, 0, 0] * ux + T[i, 1, 0] * uy + T[i, 2, 0] * uz,
@@ -419,3 +309,23 @@ def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
         point_masses(y, tdat, params, layout, k)
     else:
         _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw)
+
+
+def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: np.ndarray | None = None,
+                 with_aux: bool = False):
+    """dy/dt at one instant, same layout and precision as ``y``.
+
+    cpar: the system's parameters (:attr:`System.cpar`; default: point
+    masses).  With ``with_aux`` returns (k, aux), aux the (AUX_LEN,)
+    diagnostics of the coupled modes (see :func:`tqdyn.dynamics.aux_views`).
+    """
+    k = np.zeros_like(y)
+    cpar = make_cpar(MODE_POINT_MASS) if cpar is None else cpar
+    gw, fw, aux = workspace(y)
+    _rhs_at(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
+    return (k, aux) if with_aux else k
+
+
+@njit(cache=True)
+def _rhs_at(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
+    system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)

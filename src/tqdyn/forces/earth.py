@@ -54,6 +54,7 @@ __all__ = [
     "earth_field_static_accel",
     "earth_tides_accel",
     "earth_field_accel_batch",
+    "j2_jerk_gcrs_z",
     "PARAM_HEADER",
     "N_ROT",
 ]
@@ -349,6 +350,29 @@ def degree2_accel_ext(rx, ry, rz, tdat, params):
     return (add(add(mul(ax, tdat[0]), mul(ay, tdat[3])), mul(az, tdat[6])),
             add(add(mul(ax, tdat[1]), mul(ay, tdat[4])), mul(az, tdat[7])),
             add(add(mul(ax, tdat[2]), mul(ay, tdat[5])), mul(az, tdat[8])))
+
+
+@njit(cache=True, inline="always")
+def j2_jerk_gcrs_z(k, rx, ry, rz, vx, vy, vz):
+    """Time derivative [m/s^3, GCRS] of the zonal J2 acceleration with the
+    pole along the GCRS z axis, a = -k / r^5 [(1 - 5 q) x, (1 - 5 q) y,
+    (3 - 5 q) z], q = z^2 / r^2, k = 1.5 J2 GM R^2 [m^5/s^2] (J2 = -sqrt(5)
+    C20 of the field), for a satellite at r [m] moving with v [m/s].
+
+    A jerk *model* for the attitude rates of the local pointing laws, where
+    it enters through 1/c: it leaves out the Earth rotation of the sectorial
+    degree-2 terms (~1e-13 m/s^3 at 1e5 km), the tilt of the CIP from GCRS z
+    (~2e-14) and degrees >= 3 (~2e-14 m/s^3).  float64 scalars; returns
+    (jx, jy, jz)."""
+    r2 = rx * rx + ry * ry + rz * rz
+    f = -k / (r2 * r2 * np.sqrt(r2))
+    rv = rx * vx + ry * vy + rz * vz
+    fd = -5.0 * f * rv / r2
+    q = rz * rz / r2
+    qd = 2.0 * rz * vz / r2 - 2.0 * q * rv / r2
+    return (fd * (1.0 - 5.0 * q) * rx + f * (-5.0 * qd * rx + (1.0 - 5.0 * q) * vx),
+            fd * (1.0 - 5.0 * q) * ry + f * (-5.0 * qd * ry + (1.0 - 5.0 * q) * vy),
+            fd * (3.0 - 5.0 * q) * rz + f * (-5.0 * qd * rz + (3.0 - 5.0 * q) * vz))
 
 
 @njit(cache=True)

@@ -35,7 +35,7 @@ from numba import njit
 
 from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
 
-__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel", "third_body_accel_ext"]
+__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel", "third_body_accel_ext", "third_body_jerk"]
 
 
 @njit(cache=True)
@@ -69,6 +69,28 @@ def third_body_accel_ext(rx, ry, rz, sx, sy, sz, gm):
     d2 = add(add(mul(dx, dx), mul(dy, dy)), mul(dz, dz))
     k = neg(div(gm, mul(d2, sqrt(d2))))
     return (mul(k, add(rx, mul(f, sx))), mul(k, add(ry, mul(f, sy))), mul(k, add(rz, mul(f, sz))))
+
+
+@njit(cache=True, inline="always")
+def third_body_jerk(gm, rx, ry, rz, vx, vy, vz, sx, sy, sz, ux, uy, uz):
+    """Time derivative [m/s^3] of the third-body acceleration
+    gm [(s - r)/|s - r|^3 - s/|s|^3] of :func:`third_body_accel` for a
+    satellite at r [m] moving with v [m/s] and a body at s [m] moving with
+    u [m/s] (geocentric, one inertial frame; gm [m^3/s^2]).  The literal
+    form: its cancellation (three digits for the Sun) costs nothing at the
+    ~1e-10 m/s^3 of the Moon's and Sun's tidal jerks, which only enter the
+    attitude rates through 1/c.  float64 scalars; returns (jx, jy, jz)."""
+    dx, dy, dz = sx - rx, sy - ry, sz - rz
+    ex, ey, ez = ux - vx, uy - vy, uz - vz
+    d2 = dx * dx + dy * dy + dz * dz
+    id3 = 1.0 / (d2 * np.sqrt(d2))
+    q = 3.0 * (dx * ex + dy * ey + dz * ez) / d2
+    s2 = sx * sx + sy * sy + sz * sz
+    is3 = 1.0 / (s2 * np.sqrt(s2))
+    p = 3.0 * (sx * ux + sy * uy + sz * uz) / s2
+    return (gm * ((ex - q * dx) * id3 - (ux - p * sx) * is3),
+            gm * ((ey - q * dy) * id3 - (uy - p * sy) * is3),
+            gm * ((ez - q * dz) * id3 - (uz - p * sz) * is3))
 
 
 @njit(cache=True)

@@ -25,8 +25,8 @@ from typing import Callable
 import numpy as np
 
 from ..formats import trajectory as io
-from ..dynamics import propagate as propagator
-from ..dynamics.propagate import Checkpoint, RunResult
+from .. import dynamics
+from ..dynamics import Checkpoint, Rows, RunResult, row_names
 
 __all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
 
@@ -35,7 +35,7 @@ __all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkp
 class RunSummary:
     """What :func:`run_to_file` did.
 
-    result : the propagator's :class:`~tqdyn.propagator.RunResult`;
+    result : the propagator's :class:`~tqdyn.dynamics.RunResult`;
     path : the trajectory file; rows : time rows written;
     compile_s : JIT compilation / warm-up time [s] (0 when cached in-process).
     """
@@ -51,16 +51,17 @@ class RunSummary:
         return self.path.stat().st_size / 1e6
 
 
+def row_fields(rows: Rows) -> dict:
+    """The trajectory-file fields of a block of output rows: attribute ``sat_r``
+    is field ``sat/r`` (the first underscore is the group separator)."""
+    return {name.replace("_", "/", 1): value for name, value in rows.items()}
+
+
 def output_fields(scen) -> tuple[str, ...]:
-    """Trajectory fields a run of ``scen`` writes (see :data:`tqdyn.io.FIELDS`)."""
-    fields = ["t", "sat/r", "sat/v", "sat/a_gravity"]
-    if scen.constellation.coupled:
-        fields += ["sat/a_dragfree", "sat/T_S_I", "sat/omega", "sat/omega_dot", "sat/breathing_angle",
-                   "mosa/angle", "tm/r", "tm/v", "tm/a", "tm/a_suspension", "tm/alpha_suspension",
-                   "tm/self_gravity"]
-        if scen.constellation.free_tms:
-            fields.append("tm/housing_offset")
-    return tuple(fields)
+    """Trajectory fields a run of ``scen`` writes (see :data:`tqdyn.formats.trajectory.FIELDS`)."""
+    c = scen.constellation
+    fields = [name.replace("_", "/", 1) for name in row_names(c.coupled, c.free_tms)]
+    return tuple(fields + (["tm/self_gravity"] if c.coupled else []))
 
 
 def output_attrs(scen) -> dict:
@@ -104,7 +105,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
     """
     out_path = io.check_writable(scen.run.output)
     if model is None:
-        model = propagator.check_inputs(scen)
+        model = dynamics.check_inputs(scen)
     fixed = scen.integrator.mode == "fixed"
     if not fixed:
         checkpoint_every = 0
@@ -118,7 +119,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         start = None
         writer_factory = None
     t0 = time.perf_counter()
-    propagator.warm_up(scen.run.precision)
+    dynamics.warm_up(scen.run.precision)
     compile_s = time.perf_counter() - t0
     if writer_factory is not None:
         writer = writer_factory()
@@ -127,14 +128,14 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
                                      n_sat=len(scen.satellites),
                                      expected_rows=scen.n_steps // scen.run.output_every + 1)
         if scen.constellation.coupled:
-            writer.set_static("tm/self_gravity", propagator.self_gravity_oa(scen))
+            writer.set_static("tm/self_gravity", dynamics.self_gravity_oa(scen))
 
     def save_checkpoint(c: Checkpoint):
         partial = writer.sync()
         _write_checkpoint(ckpt, scen.to_toml(), scen.run.precision, c, partial, writer.rows_written)
 
     try:
-        result = propagator.propagate(scen, sink=writer.append, progress=progress, model=model, start=start,
+        result = dynamics.propagate(scen, sink=lambda rows: writer.append(row_fields(rows)), progress=progress, model=model, start=start,
                                       checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
         rows = writer.rows_written
         writer.close()

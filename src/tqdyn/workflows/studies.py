@@ -292,7 +292,7 @@ def plan_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_sca
     FileNotFoundError.  Runs shared by several studies appear once; longest
     first.  Nothing is written.
     """
-    from ..dynamics import propagate as propagator
+    from .. import dynamics
 
     names = _check_names(studies)
     runs_dir = Path(os.path.abspath(os.path.expanduser(os.fspath(runs_dir))))
@@ -310,7 +310,7 @@ def plan_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_sca
         path = runs_dir / f"{spec.name}-{digest}.h5"
         final = replace(scen, run=replace(scen.run, output=str(path)))
         if check_data and not run_complete(path, canonical):
-            propagator.check_inputs(final)
+            dynamics.check_inputs(final)
         planned.append(PlannedRun(spec=spec, scenario_toml=final.to_toml(), canonical_toml=canonical, digest=digest,
                                   path=path, done=run_complete(path, canonical),
                                   duration_s=float(scen.run.duration_s)))

@@ -1,0 +1,205 @@
+"""Fixed-step propagation: the compiled DP87 loop, chunk by chunk.
+
+The loop runs entirely in compiled code, one chunk of steps at a time.
+Before each chunk the time-only inputs of the force model are computed for
+every stage time of the chunk (t_n + c_i h, known in advance) and handed to
+the loop as one array, so no Python runs per step; the inputs of the next
+chunk are computed in a second thread while the compiled loop (nogil) runs.
+Time is an integer step count times the exact step (a dd pair), never a
+large bare float64.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from numba import njit
+
+from ..forces.model import ForceModel
+from ..numerics import dp87
+from ..numerics.dd import add, ld, mul, st
+from . import layout as _lay
+from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
+from .rhs import evaluate_rhs, point_masses, system_rhs
+
+__all__ = ["DEFAULT_CHUNK", "propagate_fixed", "warm_up"]
+
+DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
+
+
+def _as_precision(y_dd: np.ndarray, precision: str) -> np.ndarray:
+    """dd array -> array of the working precision (float64 drops the dd axis, rounding hi+lo)."""
+    if precision == "dd":
+        return np.array(y_dd, dtype=np.float64, order="C", copy=True)
+    return np.ascontiguousarray(y_dd[..., 0] + y_dd[..., 1])
+
+
+def _workspace(y0_dd, precision):
+    """State y (a copy of y0 in the working precision), its compensation,
+    the 13 stage derivatives, a stage state and the error estimate."""
+    y = _as_precision(y0_dd, precision)
+    return y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros(y.shape[:2])
+
+
+@njit(cache=True)
+def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout,
+              cpar, aux0, aux, gw, fw):
+    """One DP87 step in place: the 13 stages (K[0] = f(y) first, its
+    diagnostics into aux0), then the compensated update of y.  tdat_step:
+    (13, n_tdat) time-only inputs at the stage times.  Independent point
+    masses call their right-hand side directly: passing the coupled system's
+    work arrays 13 times per step costs ~4 us (their reference counts)."""
+    if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
+        point_masses(y, tdat_step[0], params, layout, K[0])
+        for i in range(1, 13):
+            dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
+            point_masses(ystage, tdat_step[i], params, layout, K[i])
+    else:
+        system_rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
+        for i in range(1, 13):
+            dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
+            system_rhs(ystage, tdat_step[i], params, layout, cpar, K[i], aux, gw, fw)
+    dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
+
+
+@njit(cache=True, nogil=True)
+def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+                 cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
+    """n_steps fixed DP87 steps.  Before step n it records the state y_n in
+    out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s acceleration (stage 1) in
+    out_a[n] (n_body, 3[, 2]) and its diagnostics in out_aux[n] (AUX_LEN,)
+    (if out_aux has rows).  tdat: (n_steps, 13, n_tdat)."""
+    for n in range(n_steps):
+        out_y[n] = y
+        aux0 = out_aux[n] if out_aux.shape[0] > 0 else aux
+        _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout,
+                  cpar, aux0, aux, gw, fw)
+        out_a[n] = K[0][:, 3:6]
+
+
+@njit(cache=True)
+def _grid_times(n0, m, h, c, t_out, t_nodes):
+    """t_out[k] = (n0 + k) h (dd, exact for the usual decimal steps) and, if
+    t_nodes has rows, the stage times t_nodes[k, i] = t_out[k] + c_i h.
+    h: (2,) dd step [s]; c: (13,) nodes; t_out: (m, 2); t_nodes: (m or 0, 13, 2)."""
+    hd = (h[0], h[1])
+    for k in range(m):
+        t = mul(hd, float(n0 + k))
+        st(t_out, t, k)
+        if t_nodes.shape[0] > 0:
+            for i in range(c.shape[0]):
+                st(t_nodes, add(t, mul(hd, c[i])), k, i)
+
+
+@njit(cache=True)
+def _scale_tableau(a, b, h, ha, hb):
+    """ha = h * a, hb = h * b in the working precision (h: generic number)."""
+    for i in range(a.shape[0]):
+        st(hb, mul(ld(b, i), h), i)
+        for j in range(a.shape[1]):
+            st(ha, mul(ld(a, i, j), h), i, j)
+
+
+def warm_up(precision: str = "dd") -> None:
+    """Compile the fixed-step kernels for ``precision`` (numba JIT, a few
+    seconds on first use in a process, then cached on disk) so that later
+    timings measure the propagation alone.  One compiled kernel serves the
+    point-mass and the coupled systems."""
+    _lay.check_precision(precision)
+    tail = (2,) if precision == "dd" else ()
+    y = np.zeros((1, 6) + tail)
+    y[0, 0] = 1.0e7
+    y[0, 4] = 6.0e3
+    coef = dp87.step_coefficients(dp87.load_tableau(), 1, precision)
+    model = ForceModel([])
+    K = np.zeros((13,) + y.shape)
+    cpar = _lay.make_cpar(_lay.MODE_POINT_MASS)
+    gw, fw, aux = _lay.workspace(y)
+    _fixed_chunk(y, np.zeros_like(y), K, np.zeros_like(y), np.zeros((1, 6)), coef.ha, coef.nz, coef.nnz,
+                 coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((1, 13, 0)), model.params, model.layout,
+                 cpar, aux, gw, fw, 1, np.empty((1,) + y.shape), np.empty((1, 1, 3) + tail),
+                 np.empty((0, _lay.AUX_LEN)))
+    _grid_times(0, 1, np.array(coef.h), coef.c, np.empty((1, 2)), np.empty((0, 13, 2)))
+    evaluate_rhs(y, np.zeros(0), model)
+
+
+# --------------------------------------------------------------------------
+# Python driver
+
+
+def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                     start=None, checkpoint=None, checkpoint_every=0, system=None):
+    coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
+    n_total = scenario.n_steps
+    every = scenario.run.output_every
+    y, comp, K, ystage, err = _workspace(y0_dd, precision)
+    n = 0
+    if start is not None:
+        if start.y.shape != y.shape or not 0 <= start.n <= n_total:
+            raise ValueError(f"checkpoint: state shape {start.y.shape} at step {start.n} does not fit this run "
+                             f"({y.shape}, {n_total} steps)")
+        n = int(start.n)
+        y[...] = start.y
+        comp[...] = start.comp
+    h = np.array(coef.h)
+    nb = y.shape[0]
+    acc_shape = (nb, 3) + y.shape[2:]
+    cpar = system.cpar
+    gw, fw, aux = _lay.workspace(y)
+    n_aux = _lay.AUX_LEN if system.coupled else 0
+    t_start = _time.perf_counter()
+    extremes: dict = {}
+    # chunk boundaries (fixed by chunk and checkpoint_every, so a resumed run
+    # takes the same steps); the time-only inputs of the next chunk are
+    # computed in a second thread while the compiled loop (nogil) runs.
+    plan = []
+    n_plan = n
+    while n_plan < n_total:
+        m = min(chunk, n_total - n_plan)
+        if checkpoint_every:
+            m = min(m, (n_plan // checkpoint_every + 1) * checkpoint_every - n_plan)
+        plan.append((n_plan, m))
+        n_plan += m
+
+    def inputs(n0, m):
+        t_out = np.empty((m, 2))
+        t_nodes = np.empty((m if model.time_dependent else 0, 13, 2))
+        _grid_times(n0, m, h, coef.c, t_out, t_nodes)
+        tdat = (model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1]) if model.time_dependent
+                else np.zeros((m, 13, 0)))
+        return t_out, tdat
+
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pending = pool.submit(inputs, *plan[0]) if plan else None
+        for idx, (n0, m) in enumerate(plan):
+            t_out, tdat = pending.result()
+            pending = pool.submit(inputs, *plan[idx + 1]) if idx + 1 < len(plan) else None
+            out_y = np.empty((m,) + y.shape)
+            out_a = np.empty((m,) + acc_shape)
+            out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
+            _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                         coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, m, out_y, out_a, out_aux)
+            if sink is not None:
+                sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
+            if n_aux:
+                update_extremes(extremes, out_aux, system)
+            n = n0 + m
+            if progress is not None:
+                progress(m)
+            if checkpoint is not None and checkpoint_every and n % checkpoint_every == 0 and n < n_total:
+                checkpoint(Checkpoint(n, y.copy(), comp.copy()))
+    # the final state and its acceleration
+    t_end = np.empty((1, 2))
+    t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))
+    _grid_times(n_total, 1, h, coef.c, t_end, t_nodes)
+    tdat_end = (model.precompute(epoch, t_nodes[0, 0, 0], t_nodes[0, 0, 1]) if model.time_dependent
+                else np.zeros(0))
+    k_end, aux_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model, cpar, with_aux=True)
+    wall = _time.perf_counter() - t_start
+    if sink is not None:
+        sink(select_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
+    return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,
+                     y_final=to_dd(y, 2), n_steps=n_total, n_rejected=0,
+                     n_rhs=13 * n_total + 1, wall_s=wall, extra=format_extremes(extremes))

@@ -1,0 +1,133 @@
+"""Layouts of the arrays the compiled right-hand side shares with Python.
+
+* ``cpar`` (:data:`CP_LEN` float64): the constellation parameters of
+  :func:`tqdyn.dynamics.rhs.system_rhs` -- mode, pointing law, control
+  switch, spacecraft geometry, self-gravity and the jerk model -- packed by
+  :func:`make_cpar`.
+* ``aux`` (:data:`AUX_LEN` float64): the per-evaluation diagnostics of the
+  coupled modes (attitude, control, TM states), read back by
+  :func:`aux_views`.
+* the state y (n_body, 6[, 2]): rows (x, y, z, vx, vy, vz) [m, m/s] in the
+  frame of the force model (:attr:`tqdyn.forces.model.ForceModel.reference`);
+  a trailing axis 2 in dd mode (hi, lo).  Bodies 0..n_sat-1 are the
+  satellites; in the free-TM mode bodies 3 + 2 i + l are the test masses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN", "SYSTEM_TDAT_BODIES",
+           "N_SYSTEM_TDAT", "make_cpar", "workspace", "aux_views"]
+
+#: Arithmetic of a propagation: double-double states (trailing axis 2) or plain float64.
+PRECISIONS = ("dd", "float64")
+
+
+def check_precision(precision):
+    """ValueError naming ``run.precision`` unless it is one of :data:`PRECISIONS`."""
+    if precision not in PRECISIONS:
+        raise ValueError(f"run.precision: {precision!r} is not allowed; allowed: {', '.join(PRECISIONS)}")
+
+
+MODE_POINT_MASS = 0
+MODE_COUPLED = 1
+MODE_FREE_TM = 2
+
+# cpar layout (float64)
+
+# cpar layout (float64)
+CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
+CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
+CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
+CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
+CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_TD = 40, 41, 42, 43   # jerk model (see _jerk_perturbation)
+CP_LEN = 44
+#: time-only inputs of the coupled system, appended to the force model's:
+#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
+#: time-only inputs of the coupled system, appended to the force model's:
+#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
+SYSTEM_TDAT_BODIES = ("moon", "sun")
+N_SYSTEM_TDAT = 12
+
+# aux layout per satellite (float64), AX_SAT values each
+
+# aux layout per satellite (float64), AX_SAT values each
+AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
+AX_TM = 23         # then per TM l: AX_TM + l * AX_TMLEN
+TM_RHI, TM_RLO, TM_VHI, TM_VLO, TM_A, TM_SUSP, TM_ALPHA, TM_OFF = 0, 3, 6, 9, 12, 15, 18, 21
+AX_TMLEN = 24
+AX_SAT = AX_TM + 2 * AX_TMLEN
+AUX_LEN = 3 * AX_SAT
+
+# float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
+
+# float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
+_FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
+              ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
+              ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
+              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
+
+
+def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
+              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1) -> np.ndarray:
+    """Pack the constellation parameters for :func:`system_rhs`.
+
+    mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
+    control : apply G_i to the orbits; gm : Earth GM [m^3/s^2] (jerk/snap of
+    the remote satellite in the local pointing laws); c : m/s; d_p : pivot
+    distance [m]; theta_nom : nominal MOSA angle [rad]; r0_nom : (2, 3) EH
+    centers in S [m]; sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2];
+    sg_s : (3, 3) common self-gravity in S [m/s^2].
+    gm_moon, gm_sun : [m^3/s^2], j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth:
+    the jerk model of the local pointing laws (0 = term absent);
+    tdat_offset : column of the system's time-only inputs (Moon, Sun states,
+    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none.
+    """
+    p = np.zeros(CP_LEN)
+    p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
+    p[CP_GM], p[CP_C], p[CP_DP], p[CP_THNOM] = gm, c, d_p, theta_nom
+    if r0_nom is not None:
+        p[CP_R0:CP_R0 + 6] = np.asarray(r0_nom, np.float64).ravel()
+    if sg_oa is not None:
+        p[CP_SG_OA:CP_SG_OA + 18] = np.asarray(sg_oa, np.float64).ravel()
+    if sg_s is not None:
+        p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
+    p[CP_GM_MOON], p[CP_GM_SUN], p[CP_J2K], p[CP_TD] = gm_moon, gm_sun, j2k, tdat_offset
+    return p
+
+
+def workspace(y: np.ndarray):
+    """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
+    (15, 3[, 2]) accelerations in the working precision, fw a tuple of
+    float64 arrays, aux (AUX_LEN,)."""
+    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
+            np.zeros(AUX_LEN))
+
+
+def aux_views(aux: np.ndarray) -> dict:
+    """Named views of aux rows (..., AUX_LEN) -> arrays with (..., 3[, 2], k) shapes (float64).
+
+    Keys: T_S_I (..., 3, 3, 3); omega, omega_dot (..., 3, 3) [S];
+    breathing_angle, theta (..., 3); a_dragfree, a_gravity (..., 3, 3) [GCRS];
+    tm_r_hi, tm_r_lo, tm_v_hi, tm_v_lo, tm_a (..., 3, 2, 3) [GCRS];
+    tm_a_suspension, tm_alpha_suspension (..., 3, 2, 3) [OA_l];
+    tm_housing_offset (..., 3, 2, 3) [GCRS, m].
+    """
+    a = np.asarray(aux)
+    s = a.reshape(a.shape[:-1] + (3, AX_SAT))
+    tm = s[..., AX_TM:].reshape(a.shape[:-1] + (3, 2, AX_TMLEN))
+
+    def v(x, lo, n):
+        return x[..., lo:lo + n]
+
+    return {
+        "T_S_I": v(s, AX_T, 9).reshape(a.shape[:-1] + (3, 3, 3)),
+        "omega": v(s, AX_W, 3), "omega_dot": v(s, AX_WD, 3),
+        "breathing_angle": s[..., AX_ALPHA], "theta": s[..., AX_THETA],
+        "a_dragfree": v(s, AX_G, 3), "a_gravity": v(s, AX_AGRAV, 3),
+        "tm_r_hi": v(tm, TM_RHI, 3), "tm_r_lo": v(tm, TM_RLO, 3),
+        "tm_v_hi": v(tm, TM_VHI, 3), "tm_v_lo": v(tm, TM_VLO, 3), "tm_a": v(tm, TM_A, 3),
+        "tm_a_suspension": v(tm, TM_SUSP, 3), "tm_alpha_suspension": v(tm, TM_ALPHA, 3),
+        "tm_housing_offset": v(tm, TM_OFF, 3),
+    }

@@ -1,0 +1,101 @@
+"""Propagate a scenario: the one entry point of the dynamics layer.
+
+:func:`propagate` builds the force model and the system of a scenario, its
+initial states, and runs the fixed-step (:mod:`.fixed`) or adaptive
+(:mod:`.adaptive`) integration.  It computes; it writes nothing: output rows
+(:class:`~tqdyn.dynamics.results.Rows`) go to a ``sink`` callable (the run
+workflow connects it to the trajectory writer), progress to a ``progress``
+callable.  States are in the force model's reference system (for the
+geocentric model: GCRS, SI).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import mpmath
+import numpy as np
+
+from ..astro.timescales import Epoch
+from ..forces.model import ForceModel, build_force_model
+from ..numerics import dp87
+from ..numerics.dd import mp_from_dd
+from .adaptive import propagate_adaptive
+from .fixed import DEFAULT_CHUNK, propagate_fixed
+from .initial import initial_state
+from .layout import PRECISIONS, check_precision
+from .results import Checkpoint, Rows, RunResult
+from .system import build_system
+
+__all__ = ["propagate", "check_inputs", "two_body_energy", "PRECISIONS", "Checkpoint", "Rows", "RunResult"]
+
+
+def two_body_energy(y_dd: np.ndarray, gm) -> list:
+    """Specific two-body energy v^2/2 - gm/|r| [J/kg] of each body, in mpmath
+    (exact from the dd states).  y_dd: (n_body, 6, 2)."""
+    vals = mp_from_dd(y_dd)
+    out = []
+    with mpmath.workdps(60):
+        g = mpmath.mpf(str(gm))
+        for row in vals:
+            r = mpmath.sqrt(sum(x * x for x in row[:3]))
+            out.append(sum(x * x for x in row[3:]) / 2 - g / r)
+    return out
+
+
+def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], None] | None = None,
+              progress: Callable[[int], None] | None = None, chunk: int = DEFAULT_CHUNK,
+              y0: np.ndarray | None = None, model: ForceModel | None = None,
+              start: Checkpoint | None = None, checkpoint: Callable[[Checkpoint], None] | None = None,
+              checkpoint_every: int = 0) -> RunResult:
+    """Propagate the scenario's satellites over ``scenario.run.duration_s``.
+
+    precision: "dd" | "float64" (default: the scenario's run.precision).
+    sink(rows): receives output rows every chunk -- a dict with "t" (hi, lo)
+    (m,) [s TDB since epoch], "sat/r" and "sat/v" (hi, lo) (m, n_sat, 3)
+    [m, m/s, GCRS], "sat/a_gravity" (m, n_sat, 3) float64 [m/s^2] -- on the
+    output grid (every run.output_every-th step; the adaptive mode samples
+    the fixed grid k * integrator.step_s by dense output).
+    progress(n): called with the number of steps just completed (fixed) or
+    the seconds of propagation time just covered (adaptive).
+    y0: optional initial dd states (n_sat, 6, 2) instead of the scenario's elements.
+    model: optional force model instead of the one built from scenario.forces.
+    start: resume a fixed-step run from this checkpoint (its rows before
+    start.n are not emitted again).  checkpoint(Checkpoint): called every
+    ``checkpoint_every`` steps (fixed mode; 0 = never) after the rows up to
+    that step went to the sink.
+    """
+    precision = precision or scenario.run.precision
+    check_precision(precision)
+    model = build_force_model(scenario.forces) if model is None else model
+    system = build_system(scenario, model)
+    model = system.with_inputs(model)
+    epoch = Epoch.from_utc(scenario.epoch_utc)
+    tab = dp87.load_tableau(scenario.integrator.tableau)
+    y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)
+    if scenario.integrator.mode == "adaptive":
+        if start is not None or checkpoint_every:
+            raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
+        result = propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system)
+    else:
+        result = propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                                  start, checkpoint, checkpoint_every, system)
+    if [t.name for t in model.terms] == ["earth_monopole"] and not system.coupled:
+        e0 = two_body_energy(result.y0, model.terms[0].gm)
+        e1 = two_body_energy(result.y_final, model.terms[0].gm)
+        with mpmath.workdps(60):
+            result.energy_rel_drift = np.array([float((b - a) / abs(a)) for a, b in zip(e0, e1)])
+    return result
+
+
+def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:
+    """Build the scenario's force model and evaluate its time-only inputs at
+    the first and last instants, so that data limits (a date outside the
+    ephemeris, EOP or lunar-kernel span, a missing file, a degree above what
+    a file holds) raise ValueError / FileNotFoundError before any
+    propagation or output starts.  Returns the model."""
+    model = build_force_model(scenario.forces) if model is None else model
+    epoch = Epoch.from_utc(scenario.epoch_utc)
+    t_end = float(scenario.run.duration_s)
+    model.precompute(epoch, np.array([0.0, t_end]), np.zeros(2))
+    return model

@@ -1,0 +1,117 @@
+"""What is propagated: the scenario's constellation as the compiled system's parameters.
+
+:func:`build_system` turns a scenario into a :class:`System`: the mode of
+:func:`tqdyn.dynamics.rhs.system_rhs` (independent point masses, the coupled
+drag-free constellation, or its free-TM verification mode) and the packed
+constellation parameters (:mod:`tqdyn.dynamics.layout`): pointing law,
+control switch, spacecraft geometry, self-gravity, and the jerk model of the
+local pointing laws (the Moon's and Sun's tidal jerks from their ephemeris
+states, the Earth's J2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..astro.constants import C_LIGHT, R_EARTH_EGM2008
+from ..astro.ephemeris import planetary_gm
+from ..astro.timescales import tdb_jd
+from ..constellation._kinematics_jit import LAW_CODES
+from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
+from ..forces.model import ForceModel, _ephemeris, build_force_model
+from . import layout as _lay
+
+__all__ = ["System", "build_system", "self_gravity_oa"]
+
+
+@dataclass(frozen=True)
+class System:
+    """What is propagated: the mode of :func:`tqdyn.dynamics.rhs.system_rhs` and its parameters.
+
+    cpar : (layout.CP_LEN,) float64 constellation parameters (mode, pointing
+    law, control switch, spacecraft geometry, self-gravity; :mod:`.layout`);
+    coupled : attitude/control diagnostics are produced (pointing != "none");
+    free_tms : the six TMs are propagated as bodies 3..8.
+    """
+
+    cpar: np.ndarray
+    coupled: bool
+    free_tms: bool
+    ephemeris: object = None
+
+    def with_inputs(self, model: ForceModel):
+        """The force model, extended by the system's own time-only inputs
+        (the Moon's and Sun's states for the jerk of the local pointing
+        laws) when it needs any; see :class:`_SystemInputs`."""
+        if self.ephemeris is None or isinstance(model, _SystemInputs):
+            return model
+        return _SystemInputs(model, self)
+
+
+class _SystemInputs:
+    """A force model whose time-only inputs are followed by the coupled
+    system's: geocentric GCRS position [m] and velocity [m/s] of the Moon and
+    the Sun (TDB), :data:`tqdyn.dynamics.layout.N_SYSTEM_TDAT` columns starting at
+    the force model's ``n_tdat`` (= ``cpar[CP_TD]``).  Everything else is the
+    force model's."""
+
+    def __init__(self, model: ForceModel, system: System):
+        self._model = model
+        self._system = system
+        self.n_tdat = model.n_tdat + _lay.N_SYSTEM_TDAT
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    @property
+    def time_dependent(self) -> bool:
+        return True
+
+    def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
+        base = self._model.precompute(epoch, t_hi, t_lo)
+        jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
+        pos, vel = self._system.ephemeris.geocentric_states(_lay.SYSTEM_TDAT_BODIES, jd1, jd2, velocity=True)
+        extra = np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (_lay.N_SYSTEM_TDAT,))
+        return np.concatenate([base, extra], axis=-1)
+
+
+def self_gravity_oa(scenario) -> np.ndarray:
+    """DC self-gravity of the scenario's TMs, (3, 2, 3) [m/s^2] in OA_l."""
+    oa, _ = scenario.spacecraft.self_gravity_values()
+    return np.broadcast_to(TABLE_IV_SELF_GRAVITY, (3, 2, 3)).copy() if oa is None else oa
+
+
+def build_system(scenario, model: ForceModel | None = None) -> System:
+    """The :class:`System` of a scenario (point masses unless
+    ``constellation.pointing`` names a law).  ``model``: the scenario's force
+    model (built if None), whose time-only inputs the system's follow."""
+    c = scenario.constellation
+    if not c.coupled:
+        return System(_lay.make_cpar(_lay.MODE_POINT_MASS), False, False)
+    sc = scenario.spacecraft
+    craft = Spacecraft(d_tm=float(sc.d_tm_m), d_p=float(sc.d_p_m), tm_axis=sc.tm_axis)
+    _, common = sc.self_gravity_values()
+    mode = _lay.MODE_FREE_TM if c.free_tms else _lay.MODE_COUPLED
+    # jerk model of the local laws: the Moon / Sun tidal terms and J2 that the force model has
+    f = scenario.forces
+    law = LAW_CODES[c.pointing]
+    bodies = [b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies] if law else []
+    eph = _ephemeris(f.ephemeris) if bodies else None
+    gms = planetary_gm() if bodies else {}
+    j2k = 1.5 * _J2_EGM2008 * float(f.gm_earth) * R_EARTH_EGM2008 ** 2 if law and f.earth_degree >= 2 else 0.0
+    if eph is not None and model is None:
+        model = build_force_model(f)
+    cpar = _lay.make_cpar(mode, law=law, control=c.control == "on",
+                          gm=float(f.gm_earth), c=C_LIGHT, d_p=craft.d_p,
+                          theta_nom=craft.theta_nominal, r0_nom=craft.nominal_housing_centers,
+                          sg_oa=self_gravity_oa(scenario), sg_s=common,
+                          gm_moon=gms.get("moon", 0.0), gm_sun=gms.get("sun", 0.0), j2k=j2k,
+                          tdat_offset=model.n_tdat if eph is not None else -1)
+    return System(cpar, True, c.free_tms, eph)
+
+
+#: J2 = -sqrt(5) C20 of EGM2008 (tide-free), for the jerk model only (it enters
+#: omega_dot of the local laws at ~1e-19 rad/s^2: 5 digits are plenty).
+_J2_EGM2008 = 1.08263e-3
