@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..astro.constants import C_LIGHT, R_EARTH_EGM2008
+from ..astro.constants import C_LIGHT
 from ..astro.ephemeris import planetary_gm
 from ..astro.timescales import tdb_jd
 from ..constellation._kinematics_jit import LAW_CODES
 from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
+from ..forces.earth import EarthField
 from ..forces.model import ForceModel, _ephemeris, build_force_model
 from . import layout as _lay
 
@@ -100,9 +101,10 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     bodies = [b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies] if law else []
     eph = _ephemeris(f.ephemeris) if bodies else None
     gms = planetary_gm() if bodies else {}
-    j2k = 1.5 * _J2_EGM2008 * float(f.gm_earth) * R_EARTH_EGM2008 ** 2 if law and f.earth_degree >= 2 else 0.0
-    if eph is not None and model is None:
+    if law and model is None:
         model = build_force_model(f)
+    earth = next((t for t in model.terms if isinstance(t, EarthField)), None) if law else None
+    j2k = earth.j2_jerk_coefficient() if earth is not None else 0.0
     cpar = _lay.make_cpar(mode, law=law, control=c.control == "on",
                           gm=float(f.gm_earth), c=C_LIGHT, d_p=craft.d_p,
                           theta_nom=craft.theta_nominal, r0_nom=craft.nominal_housing_centers,
@@ -111,7 +113,3 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
                           tdat_offset=model.n_tdat if eph is not None else -1)
     return System(cpar, True, c.free_tms, eph)
 
-
-#: J2 = -sqrt(5) C20 of EGM2008 (tide-free), for the jerk model only (it enters
-#: omega_dot of the local laws at ~1e-19 rad/s^2: 5 digits are plenty).
-_J2_EGM2008 = 1.08263e-3

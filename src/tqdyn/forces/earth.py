@@ -216,6 +216,13 @@ class EarthField:
         return np.concatenate([[m.gm, m.radius, self.degree, self.order, self.tide_degree],
                                m.C.ravel(), m.S.ravel(), [float(self.extended_degree2)]]).astype(np.float64)
 
+    def j2_jerk_coefficient(self) -> float:
+        """k = 1.5 J2 GM R^2 [m^5/s^2] of :func:`j2_jerk_gcrs_z` from this
+        field: J2 = -sqrt(5) C20 of the static model (fully normalised C20),
+        GM and R its reference values."""
+        m = self.model
+        return 1.5 * (-np.sqrt(5.0) * float(m.C[2, 0])) * float(m.gm) * float(m.radius) ** 2
+
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         """Time-only inputs at t = t_hi + t_lo [s TDB since epoch]: float64
         (*shape, n_tdat) = [T_ITRS_GCRS row-major (9), dC, dS (each the
