@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from tqdyn.formats import trajectory as io
-from tqdyn.lightpath import light_time as LP
+from tqdyn import lightpath as LP
 from tqdyn.cli.export import export
 from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation.indices import LINKS, Link
