@@ -20,10 +20,11 @@ def instantaneous_ranges(r) -> tuple[np.ndarray, np.ndarray]:
 
     r: dd positions [m], GCRS, of the test masses (N, 3, 2, 3) or of the
     satellite centres (N, 3, 3) (``(hi, lo)`` tuple, trailing axis 2, or
-    float64).  Bodies per link as in :func:`~tqdyn.lightpath.light_time.link_bodies` (TM facing TM, or
-    centre to centre); links ab and ba give the same value.  No light travel
-    time: both ends at the same coordinate time t (TDB), for comparison with
-    the light-path ranges c tau.  Returns (hi, lo), each (N, 6) [m], LISA
+    float64).  Bodies per link as in
+    :func:`~tqdyn.lightpath.light_time.link_bodies` (TM facing TM, or centre
+    to centre); links ab and ba give the same value.  No light travel time:
+    both ends at the same coordinate time t (TDB), for comparison with the
+    light-path ranges c tau.  Returns (hi, lo), each (N, 6) [m], LISA
     link order.
     """
     rh, rl = _dd_input(r, "r")
