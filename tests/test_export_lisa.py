@@ -1,6 +1,6 @@
-"""Tests of the LISA orbit-file export (tqdyn.export_lisa, `tqdyn export`).
+"""Tests of the LISA orbit-file export (tqdyn.workflows.export, tqdyn.formats.lisa, `tqdyn export`).
 
-Input: a trajectory file written with tqdyn.io.TrajectoryWriter from
+Input: a trajectory file written with tqdyn.formats.trajectory.TrajectoryWriter from
 analytic two-body Kepler orbits (numpy, this file): 3 satellites on
 a = 1e8 m, i = 74.5 deg, 120 deg apart, satellite 3 with e = 0.01, 4 hours
 at 50 s, with test masses +-0.2 m along the track (their own Kepler orbits).
@@ -28,11 +28,12 @@ import numpy as np
 import pytest
 
 from tqdyn.formats import trajectory as io
-from tqdyn.lightpath import light_time as LP
+from tqdyn import lightpath as LP
 from tqdyn.cli.export import export
 from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation.indices import LINKS, Link
-from tqdyn.formats.lisa import LISA_LINK_ORDER, export_lisa, write_lisa_orbits
+from tqdyn.formats.lisa import LISA_LINK_ORDER, write_lisa_orbits
+from tqdyn.workflows.export import export_lisa
 
 GM = 3.986004415e14  # m^3/s^2 (written into the scenario attribute, read back by the export)
 A_M = 1e8

@@ -1,4 +1,4 @@
-"""Tests of the trajectory file format (tqdyn.io): writer, reader, xarray view."""
+"""Tests of the trajectory file format (tqdyn.formats.trajectory): writer, reader, xarray view."""
 
 import os
 import pathlib
@@ -520,7 +520,7 @@ def test_check_writable_probe_failure(tmp_path, monkeypatch):
             raise PermissionError(13, "Permission denied")
         return real_open(path, flags, *a, **k)
 
-    monkeypatch.setattr(io.os, "open", fake_open)
+    monkeypatch.setattr(os, "open", fake_open)
     with pytest.raises(OutputError, match="not writable.*Permission denied"):
         check_writable(tmp_path / "x.h5")
 

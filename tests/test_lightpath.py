@@ -26,7 +26,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from tqdyn.lightpath import light_time as LP
+from tqdyn import lightpath as LP
 from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation.indices import LINKS, Link, Sat
 from tqdyn.numerics.dd import mp_from_pair

@@ -56,7 +56,7 @@ from ..formats import trajectory as io
 from ..astro.constants import GM_EARTH_EGM2008
 from ..constellation import geometry
 from ..constellation.indices import LINKS, Link, Sat
-from ..lightpath.light_time import instantaneous_ranges, light_travel_times, light_travel_times_of
+from ..lightpath import instantaneous_ranges, light_travel_times, light_travel_times_of
 from . import spectra
 from .figures import _pyplot
 from .pointing_study import PointingStudy, pointing_study_of

@@ -1,7 +1,7 @@
 """Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5``.
 
 A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
-It only composes library calls (:func:`tqdyn.export_lisa.export_lisa`).  As
+It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`).  As
 everywhere in the CLI, bad input exits with status 2 and one line
 ``tqdyn: error: ...`` on stderr, and no output file is left behind.
 """
@@ -39,7 +39,7 @@ def export(run_file, out_file, fmt, shapiro):
     if fmt not in FORMATS:
         _fail(f"--format: {fmt!r} is not allowed; allowed: {', '.join(FORMATS)}")
     from ..formats import trajectory as io
-    from ..formats.lisa import export_lisa
+    from ..workflows.export import export_lisa
 
     try:
         summary = export_lisa(run_file, out_file, shapiro=shapiro)

@@ -1,9 +1,11 @@
-"""Export a tqdyn trajectory as a LISA orbit file (format 2.x of lisaorbits).
+"""LISA orbit files (format 2.x of lisaorbits): the layout and its writer (I/O only).
 
 LISA's simulation chain (lisainstrument, pytdi, lisagwresponse) reads the
 HDF5 "orbit files" written by ``lisaorbits``.  This module writes the same
-layout from a tqdyn trajectory, so that those tools can take a TianQin (or
-any tqdyn) constellation as input.  The layout, read from the sources of
+layout (:func:`write_lisa_orbits`), so that those tools can take a TianQin (or
+any tqdyn) constellation as input; :func:`tqdyn.workflows.export.export_lisa`
+fills it from a tqdyn trajectory with the quantities computed by
+:func:`tqdyn.lightpath.proper_time.lisa_orbit_quantities`.  The layout, read from the sources of
 lisaorbits 2.4.2 (``Orbits.write``), lisainstrument 2.3.0
 (``orbiting/orbit_file.py``, ``OrbitFileV2``) and pytdi 2.2.1
 (``Data.from_orbits``):
@@ -81,28 +83,17 @@ from __future__ import annotations
 import os
 import pathlib
 import secrets
-import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import h5py
 import numpy as np
-from numba import njit
 
-from .. import __version__ as _TQDYN_VERSION
 from . import trajectory as _io
-from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
-from ..constellation.indices import LINKS
-from ..lightpath.light_time import LightTravelTimes, light_travel_times_of
 
 __all__ = [
     "LISA_LINK_ORDER",
     "LISA_ORBIT_FORMAT_VERSION",
-    "LisaExport",
-    "export_lisa",
-    "lisa_orbit_quantities",
-    "proper_time_deviation",
     "write_lisa_orbits",
 ]
 
@@ -112,9 +103,6 @@ LISA_ORBIT_FORMAT_VERSION = "2.3"
 
 LISA_LINK_ORDER = (12, 23, 31, 13, 32, 21)
 """Column order of the link datasets: "ij" = received by i, emitted by j (= tqdyn's Link order)."""
-
-_RECV = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
-_EMIT = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
 
 _UNIFORM_TOL_S = 1e-6  # max deviation of a grid time from t0 + k dt [s]
 
@@ -144,113 +132,6 @@ _DATASETS = {
     "tps/d_ppr": ((6,), "s/s", "d ppr / d tau_recv at the receiver's proper times tau = t0 + k dt"),
 }
 _RESERVED_ATTRS = ("version", "t0", "dt", "size")
-
-
-# ------------------------------------------------------------------ proper time
-
-@njit(cache=True)
-def _dd_cumsum(x, out):
-    """out[0] = 0, out[k] = sum of x[:k] (compensated, per column); x (N-1, M), out (N, M)."""
-    M = x.shape[1]
-    for m in range(M):
-        s = 0.0
-        e = 0.0
-        out[0, m] = 0.0
-        for k in range(x.shape[0]):
-            y = x[k, m]
-            t = s + y
-            bb = t - s
-            err = (s - (t - bb)) + (y - bb)
-            s = t
-            e += err
-            out[k + 1, m] = s + e
-
-
-def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Proper-time deviation delta_tau_i(t) = tau_i(t) - t of clocks on the orbits r_i(t).
-
-    d tau/dt = 1 - f with f = (GM/|r| + |v|^2/2) / c^2 (geocentric, the
-    Earth's monopole; t is taken as the geocentric coordinate time),
-    integrated with the end-corrected trapezoidal rule
-    int_k^{k+1} f = h (f_k + f_{k+1}) / 2 + h^2 (f'_k - f'_{k+1}) / 12,
-    f' = (-GM r.v/|r|^3 + v.a) / c^2 (error h^5 f''''/720 per step, ~1e-24 s
-    at 50 s on TianQin's orbit), summed with compensation; delta_tau = 0 at
-    the first sample.
-
-    t: (N,) grid times [s] (float64, or a dd (hi, lo) pair); r, v, a: (N, B,
-    3) positions [m], velocities [m/s], accelerations [m/s^2] (float64, GCRS)
-    of B clocks; gm [m^3/s^2] (default :data:`tqdyn.constants.GM_EARTH_EGM2008`).
-    Returns (delta_tau, rate, rate_dot), each (N, B): delta_tau [s],
-    d delta_tau/dt = -f [s/s] and its derivative -f' [1/s].
-    """
-    gm = float(GM_EARTH_EGM2008) if gm is None else float(gm)
-    if isinstance(t, tuple):
-        th, tl = (np.asarray(p, np.float64) for p in t)
-        h = (th[1:] - th[:-1]) + (tl[1:] - tl[:-1])
-    else:
-        h = np.diff(np.asarray(t, np.float64))
-    r, v, a = (np.asarray(x, np.float64) for x in (r, v, a))
-    rn = np.linalg.norm(r, axis=-1)
-    f = (gm / rn + 0.5 * np.einsum("...k,...k->...", v, v)) / C_LIGHT ** 2
-    fd = (-gm * np.einsum("...k,...k->...", r, v) / rn ** 3 + np.einsum("...k,...k->...", v, a)) / C_LIGHT ** 2
-    hh = h[:, None]
-    inc = hh * 0.5 * (f[:-1] + f[1:]) + hh * hh / 12.0 * (fd[:-1] - fd[1:])
-    out = np.empty_like(f)
-    _dd_cumsum(np.ascontiguousarray(-inc), out)
-    return out, -f, -fd
-
-
-# ------------------------------------------------------------------ the quantities
-
-def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: float | None = None) -> dict[str, Any]:
-    """All datasets of a LISA orbit file from a tqdyn trajectory's arrays.
-
-    t: dd (hi, lo) grid times (N,) [s, TDB]; sat_r, sat_v, sat_a: (N, 3, 3)
-    satellite positions [m] (float64 or dd (hi, lo)), velocities [m/s],
-    total accelerations [m/s^2], GCRS; lp: the light travel times on the
-    same grid (:func:`tqdyn.lightpath.light_travel_times`); gm: Earth GM for
-    the proper times [m^3/s^2].  Definitions: see the module docstring.
-
-    Returns a dict with ``t`` (N,) float64 and the arrays of :data:`_DATASETS`
-    (keys ``"tcb/x"`` ...) for all N rows (rows without a light travel time
-    are NaN), plus ``ltt_lo`` (N, 6) (dd remainder of tcb/ltt) and
-    ``t_init`` (float, where delta_tau = 0).
-    """
-    th, tl = (np.asarray(p, np.float64) for p in t)
-
-    def f64(x):
-        return x[0] + x[1] if isinstance(x, tuple) else np.asarray(x, np.float64)
-
-    x, v, a = f64(sat_r), f64(sat_v), np.asarray(sat_a, np.float64)
-    dtau, rate, rate_dot = proper_time_deviation((th, tl), x, v, a, gm)
-    ltt = lp.tau[0] + lp.tau[1]
-    ltt_lo = lp.tau[1] - (ltt - lp.tau[0])
-    d_ltt = lp.tau_rate
-    # receiver clock at t, emitter clock at t - ltt (Taylor series about the grid time t)
-    dt_r, rate_r = dtau[:, _RECV], rate[:, _RECV]
-    dt_e = dtau[:, _EMIT] - ltt * rate[:, _EMIT] + 0.5 * ltt ** 2 * rate_dot[:, _EMIT]
-    rate_e = rate[:, _EMIT] - ltt * rate_dot[:, _EMIT]
-    ppr = lp.tau[0] + (lp.tau[1] + (dt_r - dt_e))
-    d_ppr = (rate_r - rate_e + d_ltt * (1.0 + rate_e)) / (1.0 + rate_r)
-    # proper-time grid: coordinate time of tau = t_k is t_k + delta_t, delta_t = -delta_tau(t_k + delta_t)
-    delta_t = -dtau
-    delta_t = -(dtau + rate * delta_t)
-    shift = delta_t[:, _RECV]
-    tgrid = th + tl
-    # d(d_ppr)/dt by second-order finite differences over the rows that have a light travel time
-    d_ppr_dt = np.full_like(d_ppr, np.nan)
-    ok = np.all(np.isfinite(d_ppr), axis=1)
-    i0 = int(np.argmax(ok)) if ok.any() else ok.size
-    if ok.size - i0 >= 3 and ok[i0:].all():
-        d_ppr_dt[i0:] = np.gradient(d_ppr[i0:], tgrid[i0:], axis=0, edge_order=2)
-    tps_ppr = ppr + shift * d_ppr * (1.0 + rate_r)
-    tps_d_ppr = d_ppr + shift * d_ppr_dt
-    return {
-        "t": tgrid, "t_init": float(tgrid[0]),
-        "tcb/x": x, "tcb/v": v, "tcb/a": a, "tcb/delta_tau": dtau, "tcb/n": lp.unit_vectors,
-        "tcb/ltt": ltt, "tcb/d_ltt": d_ltt, "tcb/ppr": ppr, "tcb/d_ppr": d_ppr,
-        "tps/delta_t": delta_t, "tps/ppr": tps_ppr, "tps/d_ppr": tps_d_ppr, "ltt_lo": ltt_lo,
-    }
 
 
 # ------------------------------------------------------------------ writer
@@ -293,7 +174,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
     32, 21 with "ij" received by i from j; spacecraft axis 1, 2, 3)
     ----------
     path : str or os.PathLike
-        Destination (checked with :func:`tqdyn.io.check_writable`; an
+        Destination (checked with :func:`tqdyn.formats.trajectory.check_writable`; an
         existing file is replaced only when the new one is complete).
     t : (N,)
         Coordinate times [s] (float64 or a dd (hi, lo) pair); must be a
@@ -321,7 +202,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
 
     Every array must be finite (lisainstrument rejects NaN).  Returns the
     absolute path written.  Raises ValueError (bad input, naming the field)
-    or :class:`tqdyn.io.OutputError` (path not writable).
+    or :class:`tqdyn.formats.trajectory.OutputError` (path not writable).
     """
     out = _io.check_writable(path)
     t0, dt = _uniform_grid(t)
@@ -385,113 +266,3 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
         raise
     return out
 
-
-# ------------------------------------------------------------------ trajectory adapter
-
-@dataclass(frozen=True)
-class LisaExport:
-    """Summary of one export: ``path`` written; ``size`` samples from ``t0``
-    every ``dt`` [s, TDB since ``epoch_utc``]; ``dropped_rows`` leading rows
-    without an emission time inside the trajectory; ``source`` "tm" | "sat"
-    and ``note`` (light-path endpoints); ``ltt_range`` (min, max) [s];
-    ``shapiro`` whether the Earth Shapiro delay is included."""
-
-    path: pathlib.Path
-    size: int
-    t0: float
-    dt: float
-    dropped_rows: int
-    source: str
-    note: str
-    ltt_range: tuple[float, float]
-    shapiro: bool
-
-
-def _scenario_gm(toml_text: str) -> float | None:
-    """forces.gm_earth of a resolved scenario TOML, or None."""
-    try:
-        raw = tomllib.loads(toml_text or "")
-        gm = raw.get("forces", {}).get("gm_earth")
-        return float(gm) if gm is not None else None
-    except (tomllib.TOMLDecodeError, TypeError, ValueError, AttributeError):
-        return None
-
-
-def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None = None) -> LisaExport:
-    """Export a tqdyn trajectory (file path or :class:`tqdyn.io.Trajectory`) to a LISA orbit file.
-
-    Light travel times come from :func:`tqdyn.lightpath.light_travel_times_of`
-    (test mass to test mass if the trajectory has ``tm/r``, ``tm/v``,
-    ``tm/a``; satellite centres otherwise); satellite states from ``sat/r``,
-    ``sat/v``, ``sat/a_gravity`` (+ ``sat/a_dragfree``); proper times with
-    the Earth GM ``gm`` (default: the trajectory scenario's
-    ``forces.gm_earth``, else :data:`tqdyn.constants.GM_EARTH_EGM2008`).
-    The grid must be uniform and hold 3 satellites.  Leading rows whose
-    emission time precedes the first sample are dropped (normally one).
-    ``shapiro``: include the Earth's Shapiro delay in ltt.
-
-    Returns a :class:`LisaExport`.  Raises FileNotFoundError (no input
-    file), ValueError (:class:`tqdyn.io.TrajectoryFormatError` or unusable
-    content, naming the field) or :class:`tqdyn.io.OutputError`.
-    """
-    if isinstance(trajectory, (str, os.PathLike)):
-        traj = _io.read_trajectory(trajectory)
-        src = str(traj.path)
-    else:
-        traj = trajectory
-        src = str(getattr(trajectory, "path", ""))
-    out = _io.check_writable(out_path)
-    if src and out.exists() and os.path.exists(src) and os.path.samefile(src, out):
-        raise ValueError(f"output {str(out)!r} is the input trajectory; choose another output path")
-    if traj.n_sat != 3:
-        raise ValueError(f"{src}: n_sat = {traj.n_sat}; a LISA orbit file needs 3 satellites")
-    for f in ("t", "sat/r", "sat/v", "sat/a_gravity"):
-        if f not in traj:
-            raise ValueError(f"{src}: has no field {f!r} (needed for the LISA export)")
-    if len(traj) < 3:
-        raise ValueError(f"{src}: {len(traj)} time rows; the LISA export needs at least 3")
-    t = traj.dd("t")
-    _uniform_grid(t, f"{src}: t")
-    attrs = dict(getattr(traj, "attrs", {}) or {})
-    gm_v = gm if gm is not None else _scenario_gm(str(attrs.get("scenario", "")))
-    gm_v = float(GM_EARTH_EGM2008) if gm_v is None else float(gm_v)
-    lp = light_travel_times_of(traj, shapiro=shapiro, gm=gm_v)
-    sat_a = np.asarray(traj["sat/a_gravity"], np.float64)
-    if "sat/a_dragfree" in traj:
-        sat_a = sat_a + np.asarray(traj["sat/a_dragfree"], np.float64)
-    q = lisa_orbit_quantities(t, traj.dd("sat/r"), traj.dd("sat/v"), sat_a, lp, gm_v)
-    valid = np.all(np.isfinite(q["tcb/ltt"]), axis=1)
-    i0 = int(np.argmax(valid)) if valid.any() else len(valid)
-    if i0 >= len(valid) - 1 or not valid[i0:].all():
-        raise ValueError(f"{src}: light travel times undefined beyond the leading rows; cannot export")
-    sl = slice(i0, None)
-    endpoints = ("test masses (TM of satellite i facing j <- TM of satellite j facing i)" if lp.source == "tm"
-                 else "satellite centres of mass (the trajectory has no test-mass fields)")
-    meta = {
-        "generator": "tqdyn.formats.lisa",
-        "tqdyn_version": _TQDYN_VERSION,
-        "frame": _FRAME,
-        "time_scale": _TIME,
-        "epoch_utc": str(attrs.get("epoch_utc", "")),
-        "t_init": q["t_init"],
-        "tt_method": "iterative (Newton, double-double, quintic Hermite dense output of the emitter)",
-        "ignore_shapiro": not shapiro,
-        "ltt_endpoints": endpoints,
-        "ltt_note": lp.note,
-        "link_order": "12, 23, 31, 13, 32, 21 (ij: received by spacecraft i, emitted by spacecraft j)",
-        "tps_definition": _TPS_DEFINITION,
-        "gm_earth": gm_v,
-        "dropped_rows": i0,
-        "precision_note": "float64 datasets; dd remainder of tcb/ltt in tqdyn/ltt_lo (ltt = tcb/ltt + tqdyn/ltt_lo)",
-        "source_trajectory": src,
-        "tqdyn_scenario": str(attrs.get("scenario", "")),
-    }
-    path = write_lisa_orbits(
-        out, q["t"][sl], q["tcb/x"][sl], q["tcb/v"][sl], q["tcb/a"][sl], q["tcb/ltt"][sl], q["tcb/d_ltt"][sl],
-        q["tcb/n"][sl], q["tcb/ppr"][sl], q["tcb/d_ppr"][sl], delta_tau=q["tcb/delta_tau"][sl],
-        tps_ppr=q["tps/ppr"][sl], tps_d_ppr=q["tps/d_ppr"][sl], tps_delta_t=q["tps/delta_t"][sl],
-        attrs=meta, extra={"tqdyn/ltt_lo": q["ltt_lo"][sl]})
-    t0, dt = _uniform_grid(q["t"][sl])
-    ltt = q["tcb/ltt"][sl]
-    return LisaExport(path=path, size=int(ltt.shape[0]), t0=t0, dt=dt, dropped_rows=i0, source=lp.source,
-                      note=lp.note, ltt_range=(float(ltt.min()), float(ltt.max())), shapiro=bool(shapiro))

@@ -15,7 +15,7 @@ geocentric), where
 * r_e(t - tau) is the *emitting* body -- the TM of satellite b in the MOSA
   that faces a -- at the emission time, from the quintic Hermite dense output
   of its grid positions, velocities and accelerations
-  (:func:`tqdyn.integrators.hermite.hermite_eval`, nodes at the two ends of
+  (:func:`tqdyn.numerics.hermite.hermite_eval`, nodes at the two ends of
   the grid interval holding t - tau), evaluated in double-double (dd) so
   that the 1.7e8 m arms keep ~1e-24 m resolution.  The quintic's error is
   at most ~|r| (n h)^6 / 46080, about 2e-15 m on a 1e8 m orbit at h = 50 s,
@@ -41,13 +41,15 @@ Shapiro delay of the Earth (off by default, as in the paper):
 2 GM/c^3 ln((r_e + r_r + L)/(r_e + r_r - L)) with r_e = |r_e(t - tau)|,
 r_r = |r_r(t)|, L = |D|; about 7.8e-11 s (2.3 cm) for TianQin, nearly
 constant (it varies with the arm lengths only).  GM defaults to
-:data:`tqdyn.constants.GM_EARTH_EGM2008`.
+:data:`tqdyn.astro.constants.GM_EARTH_EGM2008`.  The delay by itself:
+:func:`tqdyn.lightpath.shapiro.shapiro_delay`; the instantaneous ranges
+(no light travel time): :func:`tqdyn.lightpath.ranges.instantaneous_ranges`.
 
 Bodies: the core functions take arrays, either test masses ``(N, 3, 2, 3)``
 [time, satellite, MOSA/TM, xyz] or satellite centres ``(N, 3, 3)`` [time,
 satellite, xyz] (then receiver and emitter are the satellites' centres of
 mass).  :func:`light_travel_times_of` takes a trajectory object (duck-typed
-like :class:`tqdyn.io.Trajectory`: ``name in traj``, ``traj.dd(name)``,
+like :class:`tqdyn.formats.trajectory.Trajectory`: ``name in traj``, ``traj.dd(name)``,
 ``traj[name]``) and falls back to the satellite centres when it has no test
 masses (pure-gravity runs), saying so in the result's ``source`` and
 ``note``.
@@ -56,7 +58,7 @@ dd inputs: positions and velocities are given as a ``(hi, lo)`` tuple of
 float64 arrays, as a float64 array with a trailing axis of length 2
 (``[..., 0] = hi``), or as plain float64 (lo = 0); accelerations are float64
 (a float64 acceleration costs < 1e-15 m in the interpolated position, see
-:mod:`tqdyn.integrators.hermite`).  dd outputs are ``(hi, lo)`` tuples.
+:mod:`tqdyn.numerics.hermite`).  dd outputs are ``(hi, lo)`` tuples.
 """
 
 from __future__ import annotations
@@ -66,7 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
+from ..astro.constants import C_LIGHT
 from ..constellation.indices import LINKS
 from ..numerics.hermite import hermite_eval
 from ..numerics.dd import (
@@ -75,23 +77,20 @@ from ..numerics.dd import (
     ld,
     mul,
     np_dd_add,
-    np_dd_sqr,
-    np_dd_sqrt,
     np_two_prod,
     np_two_sum,
     sqrt,
     st,
     sub,
 )
+from .shapiro import _default_gm
 
 __all__ = [
     "BODY_LAYOUTS",
     "LightTravelTimes",
-    "instantaneous_ranges",
     "light_travel_times",
     "light_travel_times_of",
     "link_bodies",
-    "shapiro_delay",
 ]
 
 BODY_LAYOUTS = ("tm", "sat")
@@ -103,10 +102,6 @@ _RECV_SAT = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
 _EMIT_SAT = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
 _RECV_MOSA = np.array([ln.receiver.mosa_facing(ln.emitter).index for ln in LINKS], dtype=np.intp)
 _EMIT_MOSA = np.array([ln.emitter.mosa_facing(ln.receiver).index for ln in LINKS], dtype=np.intp)
-
-
-def _default_gm() -> float:
-    return float(GM_EARTH_EGM2008)
 
 
 # ------------------------------------------------------------------ input helpers
@@ -386,21 +381,6 @@ class LightTravelTimes:
         return (nvr - nve + C_LIGHT * s_dot) / (C_LIGHT - nve)
 
 
-def shapiro_delay(r_emit, r_receive, gm: float | None = None) -> np.ndarray:
-    """Shapiro delay of the Earth 2 GM/c^3 ln((r_e + r_r + L)/(r_e + r_r - L)) [s].
-
-    r_emit, r_receive: (..., 3) geocentric GCRS positions [m] of the emitter
-    (at emission) and the receiver (at reception), float64; L = |r_e - r_r|.
-    gm: [m^3/s^2], default :data:`tqdyn.constants.GM_EARTH_EGM2008`.
-    Returns (...) float64."""
-    gm = _default_gm() if gm is None else float(gm)
-    re = np.asarray(r_emit, np.float64)
-    rr = np.asarray(r_receive, np.float64)
-    a, b = np.linalg.norm(re, axis=-1), np.linalg.norm(rr, axis=-1)
-    L = np.linalg.norm(re - rr, axis=-1)
-    return 2.0 * gm / C_LIGHT ** 3 * np.log((a + b + L) / (a + b - L))
-
-
 def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = None, tol: float = 1e-24,
                        max_iter: int = 10, note: str | None = None) -> LightTravelTimes:
     """Solve the light-travel-time equation of the six links on the grid ``t``.
@@ -422,7 +402,7 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
         Include the Earth's Shapiro delay (default False, as in the paper).
     gm : float
         GM of the Earth for the Shapiro delay [m^3/s^2] (default
-        :data:`tqdyn.constants.GM_EARTH_EGM2008`).
+        :data:`tqdyn.astro.constants.GM_EARTH_EGM2008`).
     tol : float
         Convergence threshold on the Newton correction [s].
     max_iter : int
@@ -497,33 +477,10 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
         iterations=iters, source=layout, note=note, shapiro_k=shap_k)
 
 
-def instantaneous_ranges(r) -> tuple[np.ndarray, np.ndarray]:
-    """Instantaneous ranges |r_emitter(t) - r_receiver(t)| of the six links, in dd.
-
-    r: dd positions [m], GCRS, of the test masses (N, 3, 2, 3) or of the
-    satellite centres (N, 3, 3) (``(hi, lo)`` tuple, trailing axis 2, or
-    float64).  Bodies per link as in :func:`link_bodies` (TM facing TM, or
-    centre to centre); links ab and ba give the same value.  No light travel
-    time: both ends at the same coordinate time t (TDB), for comparison with
-    the light-path ranges c tau.  Returns (hi, lo), each (N, 6) [m], LISA
-    link order.
-    """
-    rh, rl = _dd_input(r, "r")
-    layout = _layout_of(rh.shape, "r")
-    rec_h, emit_h = link_bodies(rh, layout)
-    rec_l, emit_l = link_bodies(rl, layout)
-    dh, dl = np_dd_add(emit_h, emit_l, -rec_h, -rec_l)
-    s2h, s2l = np_dd_sqr(dh[..., 0], dl[..., 0])
-    for q in (1, 2):
-        qh, ql = np_dd_sqr(dh[..., q], dl[..., q])
-        s2h, s2l = np_dd_add(s2h, s2l, qh, ql)
-    return np_dd_sqrt(s2h, s2l)
-
-
 def light_travel_times_of(trajectory, **kwargs) -> LightTravelTimes:
     """:func:`light_travel_times` for a trajectory object.
 
-    ``trajectory`` is duck-typed like :class:`tqdyn.io.Trajectory`
+    ``trajectory`` is duck-typed like :class:`tqdyn.formats.trajectory.Trajectory`
     (``name in trajectory``, ``trajectory.dd(name)`` -> (hi, lo),
     ``trajectory[name]`` -> float64).  With the test-mass fields ``tm/r``,
     ``tm/v``, ``tm/a`` the links run TM to TM (``source = "tm"``).  Without

@@ -2,31 +2,30 @@
 
 This module composes the library: it chooses the fields and root attributes
 of the output file from the scenario, streams the propagator's rows into
-:class:`tqdyn.io.TrajectoryWriter` (atomic: no file, or a complete one),
-writes resumable checkpoints and resumes from them.  It prints nothing; the
-CLI and the sweep driver report.
+:class:`tqdyn.formats.trajectory.TrajectoryWriter` (atomic: no file, or a
+complete one), writes resumable checkpoints (file format:
+:mod:`tqdyn.formats.checkpoint`) and resumes from them.  It prints nothing;
+the CLI and the sweep driver report.
 
 Errors: bad input (scenario, output path, data limits, a checkpoint of
-another run) raises ``ValueError`` / :class:`tqdyn.io.OutputError` before
-anything is written.  Any exception during the propagation (including
-``KeyboardInterrupt``) is re-raised after clean-up; its attribute
-``tqdyn_checkpoint`` is the checkpoint path if the run can be resumed
-(``--resume``), else None.
+another run) raises ``ValueError`` /
+:class:`tqdyn.formats.trajectory.OutputError` before anything is written.
+Any exception during the propagation (including ``KeyboardInterrupt``) is
+re-raised after clean-up; its attribute ``tqdyn_checkpoint`` is the
+checkpoint path if the run can be resumed (``--resume``), else None.
 """
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
-
 from ..formats import trajectory as io
 from .. import dynamics
 from ..dynamics import Checkpoint, Rows, RunResult, row_names
+from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
 __all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
 
@@ -132,7 +131,8 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
 
     def save_checkpoint(c: Checkpoint):
         partial = writer.sync()
-        _write_checkpoint(ckpt, scen.to_toml(), scen.run.precision, c, partial, writer.rows_written)
+        write_checkpoint(ckpt, scenario=scen.to_toml(), precision=scen.run.precision, n=c.n, y=c.y,
+                         comp=c.comp, partial=partial, rows=writer.rows_written)
 
     try:
         result = dynamics.propagate(scen, sink=lambda rows: writer.append(row_fields(rows)), progress=progress, model=model, start=start,
@@ -152,29 +152,15 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
     return RunSummary(result=result, path=out_path, rows=rows, compile_s=compile_s)
 
 
-def _write_checkpoint(path, scenario_toml, precision, c, partial, rows):
-    """Atomically write a run checkpoint (npz): the resolved scenario, the
-    step count, the state (all propagated bodies, TMs included in the free-TM
-    mode) and its compensation, the partial trajectory file and how many of
-    its rows the checkpoint covers."""
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
-        np.savez(fh, scenario=np.array(scenario_toml), precision=np.array(precision), n=np.array(c.n),
-                 y=c.y, comp=c.comp, partial=np.array(partial), rows=np.array(rows))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-
-
 def _resume(ckpt_path, scen, out_path):
     """(Checkpoint, writer factory) of an interrupted run; ValueError if
     there is none or it belongs to another scenario."""
     if not ckpt_path.exists():
         raise ValueError(f"--resume: no checkpoint {ckpt_path} to continue from")
-    with np.load(ckpt_path, allow_pickle=False) as data:
-        if str(data["scenario"]) != scen.to_toml() or str(data["precision"]) != scen.run.precision:
-            raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
-                             f"precision; give the same arguments as the interrupted run")
-        start = Checkpoint(int(data["n"]), np.array(data["y"]), np.array(data["comp"]))
-        partial, rows = str(data["partial"]), int(data["rows"])
+    data = read_checkpoint(ckpt_path)
+    if data.scenario != scen.to_toml() or data.precision != scen.run.precision:
+        raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
+                         f"precision; give the same arguments as the interrupted run")
+    start = Checkpoint(data.n, data.y, data.comp)
+    partial, rows = data.partial, data.rows
     return start, lambda: io.TrajectoryWriter.reopen(partial, out_path, rows)

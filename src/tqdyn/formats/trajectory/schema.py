@@ -1,0 +1,236 @@
+"""The ``tqdyn-trajectory`` format itself: identity, field catalogue, root attributes.
+
+:data:`FORMAT`, :data:`FORMAT_VERSION`, the per-field description
+:data:`FIELDS` (:class:`FieldSpec`), the root attributes :data:`ROOT_ATTRS`
+and their checks, the two error types and the small helpers shared by
+:mod:`~tqdyn.formats.trajectory.writer` and
+:mod:`~tqdyn.formats.trajectory.reader`.  Conventions: see
+:mod:`tqdyn.formats.trajectory` and ``docs/trajectory-format.md``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from ... import __version__ as _TQDYN_VERSION
+
+__all__ = [
+    "FORMAT",
+    "FORMAT_VERSION",
+    "FieldSpec",
+    "FIELDS",
+    "ROOT_ATTRS",
+    "OutputError",
+    "TrajectoryFormatError",
+]
+
+FORMAT = "tqdyn-trajectory"
+"""Value of the root attribute ``format``."""
+
+FORMAT_VERSION = 1
+"""Format version written by :class:`~tqdyn.formats.trajectory.TrajectoryWriter`; readers accept
+any version <= this."""
+
+# ---------------------------------------------------------------------------
+# field catalogue
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FieldSpec:
+    """Description of one trajectory field (one HDF5 path).
+
+    Attributes
+    ----------
+    kind : str
+        ``"dd"`` (group with float64 datasets ``hi``/``lo``, value = hi + lo)
+        or ``"f8"`` (one float64 dataset).
+    shape : tuple of (str | int)
+        Trailing shape *without* the time axis; ``"sat"`` stands for the
+        satellite axis (length n_sat, 1..3), ``"tm"`` for the test-mass / MOSA
+        axis (length 2).  ``()`` for a scalar per time row.
+    unit : str
+        SI unit (``"1"`` for dimensionless).
+    frame : str
+        Frame the components are expressed in (or what the quantity refers to).
+    description : str
+        One-line meaning.
+    time_dependent : bool
+        True: stored with a leading time axis of length N (same N for every
+        time-dependent field).  False: static, stored with ``shape`` only.
+    dims : tuple of str
+        xarray dimension names for ``shape`` (``"sat"``, ``"tm"``, ``"comp"``,
+        ``"row"``, ``"col"``); the time axis (``"time"``) is not included.
+    """
+
+    kind: str
+    shape: tuple
+    unit: str
+    frame: str
+    description: str
+    time_dependent: bool
+    dims: tuple
+
+    def resolved_shape(self, n_sat: int) -> tuple[int, ...]:
+        """Trailing shape (no time axis) with ``sat`` -> n_sat and ``tm`` -> 2."""
+        return tuple(n_sat if a == "sat" else 2 if a == "tm" else int(a) for a in self.shape)
+
+
+def _f(kind, shape, dims, unit, frame, description, time_dependent=True):
+    return FieldSpec(kind, tuple(shape), unit, frame, description, time_dependent, tuple(dims))
+
+
+FIELDS: dict[str, FieldSpec] = {
+    "t": _f("dd", (), (), "s", "TDB",
+            "time since epoch_utc, TDB seconds"),
+    "sat/r": _f("dd", ("sat", 3), ("sat", "comp"), "m", "GCRS",
+                "satellite centre-of-mass position"),
+    "sat/v": _f("dd", ("sat", 3), ("sat", "comp"), "m/s", "GCRS",
+                "satellite centre-of-mass velocity"),
+    "sat/a_gravity": _f("f8", ("sat", 3), ("sat", "comp"), "m/s^2", "GCRS",
+                        "satellite gravitational acceleration, all gravitational terms"),
+    "sat/a_dragfree": _f("f8", ("sat", 3), ("sat", "comp"), "m/s^2", "GCRS",
+                         "drag-free control acceleration G_i of the satellite"),
+    "sat/T_S_I": _f("f8", ("sat", 3, 3), ("sat", "row", "col"), "1", "GCRS -> S",
+                    "rotation matrix inertial (GCRS) -> body frame S; rows are X_S, Y_S, Z_S "
+                    "in GCRS components"),
+    "sat/omega": _f("f8", ("sat", 3), ("sat", "comp"), "rad/s", "S",
+                    "angular velocity of S relative to GCRS, components in S"),
+    "sat/omega_dot": _f("f8", ("sat", 3), ("sat", "comp"), "rad/s^2", "S",
+                        "angular acceleration of S relative to GCRS, components in S"),
+    "sat/breathing_angle": _f("f8", ("sat",), ("sat",), "rad", "constellation",
+                              "breathing angle alpha_i: angle at satellite i between its two arms"),
+    "mosa/angle": _f("f8", ("sat", "tm"), ("sat", "tm"), "rad", "S",
+                     "angle of X_OA_l from X_S about Z_S (MOSA l = 1, 2)"),
+    "tm/r": _f("dd", ("sat", "tm", 3), ("sat", "tm", "comp"), "m", "GCRS",
+               "test-mass centre-of-mass position"),
+    "tm/v": _f("dd", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s", "GCRS",
+               "test-mass centre-of-mass velocity (extension of format version 1)"),
+    "tm/a": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s^2", "GCRS",
+               "test-mass total acceleration: gravity + self-gravity + suspension "
+               "(extension of format version 1)"),
+    "tm/housing_offset": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m", "GCRS",
+                            "free-TM verification mode: TM position minus its housing centre "
+                            "(extension of format version 1)"),
+    "tm/a_suspension": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s^2", "OA_l",
+                          "test-mass suspension (actuation) acceleration"),
+    "tm/alpha_suspension": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "rad/s^2", "OA_l",
+                              "angular acceleration the test mass needs (suspension)"),
+    "tm/self_gravity": _f("f8", ("sat", "tm", 3), ("sat", "tm", "comp"), "m/s^2", "OA_l",
+                          "spacecraft self-gravity acceleration at the test mass (static)",
+                          time_dependent=False),
+}
+"""Every field of format version 1, keyed by HDF5 path, in canonical order."""
+
+ROOT_ATTRS: dict[str, str] = {
+    "format": f'str, always "{FORMAT}"',
+    "format_version": f"int, {FORMAT_VERSION}",
+    "tqdyn_version": "str, version of tqdyn that wrote the file",
+    "scenario": "str, the resolved scenario as TOML text",
+    "epoch_utc": "str, ISO 8601 UTC label of t = 0",
+    "time_scale": 'str, always "TDB"',
+    "frame": 'str, always "GCRS"',
+    "precision": 'str, "dd" | "float64"',
+    "step_s": "float, integrator / output step in s",
+    "integrator": "str, integrator name",
+    "pointing": 'str, "global" | "taylor1" | "taylor2" | "iterative" | "none"',
+    "control": 'str, "on" | "off"',
+}
+"""Root attributes of format version 1 and their type / allowed values."""
+
+_REQUIRED_USER_ATTRS = ("scenario", "epoch_utc", "precision", "step_s", "integrator",
+                        "pointing", "control")
+_CHOICES = {
+    "precision": ("dd", "float64"),
+    "pointing": ("global", "taylor1", "taylor2", "iterative", "none"),
+    "control": ("on", "off"),
+    "time_scale": ("TDB",),
+    "frame": ("GCRS",),
+}
+_COORDS = {
+    "tm": [1, 2],
+    "comp": ["x", "y", "z"],
+    "row": ["X_S", "Y_S", "Z_S"],
+    "col": ["x", "y", "z"],
+}
+
+
+class OutputError(OSError):
+    """The output path cannot be written (one-line message naming the path)."""
+
+
+class TrajectoryFormatError(ValueError):
+    """A file is not a readable tqdyn trajectory (one-line message naming the file)."""
+
+
+# ---------------------------------------------------------------------------
+# small helpers
+# ---------------------------------------------------------------------------
+
+
+def _fmt_shape(shape) -> str:
+    return "(" + ", ".join(str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+
+
+def _symbolic(spec: FieldSpec) -> str:
+    names = {"sat": "n_sat", "tm": "tm"}
+    return _fmt_shape(("rows",) + tuple(names.get(a, a) for a in spec.shape))
+
+
+def _spec(path: str, where: str) -> FieldSpec:
+    try:
+        return FIELDS[path]
+    except KeyError:
+        raise ValueError(f"{where}: unknown field {path!r}; allowed: {', '.join(FIELDS)}") from None
+
+
+def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """Validate the caller's root attributes and return the full attribute dict."""
+    if not isinstance(attrs, Mapping):
+        raise TypeError(f"attrs must be a mapping, got {type(attrs).__name__}")
+    missing = [k for k in _REQUIRED_USER_ATTRS if k not in attrs]
+    if missing:
+        raise ValueError(f"attrs: missing required root attribute(s) {', '.join(missing)}")
+    out: dict[str, Any] = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "tqdyn_version": _TQDYN_VERSION,
+        "time_scale": "TDB",
+        "frame": "GCRS",
+    }
+    for key, val in attrs.items():
+        if not isinstance(key, str) or not key:
+            raise ValueError(f"attrs: attribute names must be non-empty str, got {key!r}")
+        if isinstance(val, (bool, np.bool_)):
+            raise ValueError(f"attrs[{key!r}]: bool is not allowed; use a str (e.g. \"on\"/\"off\")")
+        if isinstance(val, np.generic):
+            val = val.item()
+        if not isinstance(val, (str, int, float)):
+            raise ValueError(f"attrs[{key!r}]: must be str, int or float, got {type(val).__name__}")
+        out[key] = val
+    if out["format"] != FORMAT or out["format_version"] != FORMAT_VERSION:
+        raise ValueError(f"attrs: format/format_version are set by the writer and must be "
+                         f"{FORMAT!r}/{FORMAT_VERSION}, got {out['format']!r}/{out['format_version']!r}")
+    out["format"], out["format_version"] = FORMAT, FORMAT_VERSION  # exact types (str, int)
+    for key, allowed in _CHOICES.items():
+        if out[key] not in allowed:
+            raise ValueError(f"attrs[{key!r}] = {out[key]!r}; allowed: {' | '.join(allowed)}")
+    for key in ("scenario", "epoch_utc", "integrator", "tqdyn_version"):
+        if not isinstance(out[key], str):
+            raise ValueError(f"attrs[{key!r}]: must be str, got {type(out[key]).__name__}")
+    try:
+        _dt.datetime.fromisoformat(out["epoch_utc"])
+    except ValueError:
+        raise ValueError(f"attrs['epoch_utc'] = {out['epoch_utc']!r} is not an ISO 8601 "
+                         "date-time (e.g. 2034-01-01T00:00:00)") from None
+    step = out["step_s"]
+    if isinstance(step, str) or not math.isfinite(step):
+        raise ValueError(f"attrs['step_s'] = {step!r}; must be a finite number of seconds")
+    out["step_s"] = float(step)
+    return out
+
