@@ -24,7 +24,7 @@ from typing import Callable
 
 from ..formats import trajectory as io
 from .. import dynamics
-from ..dynamics import Checkpoint, Rows, RunResult, row_names
+from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
 __all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
@@ -50,16 +50,10 @@ class RunSummary:
         return self.path.stat().st_size / 1e6
 
 
-def row_fields(rows: Rows) -> dict:
-    """The trajectory-file fields of a block of output rows: attribute ``sat_r``
-    is field ``sat/r`` (the first underscore is the group separator)."""
-    return {name.replace("_", "/", 1): value for name, value in rows.items()}
-
-
 def output_fields(scen) -> tuple[str, ...]:
     """Trajectory fields a run of ``scen`` writes (see :data:`tqdyn.formats.trajectory.FIELDS`)."""
     c = scen.constellation
-    fields = [name.replace("_", "/", 1) for name in row_names(c.coupled, c.free_tms)]
+    fields = [io.field_path(name) for name in row_names(c.coupled, c.free_tms)]
     return tuple(fields + (["tm/self_gravity"] if c.coupled else []))
 
 
@@ -135,7 +129,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
                          comp=c.comp, partial=partial, rows=writer.rows_written)
 
     try:
-        result = dynamics.propagate(scen, sink=lambda rows: writer.append(row_fields(rows)), progress=progress, model=model, start=start,
+        result = dynamics.propagate(scen, sink=lambda rows: writer.append(io.row_fields(rows)), progress=progress, model=model, start=start,
                                       checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
         rows = writer.rows_written
         writer.close()

@@ -39,6 +39,8 @@ from .schema import (
     FieldSpec,
     OutputError,
     TrajectoryFormatError,
+    field_path,
+    row_fields,
 )
 from .writer import TrajectoryWriter, check_writable
 
@@ -54,4 +56,6 @@ __all__ = [
     "TrajectoryWriter",
     "Trajectory",
     "read_trajectory",
+    "field_path",
+    "row_fields",
 ]

@@ -27,6 +27,8 @@ __all__ = [
     "ROOT_ATTRS",
     "OutputError",
     "TrajectoryFormatError",
+    "field_path",
+    "row_fields",
 ]
 
 FORMAT = "tqdyn-trajectory"
@@ -158,6 +160,23 @@ _COORDS = {
     "row": ["X_S", "Y_S", "Z_S"],
     "col": ["x", "y", "z"],
 }
+
+
+def field_path(row_name: str) -> str:
+    """The field (HDF5 path) of an output quantity of the propagation, named
+    as the attribute of :class:`tqdyn.dynamics.Rows`: the first underscore is
+    the group separator (``sat_r`` -> ``sat/r``, ``mosa_angle`` ->
+    ``mosa/angle``, ``t`` -> ``t``).  The xarray view names variables the
+    other way round (:meth:`Trajectory.to_xarray`)."""
+    path = row_name.replace("_", "/", 1)
+    _spec(path, "rows")
+    return path
+
+
+def row_fields(rows) -> dict[str, Any]:
+    """A block of output rows (:class:`tqdyn.dynamics.Rows`) as the mapping
+    field path -> values that :meth:`TrajectoryWriter.append` takes."""
+    return {field_path(name): value for name, value in rows.items()}
 
 
 class OutputError(OSError):
