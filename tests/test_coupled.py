@@ -310,24 +310,18 @@ def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
     """The attitude integrated with a local pointing law equals the frames
     that constellation.pointing computes afterwards from the propagated
     states (iterative: the light-travel-time equation solved to 1e-20 s on
-    the 4-node Hermite dense output of the trajectory, an implementation
-    independent of the compiled Taylor-model solver)."""
+    the Hermite dense output of the trajectory by tqdyn.lightpath, an
+    implementation independent of the compiled Taylor-model solver)."""
     from tqdyn.constellation import pointing as P
-    from tqdyn.numerics.hermite import interpolate_states
+    from tqdyn.lightpath import light_travel_times
 
     _, tr, _ = _run(tmp_path, f"{law}.h5", CHEAP + [f"constellation.pointing={law}"], "2h")
     assert tr.attrs["pointing"] == law
     t, R, V = tr.dd("t"), tr.dd("sat/r"), tr.dd("sat/v")
     A = tr["sat/a_gravity"] + tr["sat/a_dragfree"]
-    tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)
-
-    def position_at(sat, th, tl):
-        return interpolate_states(tn, Rd[:, sat.index], Vd[:, sat.index], A[:, sat.index],
-                                  np.stack([th, tl], -1), n_nodes=4)[0]
-
     sl = slice(1, None)  # the first row has no emission time inside the trajectory
-    b = P.beam_directions(law, tuple(x[sl] for x in R), tuple(x[sl] for x in V), A[sl],
-                          t=tuple(x[sl] for x in t), position_at=position_at)
+    lt = light_travel_times(t, R, V, A, tol=1e-20).select(sl) if law == "iterative" else None
+    b = P.beam_directions(law, tuple(x[sl] for x in R), tuple(x[sl] for x in V), A[sl], light_times=lt)
     f = P.pointing_frames(b.n)
     err_T = np.abs(f.T_S_I - tr["sat/T_S_I"][sl]).max()
     err_th = np.abs(0.5 * f.theta - tr["mosa/angle"][sl][..., 0]).max()

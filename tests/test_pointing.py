@@ -5,8 +5,8 @@ dd result (residual); (2) an exact mpmath root of the equation for a rigidly
 rotating equilateral triangle (positions evaluated analytically in mpmath);
 (3) the geometric convention (Rodrigues rotation of X_S about Z_S by
 +-theta/2 must give the beams from k and j); (4) the iterative solution on a
-real 1-day TianQin (Kepler) trajectory at 50 s with Hermite dense output
-(degree 11, tqdyn.integrators.hermite) as the reference for the other laws.
+real 1-day TianQin (Kepler) trajectory at 50 s (tqdyn.lightpath, on the
+quintic Hermite dense output of the grid) as the reference for the other laws.
 Numbers are printed (pytest -s); bounds are orders of magnitude, not tuned.
 """
 
@@ -19,7 +19,7 @@ import pytest
 from tqdyn.astro.constants import C_LIGHT
 from tqdyn.constellation import geometry as G
 from tqdyn.constellation import pointing as P
-from tqdyn.constellation.indices import Sat
+from tqdyn.constellation.indices import LINK_OF_MOSA, Sat
 from tqdyn.numerics.dd import mp_from_pair
 
 
@@ -37,20 +37,14 @@ def _raw(scenario):
 
 
 def _load(raw):
-    """The trajectory from its second row on, with a dd Hermite (degree 11)
-    position interpolator over the whole grid."""
-    from tqdyn.numerics.hermite import interpolate_states
+    """The trajectory from its second row on, with its light travel times
+    (the iterative law) solved on the whole grid."""
+    from tqdyn.lightpath import light_travel_times
 
     t, R, V, A = raw
-    tn, Rd, Vd = np.stack(t, -1), np.stack(R, -1), np.stack(V, -1)
-
-    def position_at(sat, th, tl):
-        r, _ = interpolate_states(tn, Rd[:, sat.index], Vd[:, sat.index], A[:, sat.index],
-                                  np.stack([th, tl], -1), n_nodes=4)
-        return r
-
+    lt = light_travel_times(t, R, V, A, tol=1e-20)
     sl = slice(1, None)  # the first node has no emission time inside the grid
-    return ((t[0][sl], t[1][sl]), (R[0][sl], R[1][sl]), (V[0][sl], V[1][sl]), A[sl], position_at)
+    return ((t[0][sl], t[1][sl]), (R[0][sl], R[1][sl]), (V[0][sl], V[1][sl]), A[sl], lt.select(sl))
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +58,8 @@ def trajectory(raw):
 
 
 def _all_laws(trajectory):
-    t, R, V, A, position_at = trajectory
-    return {law: P.beam_directions(law, R, V, A, t=t, position_at=position_at) for law in P.LAWS}
+    t, R, V, A, lt = trajectory
+    return {law: P.beam_directions(law, R, V, A, light_times=lt) for law in P.LAWS}
 
 
 @pytest.fixture(scope="module")
@@ -104,70 +98,71 @@ def test_mosa_rotation_convention(trajectory):
 
 def test_iterative_residual_in_mpmath(trajectory, beams):
     # reference: the equation tau = |r_j(t0 - tau) - r_i(t0)| / c, evaluated in
-    # mpmath (40 digits) on the dd tau, the dd emitter position the solver's
-    # interpolator returns at the dd time t0 - tau, and the dd receiver position.
-    t, R, V, A, position_at = trajectory
+    # mpmath (40 digits) on the dd tau and the dd emitter position of the
+    # solver, re-indexed by (satellite, MOSA), and the dd receiver position.
+    t, R, V, A, lt = trajectory
     it = beams["iterative"]
-    mpmath.mp.dps = 40
-    c = mpmath.mpf(C_LIGHT)
     worst = 0.0
-    for n in (0, 1, 500, 1727):
-        for s in Sat:
-            for m, e in ((0, s.k), (1, s.j)):
-                tau = mp_from_pair(*it.tau_dd[n, s.index, m])
-                te = mp_from_pair(t[0][n], t[1][n]) - tau
-                th = float(te)
-                tl = float(te - th)
-                re = position_at(e, np.array([th]), np.array([tl]))[0]
-                d2 = sum((mp_from_pair(*re[q]) - mp_from_pair(R[0][n, s.index, q], R[1][n, s.index, q])) ** 2
-                         for q in range(3))
-                worst = max(worst, float(abs(mpmath.sqrt(d2) / c - tau)))
-    print(f"iterative LTT residual (mpmath) max {worst:.2e} s; last correction max "
+    with mpmath.workdps(40):
+        c = mpmath.mpf(C_LIGHT)
+        for n in (0, 1, 500, 1727):
+            for s in Sat:
+                for m in (0, 1):
+                    link = LINK_OF_MOSA[s.index, m]
+                    tau = mp_from_pair(*it.tau_dd[n, s.index, m])
+                    assert tau == mp_from_pair(lt.tau[0][n, link], lt.tau[1][n, link])
+                    d2 = sum((mp_from_pair(lt.r_emit[0][n, link, q], lt.r_emit[1][n, link, q])
+                              - mp_from_pair(R[0][n, s.index, q], R[1][n, s.index, q])) ** 2 for q in range(3))
+                    worst = max(worst, float(abs(mpmath.sqrt(d2) / c - tau)))
+    print(f"iterative LTT residual (mpmath) max {worst:.2e} s; solver residual max "
           f"{np.max(np.abs(it.last_step)):.2e} s")
-    assert worst < 1e-20
+    assert worst < 1e-31   # dd rounding of |D| / c (0.58 s x 2^-106 = 7e-33 s); measured 1.4e-32 s
+    # MOSA 1 receives from k, MOSA 2 from j: the emitter of each beam is the right satellite
+    for s in Sat:
+        d = (lt.r_emit[0][:, LINK_OF_MOSA[s.index]] - R[0][:, [s.k.index, s.j.index]])
+        assert np.abs(d).max() < 2e4   # the emitter moved < 2 km/s x 0.6 s since emission
 
 
 def test_iterative_vs_exact_root_rigid_triangle():
     # reference: mpmath.findroot of the LTT equation for an equilateral triangle
-    # rotating rigidly on a circle (rho = 1e8 m, omega = 2e-5 rad/s), positions
-    # evaluated analytically in mpmath (the position_at callable does the same,
-    # rounded to dd).
-    mpmath.mp.dps = 50
-    rho, w = mpmath.mpf(10) ** 8, mpmath.mpf(2) / 10 ** 5
+    # rotating rigidly on a circle (rho = 1e8 m, omega = 2e-5 rad/s); the grid
+    # (50 s, exact positions, velocities and accelerations rounded to dd) goes
+    # through the solver of tqdyn.lightpath and is re-indexed by the law.
+    from tqdyn.lightpath import light_travel_times
 
-    def pos(s_index, tm):
-        ph = w * tm + 2 * mpmath.pi * s_index / 3
-        return [rho * mpmath.cos(ph), rho * mpmath.sin(ph), mpmath.mpf(0)]
+    with mpmath.workdps(50):
+        rho, w = mpmath.mpf(10) ** 8, mpmath.mpf(2) / 10 ** 5
 
-    def position_at(sat, th, tl):
-        out = np.empty((th.size, 3, 2))
-        for q, (a, b) in enumerate(zip(th, tl)):
-            p = pos(sat.index, mpmath.mpf(a) + mpmath.mpf(b))
-            for k in range(3):
-                hi = float(p[k])
-                out[q, k] = hi, float(p[k] - hi)
-        return out
+        def pos(s_index, tm):
+            ph = w * tm + 2 * mpmath.pi * s_index / 3
+            return [rho * mpmath.cos(ph), rho * mpmath.sin(ph), mpmath.mpf(0)]
 
-    times = [mpmath.mpf(1000), mpmath.mpf("123456.789")]
-    th = np.array([float(x) for x in times])
-    tl = np.array([float(x - float(x)) for x in times])
-    Rdd = np.empty((2, 3, 3, 2))
-    for q, tm in enumerate(times):
-        for s in range(3):
-            p = pos(s, tm)
-            for k in range(3):
-                Rdd[q, s, k] = float(p[k]), float(p[k] - float(p[k]))
-    tau, r_emit, last = P.solve_light_travel_time((th, tl), Rdd, position_at)
-    worst = 0.0
-    for q, tm in enumerate(times):
-        for s in Sat:
-            for m, e in ((0, s.k), (1, s.j)):
-                ri = pos(s.index, tm)
-                f = lambda x: mpmath.sqrt(sum((a - b) ** 2 for a, b in zip(pos(e.index, tm - x), ri))) / C_LIGHT - x
-                exact = mpmath.findroot(f, mpmath.sqrt(3) * rho / C_LIGHT)
-                worst = max(worst, float(abs(mp_from_pair(*tau[q, s.index, m]) - exact)))
+        def vel(s_index, tm):
+            ph = w * tm + 2 * mpmath.pi * s_index / 3
+            return [-rho * w * mpmath.sin(ph), rho * w * mpmath.cos(ph), mpmath.mpf(0)]
+
+        t0 = mpmath.mpf("123456.789") - 500
+        times = [t0 + 50 * k for k in range(21)]
+        dd = lambda x: (float(x), float(x - float(x)))  # noqa: E731
+        th = np.array([dd(x)[0] for x in times])
+        tl = np.array([dd(x)[1] for x in times])
+        R = np.array([[[dd(c) for c in pos(s, tm)] for s in range(3)] for tm in times])
+        V = np.array([[[dd(c) for c in vel(s, tm)] for s in range(3)] for tm in times])
+        A = np.array([[[float(-w * w * c) for c in pos(s, tm)] for s in range(3)] for tm in times])
+        lt = light_travel_times((th, tl), (R[..., 0], R[..., 1]), (V[..., 0], V[..., 1]), A, tol=1e-24)
+        it = P.beam_directions("iterative", (R[..., 0], R[..., 1]), light_times=lt)
+        worst = 0.0
+        for q in (1, 10, 20):
+            tm = times[q]
+            for s in Sat:
+                for m, e in ((0, s.k), (1, s.j)):
+                    ri = pos(s.index, tm)
+                    f = lambda x: mpmath.sqrt(sum((a - b) ** 2 for a, b in zip(pos(e.index, tm - x), ri))) / C_LIGHT - x
+                    exact = mpmath.findroot(f, mpmath.sqrt(3) * rho / C_LIGHT)
+                    worst = max(worst, float(abs(mp_from_pair(*it.tau_dd[q, s.index, m]) - exact)))
     print(f"iterative tau vs exact mpmath root (rigid triangle): {worst:.2e} s")
-    assert worst < 1e-20
+    # the quintic dense output 0.58 s from a node errs by ~1e-18 m (3e-27 s); measured 2.4e-27 s
+    assert worst < 1e-26
 
 
 def test_laws_vs_iterative_real_trajectory(raw):

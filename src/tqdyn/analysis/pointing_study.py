@@ -4,9 +4,9 @@ For every reception time of a trajectory's grid the incoming-beam directions
 of the three satellites are computed under the approximate laws ``global``,
 ``taylor1`` and ``taylor2`` (:mod:`tqdyn.constellation.pointing`) and
 compared with the ``iterative`` law (the light-travel-time equation solved
-in double-double with a degree-11 Hermite dense output of the emitters'
-stored positions, velocities and accelerations,
-:func:`tqdyn.integrators.hermite.interpolate_states` with 4 nodes).
+in double-double on the Hermite dense output of the emitters' stored
+positions, velocities and accelerations: :func:`tqdyn.lightpath.light_travel_times`
+of the satellite centres).
 
 Three error measures per law, all in rad (DESIGN 4b: the Taylor errors of
 the two beams of one satellite are nearly equal and opposite, so they almost
@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constellation import pointing as _pointing
-from ..numerics.hermite import interpolate_states
+from ..lightpath import light_travel_times
 
 __all__ = ["APPROXIMATE_LAWS", "LawComparison", "PointingStudy", "compare_pointing_laws", "pointing_study_of"]
 
@@ -83,7 +83,7 @@ class PointingStudy:
 
     t : (M,) float64 reception times [s, TDB since the epoch]; laws : law
     name -> :class:`LawComparison`; tau_error : (M, 3, 2) [s], |L/c -
-    tau_iterative|; ltt_residual : largest last correction of the iterative
+    tau_iterative|; ltt_residual : largest residual of the light-time equation of the iterative
     light-travel-time solution [s] (its convergence).
     """
 
@@ -123,7 +123,8 @@ def compare_pointing_laws(t, R, V, A, *, laws=APPROXIMATE_LAWS, stride: int = 1,
     stride : evaluate every ``stride``-th grid time (the interpolation always
         uses the whole grid); the first row is skipped (its emission time lies
         before the grid).
-    tol : convergence threshold of the iterative light travel time [s].
+    tol : convergence threshold of the iterative light travel time [s]
+        (Newton correction of :func:`tqdyn.lightpath.light_travel_times`).
 
     Returns :class:`PointingStudy` with M = len(range(1, N, stride)) times.
     """
@@ -138,24 +139,17 @@ def compare_pointing_laws(t, R, V, A, *, laws=APPROXIMATE_LAWS, stride: int = 1,
     vh, vl = _pair(V, "V")
     acc = np.asarray(A, np.float64)
     n = th.shape[0]
-    if th.ndim != 1 or n < 4:
-        raise ValueError(f"t: {th.shape} is not a time axis of at least 4 rows (the dense output needs 4 nodes)")
+    if th.ndim != 1 or n < 2:
+        raise ValueError(f"t: {th.shape} is not a time axis of at least 2 rows (the dense output interpolates "
+                         "between rows)")
     for name, arr in (("R", rh), ("V", vh), ("A", acc)):
         if arr.shape != (n, 3, 3):
             raise ValueError(f"{name}: shape {arr.shape}; allowed: ({n}, 3, 3) (time, satellite, component)")
-    tn = np.stack([th, tl], -1)
-    Rd = np.stack([rh, rl], -1)
-    Vd = np.stack([vh, vl], -1)
-
-    def position_at(sat, q_hi, q_lo):
-        r, _ = interpolate_states(tn, Rd[:, sat.index], Vd[:, sat.index], acc[:, sat.index],
-                                  np.stack([q_hi, q_lo], -1), n_nodes=4)
-        return r
-
+    lt = light_travel_times((th, tl), (rh, rl), (vh, vl), acc, tol=tol)
     sel = slice(1, None, int(stride))
     ts = (th[sel], tl[sel])
     Rs, Vs, As = (rh[sel], rl[sel]), (vh[sel], vl[sel]), acc[sel]
-    it = _pointing.beam_directions("iterative", Rs, t=ts, position_at=position_at, tol=tol)
+    it = _pointing.beam_directions("iterative", Rs, light_times=lt.select(sel))
     f_it = _pointing.pointing_frames(it.n)
     out = {}
     approx_tau = None
@@ -169,7 +163,7 @@ def compare_pointing_laws(t, R, V, A, *, laws=APPROXIMATE_LAWS, stride: int = 1,
     if approx_tau is None:
         approx_tau = _pointing.beam_directions("global", Rs).tau
     return PointingStudy(t=ts[0] + ts[1], laws=out, tau_error=np.abs(approx_tau - it.tau),
-                         ltt_residual=float(np.max(np.abs(it.last_step))))
+                         ltt_residual=float(np.nanmax(np.abs(it.last_step))))
 
 
 def pointing_study_of(trajectory, *, laws=APPROXIMATE_LAWS, stride: int = 1, max_rows: int | None = None,
@@ -181,7 +175,7 @@ def pointing_study_of(trajectory, *, laws=APPROXIMATE_LAWS, stride: int = 1, max
     ``trajectory.attrs``).  Uses ``t``, ``sat/r``, ``sat/v`` and the total
     acceleration ``sat/a_gravity`` (+ ``sat/a_dragfree`` when the root
     attribute ``control`` is "on": the drag-free acceleration then acts on
-    the orbit).  The grid must be fine enough for the degree-11 Hermite
+    the orbit).  The grid must be fine enough for the quintic Hermite
     interpolation (the 50 s integrator grid: ``run.output_every = 1``).
     ``max_rows``: use only the first ``max_rows`` rows (None: all).
     """

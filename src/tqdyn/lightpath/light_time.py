@@ -63,7 +63,7 @@ float64 arrays, as a float64 array with a trailing axis of length 2
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -342,6 +342,15 @@ class LightTravelTimes:
     source: str
     note: str
     shapiro_k: float = 0.0
+
+    def select(self, rows) -> "LightTravelTimes":
+        """The same light travel times at the rows ``rows`` only (a slice,
+        an index array or a boolean mask along the time axis)."""
+        pick = lambda x: (x[0][rows], x[1][rows]) if isinstance(x, tuple) else x[rows]  # noqa: E731
+        return replace(self, t=pick(self.t), tau=pick(self.tau), range=pick(self.range),
+                       r_receive=pick(self.r_receive), v_receive=pick(self.v_receive), r_emit=pick(self.r_emit),
+                       v_emit=pick(self.v_emit), residual=pick(self.residual), shapiro=pick(self.shapiro),
+                       iterations=pick(self.iterations))
 
     @property
     def tau_f64(self) -> np.ndarray:
