@@ -32,15 +32,9 @@ import erfa
 import numpy as np
 import pytest
 
-from tqdyn.astro.eop import (
-    ARCSEC,
-    EOP,
-    load_eop,
-    load_tidal_eop_terms,
-    parse_eop_c04,
-    tidal_arguments,
-    tidal_eop_corrections,
-)
+from tqdyn.astro.eop import ARCSEC, EOP, tidal_arguments, tidal_eop_corrections
+from tqdyn.readers.eop_c04 import load_eop, parse_eop_c04
+from tqdyn.readers.iers_tables import load_tidal_eop_terms
 
 UAS = ARCSEC * 1e-6
 

@@ -24,11 +24,11 @@ import numpy as np
 import pytest
 from jplephem.spk import SPK
 
-from tqdyn.astro.ephemeris import (BODIES, Ephemeris, default_ephemeris, default_ephemeris_path, parse_gm_tpc,
-                             planetary_gm)
+from tqdyn.astro.ephemeris import BODIES, Ephemeris, default_ephemeris, default_ephemeris_path, planetary_gm
 from tqdyn.forces.third_body import ThirdBodies, third_body_accel
 from tqdyn.forces.third_body_ephemeris import third_bodies
 from tqdyn.astro.timescales import Epoch, tdb_jd
+from tqdyn.readers.pck import parse_gm_tpc
 
 JD_EPOCH = 2453162.5  # 2004-06-06 00:00 (TDB here)
 BARY = {"mercury": 1, "venus": 2, "mars": 4, "jupiter": 5, "saturn": 6, "uranus": 7, "neptune": 8}

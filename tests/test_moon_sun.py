@@ -1,5 +1,6 @@
-"""The Moon's field with libration (tqdyn.forces.moon) and the Sun's J2 with
-its IAU orientation (tqdyn.forces.sun), against independent references.
+"""The Moon's field (tqdyn.forces.moon) with libration
+(tqdyn.astro.lunar_orientation) and the Sun's J2 with its IAU orientation
+(tqdyn.forces.sun), against independent references.
 
 Where each reference comes from:
 
@@ -33,9 +34,11 @@ import mpmath
 import numpy as np
 import pytest
 
+from tqdyn.astro import lunar_orientation
 from tqdyn.astro.ephemeris import default_ephemeris
 from tqdyn.forces import moon
 from tqdyn.forces import sun
+from tqdyn.readers import pck
 from tqdyn.readers.naif import parse_text_kernel, read_text_kernel
 from tqdyn.forces.spherical_harmonics import sh_accel
 from tqdyn.astro.timescales import Epoch, tdb_jd
@@ -112,7 +115,7 @@ def test_pck00010_values():
     assert k["BODY10_PM"] == [84.176, 14.1844, 0.0]
     assert k["BODY301_PM"] == [38.3213, 13.17635815, -1.4e-12]
     assert len(k["BODY3_NUT_PREC_ANGLES"]) == 26 and k["BODY3_NUT_PREC_ANGLES"][-2:] == [25.053, 473327.79642]
-    el = moon.read_iau_moon_elements()
+    el = pck.read_iau_moon_elements()
     assert el.angles.shape == (13, 2) and el.nut_pm[0] == 3.5610 and el.nut_dec[12] == -0.0009
 
 
@@ -123,9 +126,9 @@ def test_pck00010_values():
 def test_rotations_orthonormal():
     jd1, jd2 = tdb_jd(EPOCH, np.linspace(0.0, 90 * 86400.0, 501))
     mats = {
-        "pa_de421": moon.lunar_pa_rotation(jd1, jd2, "de421"),
-        "pa_iau": moon.lunar_pa_rotation(jd1, jd2, "iau"),
-        "me_iau": moon.lunar_iau_rotation(jd1, jd2),
+        "pa_de421": lunar_orientation.lunar_pa_rotation(jd1, jd2, "de421"),
+        "pa_iau": lunar_orientation.lunar_pa_rotation(jd1, jd2, "iau"),
+        "me_iau": lunar_orientation.lunar_iau_rotation(jd1, jd2),
         "sun_iau": sun.solar_iau_rotation(jd1, jd2),
     }
     for name, m in mats.items():
@@ -133,7 +136,7 @@ def test_rotations_orthonormal():
         err = np.abs(m @ np.swapaxes(m, -1, -2) - np.eye(3)).max()
         assert err < 1e-15, (name, err)
         assert np.allclose(np.linalg.det(m), 1.0, atol=1e-15), name
-    assert np.abs(moon.T_PA_ME_DE421 @ moon.T_PA_ME_DE421.T - np.eye(3)).max() < 1e-15
+    assert np.abs(lunar_orientation.T_PA_ME_DE421 @ lunar_orientation.T_PA_ME_DE421.T - np.eye(3)).max() < 1e-15
 
 
 def test_euler_composition_matches_erfa():
@@ -141,16 +144,16 @@ def test_euler_composition_matches_erfa():
     from angles that match jplephem's own Chebyshev evaluation of the
     kernel; the IAU matrices = R3(W) R1(90-dec) R3(90+ra) likewise."""
     jd1, jd2 = tdb_jd(EPOCH, np.array([0.0, 3.3e6, 7.7e6]))
-    ang = moon.lunar_pa_euler_angles(jd1, jd2)
-    mats = moon.lunar_pa_rotation(jd1, jd2)
+    ang = lunar_orientation.lunar_pa_euler_angles(jd1, jd2)
+    mats = lunar_orientation.lunar_pa_rotation(jd1, jd2)
     # the compiled Chebyshev evaluation = jplephem's own (psi ~ 3e3 rad: ulp 5e-13)
     from jplephem.pck import PCK
 
     seg = PCK.open(str(importlib.resources.files("tqdyn") / "data" / "moon_pa_de421_1900-2050.bpc")).segments[0]
     jd_all = np.arange(2415020.5, 2470172.5, 7.3)
     ref = seg.compute(jd_all, 0.0, derivative=False).T
-    assert np.abs(moon.lunar_pa_euler_angles(jd_all, 0.0) - ref).max() < 5e-12
-    assert np.abs(moon.lunar_pa_euler_angles(jd1, jd2) - seg.compute(jd1, jd2, derivative=False).T).max() < 5e-12
+    assert np.abs(lunar_orientation.lunar_pa_euler_angles(jd_all, 0.0) - ref).max() < 5e-12
+    assert np.abs(lunar_orientation.lunar_pa_euler_angles(jd1, jd2) - seg.compute(jd1, jd2, derivative=False).T).max() < 5e-12
     for k in range(3):
         phi, theta, psi = ang[k]
         ref = erfa.rz(psi, erfa.rx(theta, erfa.rz(phi, np.eye(3))))
@@ -167,8 +170,8 @@ def test_pa_rotation_naif_example():
     20:10:00 UTC (DE421, geometric) in MOON_PA and MOON_ME, km."""
     tdb = Epoch.from_utc("2008-03-17T20:10:00").tdb
     earth_from_moon = -default_ephemeris().geocentric("moon", tdb[0], tdb[1])[0]  # m, ICRF
-    pa = moon.lunar_pa_rotation(tdb[0], tdb[1]) @ earth_from_moon
-    me = moon.T_PA_ME_DE421.T @ pa
+    pa = lunar_orientation.lunar_pa_rotation(tdb[0], tdb[1]) @ earth_from_moon
+    me = lunar_orientation.T_PA_ME_DE421.T @ pa
     pa_naif = np.array([379908.634, 33385.003, -12516.8859]) * 1e3
     me_naif = np.array([379892.825, 33510.118, -12661.5278]) * 1e3
     # printed to 1 m (x, y) and 0.1 m (z): 1 m at 3.8e8 m is 2.6e-9 rad
@@ -179,7 +182,7 @@ def test_pa_rotation_naif_example():
     wrong = erfa.rz(-a1, erfa.ry(-a2, erfa.rx(-a3, np.eye(3))))
     assert np.abs(wrong @ pa - me_naif).max() > 3.0
     # and the stated size of the PA-ME rotation (0.0288473 deg)
-    angle = math.degrees(math.acos((np.trace(moon.T_PA_ME_DE421) - 1) / 2))
+    angle = math.degrees(math.acos((np.trace(lunar_orientation.T_PA_ME_DE421) - 1) / 2))
     assert abs(angle - 0.0288473) < 5e-7
 
 
@@ -191,29 +194,29 @@ def test_pa_de421_vs_iau():
     (moon_080317.tf).  Without the ~104" PA-ME offset they differ by
     89"..118" (> 4e-4 rad), so the check sees the offset and its sign."""
     jd = np.arange(2415021.0, 2470172.0, 0.5)  # 1900-01-01 .. 2050-12-31, TDB
-    de = moon.lunar_pa_rotation(jd, 0.0, "de421")
-    iau = moon.lunar_pa_rotation(jd, 0.0, "iau")
+    de = lunar_orientation.lunar_pa_rotation(jd, 0.0, "de421")
+    iau = lunar_orientation.lunar_pa_rotation(jd, 0.0, "iau")
     ang = _angle(de, iau)
     assert ang.max() < 1e-4, ang.max() / AS
     recent = (jd > 2451545.0) & (jd < 2458850.0)  # 2000-2020
     assert abs(ang[recent].max() - 0.0051 * 3600 * AS) < 0.1 * 0.0051 * 3600 * AS
     assert abs(ang[recent].mean() - 0.00249 * 3600 * AS) < 0.1 * 0.00249 * 3600 * AS
-    bare = _angle(de, moon.lunar_iau_rotation(jd, 0.0))
+    bare = _angle(de, lunar_orientation.lunar_iau_rotation(jd, 0.0))
     assert bare.min() > 4e-4
-    assert np.abs(iau - moon.T_PA_ME_DE421 @ moon.lunar_iau_rotation(jd, 0.0)).max() < 1e-15
+    assert np.abs(iau - lunar_orientation.T_PA_ME_DE421 @ lunar_orientation.lunar_iau_rotation(jd, 0.0)).max() < 1e-15
 
 
 def test_orientation_bad_input():
     with pytest.raises(ValueError, match="outside the kernel span"):
-        moon.lunar_pa_rotation(2415000.5, 0.0)
+        lunar_orientation.lunar_pa_rotation(2415000.5, 0.0)
     with pytest.raises(ValueError, match="2470172"):
-        moon.lunar_pa_rotation(2470172.5, 1.0)
+        lunar_orientation.lunar_pa_rotation(2470172.5, 1.0)
     with pytest.raises(ValueError, match="libration 'spice'"):
-        moon.lunar_pa_rotation(2451545.0, 0.0, "spice")
+        lunar_orientation.lunar_pa_rotation(2451545.0, 0.0, "spice")
     with pytest.raises(FileNotFoundError):
-        moon.load_lunar_pa_kernel("/nonexistent/moon.bpc")
+        pck.load_lunar_pa_kernel("/nonexistent/moon.bpc")
     with pytest.raises(FileNotFoundError):
-        sun.read_iau_sun_elements("/nonexistent/pck.tpc")
+        pck.read_iau_sun_elements("/nonexistent/pck.tpc")
     with pytest.raises(ValueError, match="degree 1"):
         moon.MoonField(degree=1)
     with pytest.raises(ValueError, match="libration"):

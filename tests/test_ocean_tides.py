@@ -19,13 +19,8 @@ import numpy as np
 import pytest
 from tide_support import max_accel, standin_orientation
 
-from tqdyn.forces.ocean_tides import (
-    FES2004_MAX_DEGREE,
-    OceanTides,
-    ocean_tide_coefficients,
-    parse_fes2004,
-    read_fes2004,
-)
+from tqdyn.forces.ocean_tides import OceanTides, ocean_tide_coefficients
+from tqdyn.readers.fes2004 import FES2004_MAX_DEGREE, parse_fes2004, read_fes2004
 from tqdyn.astro.tidal_arguments import delaunay_arguments, doodson_arguments, tidal_phase
 from tqdyn.astro.timescales import Epoch
 

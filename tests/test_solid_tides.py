@@ -38,15 +38,17 @@ from tide_support import (
 )
 
 from tqdyn.forces.solid_tides import (
-    LoveNumbers,
     SolidTides,
+    permanent_tide_dc20,
+    step1_coefficients,
+    step2_coefficients,
+)
+from tqdyn.readers.iers_tables import (
+    LoveNumbers,
     Step2Table,
     load_love_numbers,
     load_step2_table,
     parse_step2_table,
-    permanent_tide_dc20,
-    step1_coefficients,
-    step2_coefficients,
 )
 from tqdyn.astro.tidal_arguments import delaunay_arguments, doodson_arguments, doodson_multipliers
 from tqdyn.astro.timescales import Epoch, tdb_jd

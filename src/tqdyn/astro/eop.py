@@ -2,18 +2,18 @@
 
 What this module provides
 -------------------------
-* :func:`load_eop` -- reader of the IERS EOP 14 C04 daily series
+* :func:`tqdyn.readers.eop_c04.load_eop` -- reader of the IERS EOP 14 C04 daily series
   (``data/eopc04_14_IAU2000.62-now.txt``, shipped; see ``data/SOURCES.md``)
   into an :class:`EOP` table: polar motion x_p, y_p and celestial pole
   offsets dX, dY in **rad**, UT1-UTC and LOD in **s**, one row per day at
   0 h UTC (MJD in UTC).
 * :meth:`EOP.at` -- interpolation to any instants (arrays of any shape).
-* :func:`load_tidal_eop_terms` / :func:`tidal_eop_corrections` -- the IERS
+* :func:`tqdyn.readers.iers_tables.load_tidal_eop_terms` / :func:`tidal_eop_corrections` -- the IERS
   2010 diurnal and semidiurnal corrections to polar motion and UT1 that the
   C04 series does not contain (ocean tides: TN36 Tables 8.2 and 8.3, as in
   the IERS routine ``interp.f``/PMUT1_OCEANS; libration in polar motion:
   TN36 Table 5.1a, as in PMSDNUT2).  They are optional
-  (:func:`tqdyn.frames.earth_orientation` ``tidal_eop=``).
+  (:func:`tqdyn.astro.earth_orientation.earth_orientation` ``tidal_eop=``).
 
 Interpolation
 -------------
@@ -32,7 +32,7 @@ table (``erfa.dat``, which also carries the pre-1972 linear drifts), i.e. the
 interpolated quantity is UT1-TAI and TAI-UTC of the requested instant is
 added back.  For a query at a node the correction is zero and the tabulated
 UT1-UTC is returned exactly.  :meth:`EOP.ut1_minus_tai` gives UT1-TAI
-directly (what :mod:`tqdyn.frames` uses: UT1 = TAI + (UT1-TAI), no UTC
+directly (what :mod:`tqdyn.astro.earth_orientation` uses: UT1 = TAI + (UT1-TAI), no UTC
 needed).
 
 How much the interpolation scheme matters (measured in ``tests/test_eop.py``,
@@ -54,11 +54,7 @@ days of UTC (ERFA quasi-JD convention on leap-second days).
 
 from __future__ import annotations
 
-import functools
-import importlib.resources
 import math
-import os
-import re
 import warnings
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -69,25 +65,19 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
-from ..readers.files import read_iers_table
+from ..readers.iers_tables import TidalEOPTerms
 
 __all__ = [
     "ARCSEC",
     "EOP",
     "EOPValues",
-    "TidalEOPTerms",
-    "load_eop",
-    "load_tidal_eop_terms",
-    "parse_eop_c04",
     "tidal_arguments",
     "tidal_eop_corrections",
 ]
 
 #: One arcsecond in radians (pi / 648000).
 ARCSEC = math.pi / 648000.0
-_MICROARCSEC = ARCSEC * 1e-6
 
-_EOP_FILE = "eopc04_14_IAU2000.62-now.txt"
 _MJD_JD0 = 2400000.5
 _DAY = 86400.0
 
@@ -131,7 +121,7 @@ class EOP:
 
     TAI-UTC at the nodes (from ``erfa.dat``) is computed on construction and
     kept privately (it is what removes the leap-second jumps of UT1-UTC).
-    Construct with :func:`load_eop` (or directly from arrays, e.g. in tests).
+    Construct with :func:`tqdyn.readers.eop_c04.load_eop` (or directly from arrays, e.g. in tests).
     """
 
     mjd: np.ndarray
@@ -340,158 +330,7 @@ def _mjd_iso(mjd: float) -> str:
 
 
 # ----------------------------------------------------------------------
-# reader
-
-_C04_ROW = re.compile(r"^\s*(\d{4})\s+(\d{1,2})\s+(\d{1,2})\s+(\d{5})\s")
-
-
-def parse_eop_c04(text: str, source: str = "text") -> EOP:
-    """Parse the text of an IERS EOP (14 or 20) C04 file into an :class:`EOP`.
-
-    Data rows are ``Y M D MJD x y UT1-UTC LOD dX dY`` followed by their
-    errors (x, y, dX, dY in arcsec; UT1-UTC, LOD in s); header lines are
-    skipped.  Each row's MJD is checked against its calendar date.
-    Angles are converted to rad.  Raises ``ValueError`` for a file without
-    data rows, a malformed row, or non-consecutive days.
-    """
-    rows = []
-    for lineno, line in enumerate(text.splitlines(), 1):
-        m = _C04_ROW.match(line)
-        if m is None:
-            continue
-        tok = line.split()
-        if len(tok) < 10:
-            raise ValueError(f"{source}:{lineno}: EOP C04 row has {len(tok)} fields, expected >= 10")
-        try:
-            y, mo, d, mjd = (int(t) for t in tok[:4])
-            vals = [float(t) for t in tok[4:10]]
-        except ValueError:
-            raise ValueError(f"{source}:{lineno}: cannot parse EOP C04 row {line.strip()!r}") from None
-        rows.append((y, mo, d, mjd, *vals))
-    if not rows:
-        raise ValueError(f"{source}: no EOP C04 data rows found")
-    a = np.array(rows, dtype=np.float64)
-    jd1, jd2 = erfa.cal2jd(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2].astype(int))
-    bad = np.nonzero(jd1 + jd2 - _MJD_JD0 != a[:, 3])[0]
-    if bad.size:
-        r = rows[bad[0]]
-        raise ValueError(f"{source}: row {r[:4]}: MJD does not match the calendar date")
-    return EOP(mjd=a[:, 3], xp=a[:, 4] * ARCSEC, yp=a[:, 5] * ARCSEC, dut1=a[:, 6], lod=a[:, 7],
-               dx=a[:, 8] * ARCSEC, dy=a[:, 9] * ARCSEC, source=source)
-
-
-@functools.lru_cache(maxsize=1)
-def _default_eop() -> EOP:
-    res = importlib.resources.files("tqdyn") / "data" / _EOP_FILE
-    return parse_eop_c04(res.read_text(encoding="ascii"), source=f"tqdyn/data/{_EOP_FILE} (IERS EOP 14 C04)")
-
-
-def load_eop(path=None) -> EOP:
-    """Read an IERS C04 EOP file into an :class:`EOP` (x, y, dX, dY in rad; s).
-
-    ``path=None``: the shipped IERS EOP 14 C04 series
-    (``tqdyn/data/eopc04_14_IAU2000.62-now.txt``, 1962-01-01 .. 2024-09-03),
-    parsed once and cached.  Otherwise a path to a file of the same format.
-    Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for a
-    malformed one.
-    """
-    if path is None:
-        return _default_eop()
-    p = os.fspath(path)
-    if not os.path.isfile(p):
-        raise FileNotFoundError(f"EOP file not found: {p}")
-    with open(p, encoding="ascii", errors="replace") as fh:
-        return parse_eop_c04(fh.read(), source=p)
-
-
-# ----------------------------------------------------------------------
 # diurnal / semidiurnal corrections (ocean tides, libration)
-
-
-@dataclass(frozen=True, eq=False)
-class TidalEOPTerms:
-    """Trigonometric terms of the sub-daily EOP corrections (IERS 2010).
-
-    Each term j has integer multipliers ``mult[j]`` of the six arguments
-    (gamma = GMST + pi, l, l', F, D, Omega) and coefficients of
-    sin(arg) and cos(arg):
-
-    pm_mult (n_pm, 6) int64, pm_coef (n_pm, 4) float64 [rad]:
-        x_p sin, x_p cos, y_p sin, y_p cos (ocean tides, TN36 Table 8.2, plus,
-        if included, the libration terms of Table 5.1a);
-    ut1_mult (n_ut, 6) int64, ut1_coef (n_ut, 2) float64 [s]:
-        UT1 sin, UT1 cos (ocean tides, TN36 Table 8.3).
-    periods_pm, periods_ut1 : the tables' period column [d] (for checks only).
-    """
-
-    pm_mult: np.ndarray
-    pm_coef: np.ndarray
-    ut1_mult: np.ndarray
-    ut1_coef: np.ndarray
-    periods_pm: np.ndarray
-    periods_ut1: np.ndarray
-    source: str = ""
-
-
-def _parse_tidal_table(text: str, n_coef: int, source: str):
-    """Rows '... m1..m6 doodson period c1..c_ncoef' of an IERS table (Orekit
-    transcription); lines starting with '#' and non-numeric lines skipped.
-    Returns (mult (n,6) int64, period (n,), coef (n, n_coef))."""
-    mult, per, coef = [], [], []
-    need = 8 + n_coef
-    for line in text.splitlines():
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        tok = s.split()
-        if len(tok) < need:
-            continue
-        tail = tok[-need:]
-        try:
-            m = [int(t) for t in tail[:6]]
-            doodson = float(tail[6])
-            p = float(tail[7])
-            c = [float(t) for t in tail[8:]]
-        except ValueError:
-            continue
-        if "." not in tail[6] or doodson <= 0:
-            continue
-        mult.append(m)
-        per.append(p)
-        coef.append(c)
-    if not mult:
-        raise ValueError(f"{source}: no tidal terms found")
-    return np.array(mult, dtype=np.int64), np.array(per), np.array(coef)
-
-
-@functools.lru_cache(maxsize=4)
-def load_tidal_eop_terms(ocean: bool = True, libration: bool = True) -> TidalEOPTerms:
-    """Sub-daily EOP correction terms from the shipped IERS 2010 tables.
-
-    ocean: diurnal and semidiurnal ocean-tide terms in x_p, y_p (TN36 Table
-    8.2, 71 terms, ``iers2010/tab8.2ab.txt``) and UT1 (Table 8.3,
-    ``iers2010/tab8.3ab.txt``), the coefficients of the IERS routine
-    ``interp.f`` (PMUT1_OCEANS); libration: the 10 quasi-diurnal libration
-    terms in polar motion (Table 5.1a, ``iers2010/tab5.1a.txt``, long-period
-    terms removed as in PMSDNUT2).  The UT1 libration (Table 5.1b) is not
-    shipped and not included (amplitude a few us).  Coefficients are
-    converted to rad (from uas) and s (from us).  Cached.
-    """
-    pm_m, pm_c, pm_p = [np.zeros((0, 6), np.int64)], [np.zeros((0, 4))], [np.zeros(0)]
-    ut_m, ut_c, ut_p = np.zeros((0, 6), np.int64), np.zeros((0, 2)), np.zeros(0)
-    src = []
-    if ocean:
-        m, p, c = _parse_tidal_table(read_iers_table("tab8.2ab.txt"), 4, "tab8.2ab.txt")
-        pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
-        ut_m, ut_p, c = _parse_tidal_table(read_iers_table("tab8.3ab.txt"), 2, "tab8.3ab.txt")
-        ut_c = c * 1e-6
-        src.append("ocean tides: IERS 2010 Tables 8.2, 8.3 (interp.f)")
-    if libration:
-        m, p, c = _parse_tidal_table(read_iers_table("tab5.1a.txt"), 4, "tab5.1a.txt")
-        pm_m.append(m), pm_c.append(c * _MICROARCSEC), pm_p.append(p)
-        src.append("polar-motion libration: IERS 2010 Table 5.1a (PMSDNUT2)")
-    return TidalEOPTerms(np.concatenate(pm_m), np.concatenate(pm_c), ut_m, ut_c,
-                         np.concatenate(pm_p), ut_p, "; ".join(src))
 
 
 def tidal_arguments(ut1, tt) -> np.ndarray:
@@ -516,7 +355,7 @@ def tidal_eop_corrections(args, terms: TidalEOPTerms):
 
     args : (..., 6) float64 [rad], the arguments (gamma = GMST + pi, l, l', F,
         D, Omega), e.g. from :func:`tidal_arguments`.
-    terms : :class:`TidalEOPTerms`.
+    terms : :class:`tqdyn.readers.iers_tables.TidalEOPTerms`.
     Each term contributes s * sin(a) + c * cos(a) with a = mult . args
     (the convention of interp.f and PMSDNUT2).  Returns three float64 arrays
     of shape args.shape[:-1].

@@ -16,7 +16,7 @@ their moons), which is what a point-mass perturbation with the *system* GM
 no moons, barycenter and body coincide in the DE files.
 
 Time argument: TDB as a two-part Julian date ``(jd1, jd2)`` in days (ERFA
-convention, see :mod:`tqdyn.timescales`), kept two-part down to the
+convention, see :mod:`tqdyn.astro.timescales`), kept two-part down to the
 Chebyshev evaluation: the fraction of the Chebyshev interval is formed as
 ``((jd1 - J2000) * 86400 - init - k * intlen) + jd2 * 86400`` whose first
 bracket is exact for ``jd1`` on a half day, so the time resolution is that of
@@ -35,7 +35,7 @@ in time) are handled by evaluating each instant in the segment that covers it.
 Shipped default: DE421 (1899-07-29 .. 2053-10-09), from the PyPI package
 ``skyfield-data`` (a tqdyn dependency).  Any other DE file (DE430, DE440 ...)
 by path.  GMs: ``data/gm_de431.tpc`` (DE430/DE431 values, km^3/s^2 in the
-file, m^3/s^2 here).  DE421 itself was integrated with slightly different
+file, m^3/s^2 here; read by :func:`tqdyn.readers.pck.parse_gm_tpc`).  DE421 itself was integrated with slightly different
 GMs (it predates DE430); the differences are small relative amounts that
 only scale the point-mass terms, and the DE430 set is the one of the paper's
 model (Table II: DE430).
@@ -48,14 +48,13 @@ import functools
 import importlib.resources
 import math
 import os
-import re
-from decimal import Decimal
 
 import erfa
 import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from ..readers.pck import _shipped_gm
 from .constants import DAY_S, J2000_JD
 
 __all__ = [
@@ -64,7 +63,6 @@ __all__ = [
     "Ephemeris",
     "default_ephemeris",
     "default_ephemeris_path",
-    "parse_gm_tpc",
     "planetary_gm",
 ]
 
@@ -427,7 +425,7 @@ class Ephemeris:
             One of :data:`BODIES` (case-insensitive).
         jd1, jd2 : float or array_like
             Two-part TDB Julian dates [d] (e.g. from
-            :func:`tqdyn.timescales.tdb_jd`), broadcast to shape S.
+            :func:`tqdyn.astro.timescales.tdb_jd`), broadcast to shape S.
 
         Returns
         -------
@@ -454,42 +452,6 @@ def default_ephemeris() -> Ephemeris:
 
 # --------------------------------------------------------------------------
 # GMs
-
-_GM_RE = re.compile(r"BODY(\d+)_GM\s*=\s*\(\s*([-+0-9.EeDd]+)\s*\)")
-
-
-def parse_gm_tpc(text: str) -> dict[int, float]:
-    """Read the GM assignments of a NAIF text PCK (``BODYnnn_GM = ( value )``
-    inside ``\\begindata`` blocks).
-
-    text: the file's content.  Returns {NAIF id: GM [m^3/s^2]} (the file's
-    km^3/s^2 times 1e9, converted from the exact decimal, one rounding).
-    Raises ValueError if no GM is found.
-    """
-    out: dict[int, float] = {}
-    data = False
-    for line in text.splitlines():
-        s = line.strip()
-        if s.startswith("\\begindata"):
-            data = True
-            continue
-        if s.startswith("\\begintext"):
-            data = False
-            continue
-        if data:
-            for m in _GM_RE.finditer(s):
-                out[int(m[1])] = float(Decimal(m[2].replace("D", "E").replace("d", "e")) * 10**9)
-    if not out:
-        raise ValueError("GM kernel: no BODYnnn_GM assignment found inside \\begindata blocks")
-    return out
-
-
-@functools.lru_cache(maxsize=1)
-def _shipped_gm() -> dict[int, float]:
-    path = importlib.resources.files("tqdyn") / "data" / "gm_de431.tpc"
-    if not path.is_file():
-        raise FileNotFoundError(f"tqdyn data file not found: {path}")
-    return parse_gm_tpc(path.read_text(encoding="ascii", errors="replace"))
 
 
 @functools.lru_cache(maxsize=1)

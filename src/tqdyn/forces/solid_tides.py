@@ -5,6 +5,7 @@ Output: corrections dC[n, m], dS[n, m] (n, m <= 4) to the fully normalised,
 dimensionless Stokes coefficients of the Earth's field in the ITRS, to be
 added to a static field of reference radius ``r_ref`` and constant
 ``gm_earth`` (EGM2008 by default: 6378136.3 m, 3.986004415e14 m^3/s^2).
+The TN36 tables used here are read by :mod:`tqdyn.readers.iers_tables`.
 
 Step 1 (frequency-independent, TN36 eq. 6.6 and 6.7), for the Sun and the
 Moon (j) at geocentric ITRS positions r_j (latitude Phi_j, east longitude
@@ -22,7 +23,7 @@ P_nm without the Condon-Shortley phase (geodesy convention, as in EGM2008).
 
 Step 2 (frequency dependence of k_20, k_21, k_22; TN36 eq. 6.8a-c and
 Tables 6.5a-c, ``data/iers2010/tab6.5{a,b,c}.txt``), theta_f from
-:mod:`tqdyn.forces.tidal_arguments`:
+:mod:`tqdyn.astro.tidal_arguments`:
 
     dC_20          = sum_f(2,0) [ip_f cos theta_f - op_f sin theta_f]
     dC_21 - i dS_21 = -i sum_f(2,1) (ip_f + i op_f) exp(i theta_f)
@@ -63,9 +64,7 @@ which the permanent part 4.6e-12), degree 3 4.5e-15, degree 4 (k+)
 
 from __future__ import annotations
 
-import functools
 import math
-import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -74,25 +73,13 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..readers.files import read_iers_table
 from ..astro.constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
-from ..astro.tidal_arguments import (
-    delaunay_arguments,
-    delaunay_multipliers,
-    doodson_arguments,
-    doodson_multipliers,
-    tidal_harmonic_sum,
-)
+from ..astro.tidal_arguments import delaunay_arguments, doodson_arguments, tidal_harmonic_sum
+from ..readers.iers_tables import LoveNumbers, Step2Table, load_love_numbers, load_step2_table
 
 __all__ = [
     "PERMANENT_TIDE_H0_M",
-    "LoveNumbers",
     "SolidTides",
-    "Step2Table",
-    "load_love_numbers",
-    "load_step2_table",
-    "parse_love_numbers",
-    "parse_step2_table",
     "permanent_tide_dc20",
     "step1_coefficients",
     "step2_coefficients",
@@ -104,158 +91,6 @@ __all__ = [
 PERMANENT_TIDE_H0_M = -0.31460
 
 _NMAX = 4  # degree of the corrections produced here (degree 4 from k+)
-_DOODSON_TOKEN = re.compile(r"^\d{1,3},\d{3}$")
-
-
-# --------------------------------------------------------------------------
-# data: nominal Love numbers (TN36 Table 6.3) and step-2 tables (6.5a-c)
-
-
-@dataclass(frozen=True, eq=False)
-class LoveNumbers:
-    """Nominal (anelastic) external-potential Love numbers, TN36 Table 6.3.
-
-    k: complex (4, 4) array, k[n, m] for n = 2, 3 and m <= n (others 0);
-    k_plus: float (3,), k+_2m (m = 0, 1, 2) for the degree-4 terms.
-    Dimensionless.
-    """
-
-    k: np.ndarray
-    k_plus: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
-class Step2Table:
-    """Frequency-dependent Love-number corrections, TN36 Tables 6.5a-c.
-
-    order: (n_f,) int, m = 0 (Table 6.5b), 1 (6.5a) or 2 (6.5c);
-    doodson: (n_f, 6) int Doodson multipliers; ip, op: (n_f,) float64 in-phase
-    and out-of-phase amplitudes A_m delta k_f H_f, dimensionless (the files'
-    units of 1e-12 applied); names: Darwin names ('' where the table has none).
-    """
-
-    order: np.ndarray
-    doodson: np.ndarray
-    ip: np.ndarray
-    op: np.ndarray
-    names: tuple[str, ...]
-
-    def __len__(self) -> int:
-        return int(self.order.shape[0])
-
-    @functools.cached_property
-    def _weights(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(mult (n_f, 6) float, W_cos (n_f, 5), W_sin (n_f, 5)): the five
-        outputs (C20, C21, S21, C22, S22) are cos(theta) @ W_cos + sin(theta) @ W_sin."""
-        m0, m1, m2 = (self.order == 0), (self.order == 1), (self.order == 2)
-        ip, op = self.ip, self.op
-        wc = np.zeros((len(self), 5))
-        ws = np.zeros((len(self), 5))
-        wc[m0, 0], ws[m0, 0] = ip[m0], -op[m0]          # C20 = ip cos - op sin
-        wc[m1, 1], ws[m1, 1] = op[m1], ip[m1]           # C21 = ip sin + op cos
-        wc[m1, 2], ws[m1, 2] = ip[m1], -op[m1]          # S21 = ip cos - op sin
-        wc[m2, 3], ws[m2, 3] = ip[m2], -op[m2]          # C22 = ip cos - op sin
-        wc[m2, 4], ws[m2, 4] = -op[m2], -ip[m2]         # S22 = -(ip sin + op cos)
-        return self.doodson.astype(np.float64), wc, ws
-
-
-def parse_love_numbers(text: str) -> LoveNumbers:
-    """Parse TN36 Table 6.3 as shipped (``n m Re(k) Im(k) k+`` rows, '#'
-    comments).  Returns :class:`LoveNumbers`; raises ValueError if a degree-2
-    or degree-3 entry is missing or a row is malformed."""
-    k = np.zeros((4, 4), dtype=np.complex128)
-    kp = np.zeros(3)
-    seen = set()
-    for lineno, line in enumerate(text.splitlines(), 1):
-        s = line.split("#", 1)[0].strip()
-        if not s:
-            continue
-        parts = s.split()
-        if len(parts) != 5:
-            raise ValueError(f"Love-number table line {lineno}: expected 'n m Re Im k+', got {line!r}")
-        n, m = int(parts[0]), int(parts[1])
-        if not (2 <= n <= 3 and 0 <= m <= n):
-            raise ValueError(f"Love-number table line {lineno}: degree/order ({n}, {m}) outside n = 2..3, m <= n")
-        k[n, m] = complex(float(parts[2]), float(parts[3]))
-        if n == 2:
-            kp[m] = float(parts[4])
-        seen.add((n, m))
-    missing = [(n, m) for n in (2, 3) for m in range(n + 1) if (n, m) not in seen]
-    if missing:
-        raise ValueError(f"Love-number table: missing entries {missing}")
-    return LoveNumbers(k=k, k_plus=kp)
-
-
-def parse_step2_table(text: str, order: int) -> Step2Table:
-    """Parse one of TN36 Tables 6.5a (order 1), 6.5b (order 0), 6.5c (order 2)
-    in the shipped text layout.
-
-    Data rows are recognised by their Doodson number written ``ddd,ddd``.
-    Column layouts after the Doodson number: 6.5a ``tau s h p N' ps l l' F D
-    Omega dkR dkI ip op``; 6.5b ``deg/hr (11 multipliers) dkR ip dkI op``;
-    6.5c ``deg/hr (11 multipliers) dkR ip``.  Every row's Doodson number is
-    checked against its printed Doodson and Delaunay multipliers
-    (ValueError on mismatch).  Amplitudes returned dimensionless (x 1e-12).
-    """
-    if order not in (0, 1, 2):
-        raise ValueError(f"step-2 table: order must be 0, 1 or 2, got {order}")
-    names, mults, ip, op = [], [], [], []
-    for lineno, line in enumerate(text.splitlines(), 1):
-        tok = line.split()
-        idx = [i for i, t in enumerate(tok) if _DOODSON_TOKEN.match(t)]
-        if not idx:
-            continue
-        i = idx[0]
-        after = tok[i + 1:]
-        try:
-            if order == 1:  # 6.5a
-                ints, rest = after[0:11], after[11:]
-                amp_ip, amp_op = float(rest[2]), float(rest[3])
-            elif order == 0:  # 6.5b
-                ints, rest = after[1:12], after[12:]
-                amp_ip, amp_op = float(rest[1]), float(rest[3])
-            else:  # 6.5c
-                ints, rest = after[1:12], after[12:]
-                amp_ip, amp_op = float(rest[1]), 0.0
-            ints = [int(x) for x in ints]
-        except (IndexError, ValueError):
-            raise ValueError(f"step-2 table (order {order}) line {lineno}: cannot parse {line!r}") from None
-        n = doodson_multipliers(tok[i])
-        if list(n) != ints[:6]:
-            raise ValueError(f"step-2 table line {lineno}: Doodson number {tok[i]} does not match "
-                             f"the printed multipliers {ints[:6]}")
-        n1, big = delaunay_multipliers(n)
-        if list(big) != ints[6:] or n1 != order:
-            raise ValueError(f"step-2 table line {lineno}: Doodson number {tok[i]} implies Delaunay "
-                             f"multipliers {list(big)} and order {n1}; printed {ints[6:]}, table order {order}")
-        names.append(tok[0] if i >= 2 or (i == 1 and order != 1) else "")
-        mults.append(n)
-        ip.append(amp_ip * 1e-12)
-        op.append(amp_op * 1e-12)
-    if not mults:
-        raise ValueError(f"step-2 table (order {order}): no data rows found")
-    return Step2Table(order=np.full(len(mults), order, dtype=np.int64), doodson=np.array(mults, dtype=np.int64),
-                      ip=np.array(ip), op=np.array(op), names=tuple(names))
-
-
-@functools.lru_cache(maxsize=1)
-def load_love_numbers() -> LoveNumbers:
-    """The shipped TN36 Table 6.3 (``data/iers2010/tab6.3.txt``), parsed once."""
-    return parse_love_numbers(read_iers_table("tab6.3.txt"))
-
-
-@functools.lru_cache(maxsize=1)
-def load_step2_table() -> Step2Table:
-    """The shipped TN36 Tables 6.5b (m = 0), 6.5a (m = 1), 6.5c (m = 2),
-    concatenated in that order (21 + 48 + 2 = 71 constituents)."""
-    parts = [parse_step2_table(read_iers_table("tab6.5b.txt"), 0),
-             parse_step2_table(read_iers_table("tab6.5a.txt"), 1),
-             parse_step2_table(read_iers_table("tab6.5c.txt"), 2)]
-    return Step2Table(order=np.concatenate([p.order for p in parts]),
-                      doodson=np.concatenate([p.doodson for p in parts]),
-                      ip=np.concatenate([p.ip for p in parts]),
-                      op=np.concatenate([p.op for p in parts]),
-                      names=sum((p.names for p in parts), ()))
 
 
 # --------------------------------------------------------------------------
@@ -370,7 +205,7 @@ def step2_coefficients(beta, table: Step2Table):
     (TN36 eq. 6.8a-c, real forms in the module docstring).
 
     beta: S + (6,) Doodson arguments [rad] (tau, s, h, p, N', p_s);
-    table: :class:`Step2Table` (:func:`load_step2_table`).
+    table: :class:`Step2Table` (:func:`tqdyn.readers.iers_tables.load_step2_table`).
     Returns (dC, dS), float64 S + (3, 3) indexed [n, m] (degree 2 only),
     dimensionless, fully normalised.
     """
@@ -442,10 +277,10 @@ class SolidTides:
         (only for a zero-tide static field; tqdyn's EGM2008 is tide-free ->
         False, see the module docstring).
     gm_earth [m^3/s^2], r_ref [m] : of the static field (EGM2008 defaults).
-    gm_moon, gm_sun [m^3/s^2] : None -> :func:`tqdyn.ephemeris.planetary_gm`.
+    gm_moon, gm_sun [m^3/s^2] : None -> :func:`tqdyn.astro.ephemeris.planetary_gm`.
     orientation : callable (epoch, t_hi, t_lo) -> object with T_ITRS_GCRS
         S + (3, 3), gmst [rad] S, tt (jd1, jd2); None ->
-        :func:`tqdyn.frames.earth_orientation`.
+        :func:`tqdyn.astro.earth_orientation.earth_orientation`.
     ephemeris : object with ``geocentric(body, jd1, jd2) -> (pos [m], vel)``
         (TDB Julian dates, GCRS); None -> the shipped DE421.
     love, table : Love numbers and step-2 table; None -> the shipped TN36

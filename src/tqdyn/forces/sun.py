@@ -6,14 +6,15 @@ et al. 2011, Celest. Mech. Dyn. Astr. 109, 101), as in NAIF's
 ``pck00010.tpc``: north pole alpha0 = 286.13 deg, delta0 = 63.87 deg (ICRF,
 constant), prime meridian W = 84.176 deg + 14.1844 deg/d * d (d: days of TDB
 since J2000).  The J2 term is zonal, so only the pole enters it; the prime
-meridian is used by :func:`solar_iau_rotation` only.
+meridian is used by :func:`solar_iau_rotation` only.  The elements are read
+by :func:`tqdyn.readers.pck.read_iau_sun_elements`.
 
 Field: the zonal degree-2 term with the unnormalised J2 = -C20_unnorm; in
 fully normalised form C20 = -J2 / sqrt(5).  Default J2 = 2.1106088532726840e-7
 at R = 696000 km (the DE430/DE431 ephemeris header value, as quoted in
 mockingbirdnest/Principia ``astronomy/sol_gravity_model.proto.txt``; the
 IAU text PCK has no solar J2), with GM of the Sun from
-``tqdyn.ephemeris.planetary_gm()["sun"]``, the DE430/DE431 value
+``tqdyn.astro.ephemeris.planetary_gm()["sun"]``, the DE430/DE431 value
 1.32712440041939400e20 m^3/s^2 (NAIF gm_de431.tpc, BODY10_GM).
 
 For a body-centred position d and the unit pole vector p (|d| = r, z = d.p)
@@ -41,8 +42,6 @@ Earth-field term.
 
 from __future__ import annotations
 
-import functools
-import importlib.resources
 import math
 from dataclasses import dataclass, field
 
@@ -52,15 +51,13 @@ from numba import njit
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..astro.constants import J2000_JD
 from ..astro.timescales import tdb_jd
-from ..readers.naif import read_text_kernel
+from ..readers.pck import IauSunElements, read_iau_sun_elements
 
 __all__ = [
     "GM_SUN_DE430",
     "J2_SUN_DE430",
     "R_SUN_IAU_M",
-    "IauSunElements",
     "SunJ2",
-    "read_iau_sun_elements",
     "solar_iau_rotation",
     "sun_j2_accel",
     "sun_pole",
@@ -75,46 +72,8 @@ J2_SUN_DE430 = 2.1106088532726840e-7
 R_SUN_IAU_M = 696000e3
 
 #: GM of the Sun [m^3/s^2], DE430/DE431 (NAIF gm_de431.tpc BODY10_GM =
-#: 1.3271244004193938e11 km^3/s^2), as ``tqdyn.ephemeris.planetary_gm()["sun"]``.
+#: 1.3271244004193938e11 km^3/s^2), as ``tqdyn.astro.ephemeris.planetary_gm()["sun"]``.
 GM_SUN_DE430 = 1.32712440041939400e20
-
-_IAU_KERNEL = "pck00010.tpc"
-
-
-@dataclass(frozen=True)
-class IauSunElements:
-    """IAU (WGCCRE 2009) rotational elements of the Sun, in degrees.
-
-    ra, dec: (3,) pole coefficients in T [Julian centuries of TDB since
-    J2000] (deg, deg/cy, deg/cy^2); pm: (3,) prime-meridian coefficients in
-    d [days of TDB since J2000] (deg, deg/d, deg/d^2).
-    """
-
-    ra: np.ndarray
-    dec: np.ndarray
-    pm: np.ndarray
-
-
-def _poly3(values, name) -> np.ndarray:
-    if not 1 <= len(values) <= 3:
-        raise ValueError(f"{name}: expected 1 to 3 polynomial coefficients, got {len(values)}")
-    v = np.zeros(3)
-    v[: len(values)] = values
-    return v
-
-
-@functools.lru_cache(maxsize=4)
-def read_iau_sun_elements(path=None) -> IauSunElements:
-    """Read BODY10_POLE_RA, BODY10_POLE_DEC and BODY10_PM from a NAIF text
-    PCK (path, or None for the shipped ``tqdyn/data/pck00010.tpc``).
-    Raises FileNotFoundError, or ValueError naming a missing variable."""
-    src = importlib.resources.files("tqdyn") / "data" / _IAU_KERNEL if path is None else path
-    k = read_text_kernel(src)
-    need = ("BODY10_POLE_RA", "BODY10_POLE_DEC", "BODY10_PM")
-    missing = [n for n in need if n not in k]
-    if missing:
-        raise ValueError(f"IAU Sun elements: {src} lacks {', '.join(missing)}")
-    return IauSunElements(*(_poly3(k[n], n) for n in need))
 
 
 def sun_pole(elements: IauSunElements | None = None) -> np.ndarray:
@@ -182,7 +141,7 @@ def sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat, params):
 
 
 def _sun_gm() -> float:
-    """GM of the Sun [m^3/s^2]: ``tqdyn.ephemeris.planetary_gm()["sun"]``
+    """GM of the Sun [m^3/s^2]: ``tqdyn.astro.ephemeris.planetary_gm()["sun"]``
     (the DE430/DE431 value, which GM_SUN_DE430 repeats)."""
     from ..astro.ephemeris import planetary_gm
 
@@ -209,10 +168,10 @@ class SunJ2:
     minus Earth.
 
     j2: unnormalised J2 [1]; radius: its reference radius [m]; gm: GM of
-    the Sun [m^3/s^2] (None: ``tqdyn.ephemeris.planetary_gm()["sun"]``,
+    the Sun [m^3/s^2] (None: ``tqdyn.astro.ephemeris.planetary_gm()["sun"]``,
     DE430); ephemeris: an object with ``geocentric(body, jd1, jd2) ->
     (pos [m], vel [m/s])`` (GCRS, TDB two-part JD), None for
-    :func:`tqdyn.ephemeris.default_ephemeris`.
+    :func:`tqdyn.astro.ephemeris.default_ephemeris`.
 
     Parameters handed to the compiled model: [gm, J2 R^2, pole (3)];
     time-only inputs: the Sun's geocentric GCRS position [m] (3 columns).

@@ -1,39 +1,9 @@
-"""Scenarios: TOML files -> validated, frozen configuration dataclasses.
+"""Scenario configuration: the frozen, validated dataclasses of a tqdyn run
+(:class:`Scenario` and its sections) and :class:`ScenarioError`.
 
-A scenario fixes everything a tqdyn run needs: the epoch, the initial
-Keplerian elements of the satellites, the force model switches, the
-integrator and the run length.  Numbers are read with
-``tomllib.loads(..., parse_float=decimal.Decimal)`` and kept as ``Decimal``
-so that decimal inputs such as ``raan_deg = 211.6`` stay exact until they are
-converted at extended precision (see :mod:`tqdyn.elements`).
-
-Conventions
------------
-* Units: SI (m, s, m^3/s^2) unless the TOML key carries a unit suffix
-  (``a_km``, ``*_deg``); the dataclasses store SI values with a unit suffix
-  in the field name (``a_m``, ``step_s``, ``duration_s``, ``d_tm_m``).
-* Frame: satellite elements are osculating two-body elements in the GCRS
-  (geocentric, ICRF axes), referred to the scenario epoch.
-* Time: ``scenario.epoch_utc`` is a UTC calendar date-time; run durations and
-  steps are TDB seconds after that epoch (see :mod:`tqdyn.timescales`).
-
-TOML layout (every section and key optional except at least one
-``[[satellites]]`` entry with ``a_km``)::
-
-    [scenario]      name, description, epoch_utc, extends (a built-in scenario
-                    whose tables this file updates key by key)
-    [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
-                    precision ("dd" | "float64"), output, output_every
-    [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
-                    tableau ("corrected" | "published"), rtol
-    [forces]        earth_monopole, gm_earth [m^3/s^2]
-    [constellation] pointing ("none" | "global" | "taylor1" | "taylor2" |
-                    "iterative"), control ("on" | "off"), free_tms (bool)
-    [spacecraft]    d_tm [m], d_p [m], tm_axis ("x" | "y" | "z"),
-                    self_gravity ("table-iv" | "off" | array (2, 3) or
-                    (3, 2, 3) [m/s^2] in OA_l), self_gravity_common (array
-                    (3,) or (3, 3) [m/s^2] in S, on both TMs of a satellite)
-    [[satellites]]  name, a_km, e, i_deg, raan_deg, argp_deg, nu_deg
+TOML files are read into these by :mod:`tqdyn.scenario.loader`;
+:meth:`Scenario.to_toml` writes a resolved scenario back as TOML.  Units,
+frames and the TOML layout: see :mod:`tqdyn.scenario`.
 
 Errors are :class:`ScenarioError` (a ``ValueError``) with one line
 ``"<field>: <value> <problem>; allowed: <what is allowed>"``.
@@ -43,17 +13,13 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-import os
-import re
-import tomllib
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation, localcontext
-from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
-from .astro.constants import GM_EARTH_EGM2008
-from .astro.timescales import Epoch
+from ..astro.constants import GM_EARTH_EGM2008
+from ..astro.timescales import Epoch
 
 __all__ = [
     "SatelliteConfig",
@@ -65,18 +31,15 @@ __all__ = [
     "POINTING_LAWS",
     "Scenario",
     "ScenarioError",
-    "builtin_scenarios",
-    "load_scenario",
-    "loads_scenario",
-    "parse_duration",
-    "DEFAULT_SCENARIO",
-    "DEFAULT_EPOCH_UTC",
+    "CONTROL_MODES",
+    "LIBRATION_MODELS",
+    "MAX_EARTH_DEGREE",
+    "MAX_MOON_DEGREE",
+    "MAX_OCEAN_TIDE_DEGREE",
+    "SELF_GRAVITY_MODELS",
+    "THIRD_BODIES",
+    "TM_AXES",
 ]
-
-DEFAULT_SCENARIO = "tianqin"
-#: Epoch used when a scenario file has no ``scenario.epoch_utc`` (UTC): the
-#: epoch of the TianQin Table I elements.
-DEFAULT_EPOCH_UTC = "2004-06-06T00:00:00"
 
 _PRECISIONS = ("dd", "float64")
 _METHODS = ("dp87",)
@@ -164,37 +127,30 @@ def _set(obj: Any, name: str, value: Any) -> None:
     object.__setattr__(obj, name, value)
 
 
-_UNITS = {"s": Decimal(1), "min": Decimal(60), "h": Decimal(3600), "d": Decimal(86400)}
-_DURATION_RE = re.compile(r"^\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(s|min|h|d)?\s*$")
-_DURATION_FORMS = 'a number of seconds or a string "<number><unit>" with unit s, min, h or d (e.g. "90d", "1.5d", "12h", "30min", "3600s")'
+# --------------------------------------------------------------------------- TOML type names (messages)
 
 
-def _parse_duration(value: Any, name: str) -> Decimal:
+def _a(noun: str) -> str:
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
+def _toml_type(value: Any) -> str:
     if isinstance(value, bool):
-        raise ScenarioError(name, value, "is a boolean", _DURATION_FORMS)
+        return "boolean"
+    if isinstance(value, int):
+        return "integer"
+    if isinstance(value, (Decimal, float)):
+        return "float"
     if isinstance(value, str):
-        m = _DURATION_RE.match(value)
-        if m is None:
-            raise ScenarioError(name, value, "is not a duration", _DURATION_FORMS)
-        with localcontext() as ctx:
-            ctx.prec = _EXACT
-            return Decimal(m[1]) * _UNITS[m[2] or "s"]
-    if isinstance(value, (int, Decimal, float)):
-        d = _to_decimal(value, name)
-        return d
-    raise ScenarioError(name, value, f"has type {type(value).__name__}", _DURATION_FORMS)
+        return "string"
+    if isinstance(value, list):
+        return "array"
+    if isinstance(value, dict):
+        return "table"
+    if isinstance(value, (_dt.date, _dt.time)):
+        return "date-time"
+    return type(value).__name__
 
-
-def parse_duration(value: Any) -> Decimal:
-    """Parse a duration into seconds (``Decimal``, exact).
-
-    Accepts numbers (seconds: int, Decimal, float) and strings
-    ``"<number><unit>"`` with unit ``s``, ``min``, ``h`` or ``d`` (1 d =
-    86400 s), e.g. ``"90d"`` -> 7776000, ``"1.5d"`` -> 129600.0, ``"12h"``,
-    ``"30min"``, ``"3600s"``; a bare numeric string means seconds.  The sign
-    is not checked here.  Raises :class:`ScenarioError` (a ``ValueError``).
-    """
-    return _parse_duration(value, "duration")
 
 
 # --------------------------------------------------------------------------- dataclasses
@@ -541,7 +497,7 @@ class Scenario:
 
     @property
     def epoch(self) -> Epoch:
-        """The scenario epoch as a :class:`tqdyn.timescales.Epoch` (UTC/TAI/TT/TDB two-part JDs)."""
+        """The scenario epoch as a :class:`tqdyn.astro.timescales.Epoch` (UTC/TAI/TT/TDB two-part JDs)."""
         return Epoch.from_utc(self.epoch_utc)
 
     @property
@@ -558,7 +514,7 @@ class Scenario:
             return int(q.to_integral_value(rounding="ROUND_CEILING"))
 
     def to_toml(self) -> str:
-        """The resolved scenario as TOML text; :func:`loads_scenario` / :func:`load_scenario`
+        """The resolved scenario as TOML text; :func:`~tqdyn.scenario.loader.loads_scenario` / :func:`~tqdyn.scenario.loader.load_scenario`
         read it back to an equal :class:`Scenario`.  Numbers are written in
         their exact decimal form (durations and steps in s)."""
         out: list[str] = ["# tqdyn scenario (resolved). Units: SI unless the key name says otherwise.", ""]
@@ -629,303 +585,3 @@ def _toml_str(s: str) -> str:
         else:
             out.append(ch)
     return '"' + "".join(out) + '"'
-
-
-# --------------------------------------------------------------------------- raw table -> Scenario
-
-_STR, _NUM, _INT, _BOOL, _DUR, _EPOCH = "string", "number", "integer", "boolean", "duration", "epoch"
-_STRLIST = "list of strings"
-_ANY = "any"  # validated by the dataclass itself
-
-_SCHEMA: dict[str, dict[str, str]] = {
-    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "extends": _STR},
-    "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
-    "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
-    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
-               "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
-               "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
-               "earth_field_indirect": _BOOL, "eop": _BOOL},
-    "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY},
-    "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
-}
-_SAT_SCHEMA: dict[str, str] = {
-    "name": _STR, "a_km": _NUM, "e": _NUM, "i_deg": _NUM, "raan_deg": _NUM, "argp_deg": _NUM, "nu_deg": _NUM,
-}
-_TOP_KEYS = tuple(_SCHEMA) + ("satellites",)
-# TOML key -> dataclass field, where they differ
-_FIELD_OF = {"step": "step_s", "duration": "duration_s", "d_tm": "d_tm_m", "d_p": "d_p_m"}
-
-
-def _typed(value: Any, kind: str, name: str) -> Any:
-    """Check the TOML type of a raw value and convert it (no range checks)."""
-    if kind == _STR:
-        _require(isinstance(value, str), name, value, f"is {_a(_toml_type(value))}", "a string")
-        return value
-    if kind == _BOOL:
-        _require(isinstance(value, bool), name, value, f"is {_a(_toml_type(value))}", "true or false")
-        return value
-    if kind == _INT:
-        _require(isinstance(value, int) and not isinstance(value, bool), name, value, f"is {_a(_toml_type(value))}", "an integer")
-        return value
-    if kind == _NUM:
-        ok = isinstance(value, (int, Decimal)) and not isinstance(value, bool)
-        _require(ok, name, value, f"is {_a(_toml_type(value))}", "a number")
-        _require(Decimal(value).is_finite(), name, value, "is not finite", "a finite number")
-        return Decimal(value)
-    if kind == _STRLIST:
-        ok = isinstance(value, list) and all(isinstance(x, str) for x in value)
-        _require(ok, name, value, f"is {_a(_toml_type(value))}", "a list of strings")
-        return tuple(value)
-    if kind == _ANY:
-        return value
-    if kind == _DUR:
-        d = _parse_duration(value, name)
-        return d
-    if kind == _EPOCH:
-        if isinstance(value, str):
-            return value
-        if isinstance(value, _dt.datetime):
-            off = value.utcoffset()
-            _require(off is None or off == _dt.timedelta(0), name, value.isoformat(), "has a non-zero UTC offset", "a UTC date-time")
-            return value.replace(tzinfo=None).isoformat()
-        if isinstance(value, _dt.date):
-            return value.isoformat()
-        raise ScenarioError(name, value, f"is {_a(_toml_type(value))}", "a UTC date-time string YYYY-MM-DDTHH:MM:SS[.fff]")
-    raise AssertionError(kind)  # pragma: no cover
-
-
-def _a(noun: str) -> str:
-    return ("an " if noun[:1] in "aeiou" else "a ") + noun
-
-
-def _toml_type(value: Any) -> str:
-    if isinstance(value, bool):
-        return "boolean"
-    if isinstance(value, int):
-        return "integer"
-    if isinstance(value, (Decimal, float)):
-        return "float"
-    if isinstance(value, str):
-        return "string"
-    if isinstance(value, list):
-        return "array"
-    if isinstance(value, dict):
-        return "table"
-    if isinstance(value, (_dt.date, _dt.time)):
-        return "date-time"
-    return type(value).__name__
-
-
-def _check_table(table: Any, name: str, allowed: Sequence[str]) -> dict:
-    _require(isinstance(table, dict), name, table, f"is {_a(_toml_type(table))}", "a table")
-    for key in table:
-        if key not in allowed:
-            raise ScenarioError(f"{name}.{key}" if name else key, problem="is not a known key", allowed=", ".join(allowed))
-    return table
-
-
-def _build(cls, prefix: str, raw: Mapping[str, Any], schema: Mapping[str, str]):
-    """Type-check raw TOML values, construct ``cls`` and map its errors back to TOML names."""
-    kwargs: dict[str, Any] = {}
-    for key, kind in schema.items():
-        if key in raw:
-            kwargs[_FIELD_OF.get(key, key)] = _typed(raw[key], kind, f"{prefix}.{key}")
-    try:
-        return cls(**kwargs)
-    except ScenarioError as err:
-        key = err.field.rsplit(".", 1)[-1]
-        toml_key = {v: k for k, v in _FIELD_OF.items()}.get(key, key)
-        value = raw.get(toml_key, err.value)
-        raise ScenarioError(f"{prefix}.{toml_key}", value, err.problem, err.allowed) from None
-
-
-def _build_satellite(raw: Any, k: int) -> SatelliteConfig:
-    prefix = f"satellites.{k}"
-    _check_table(raw, prefix, tuple(_SAT_SCHEMA))
-    _require("a_km" in raw, f"{prefix}.a_km", _NOVALUE, "is missing", "a semi-major axis in km (> 0)")
-    vals = {key: _typed(raw[key], kind, f"{prefix}.{key}") for key, kind in _SAT_SCHEMA.items() if key in raw}
-    a_km = vals.pop("a_km")
-    with localcontext() as ctx:
-        ctx.prec = _EXACT
-        a_m = a_km * 1000
-    _require(a_km > 0, f"{prefix}.a_km", a_km, "is not positive", "a_km > 0 km")
-    kwargs = {"name": vals.pop("name", f"Sat{k}"), "a_m": a_m, "e": Decimal(0), "i_deg": Decimal(0),
-              "raan_deg": Decimal(0), "argp_deg": Decimal(0), "nu_deg": Decimal(0)}
-    kwargs.update(vals)
-    try:
-        return SatelliteConfig(**kwargs)
-    except ScenarioError as err:
-        key = err.field.rsplit(".", 1)[-1]
-        key = "a_km" if key == "a_m" else key
-        raise ScenarioError(f"{prefix}.{key}", raw.get(key, err.value), err.problem, err.allowed) from None
-
-
-def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
-    _check_table(raw, "", _TOP_KEYS)
-    for sec in _SCHEMA:
-        _check_table(raw.get(sec, {}), sec, tuple(_SCHEMA[sec]))
-    meta = raw.get("scenario", {})
-    run = _build(RunConfig, "run", raw.get("run", {}), _SCHEMA["run"])
-    integ = _build(IntegratorConfig, "integrator", raw.get("integrator", {}), _SCHEMA["integrator"])
-    forces = _build(ForcesConfig, "forces", raw.get("forces", {}), _SCHEMA["forces"])
-    craft = _build(SpacecraftConfig, "spacecraft", raw.get("spacecraft", {}), _SCHEMA["spacecraft"])
-    const = _build(ConstellationConfig, "constellation", raw.get("constellation", {}), _SCHEMA["constellation"])
-    sats_raw = raw.get("satellites")
-    _require(sats_raw is not None, "satellites", _NOVALUE, "is missing", "at least one [[satellites]] table")
-    _require(isinstance(sats_raw, list) and len(sats_raw) >= 1, "satellites", sats_raw, "is not a non-empty array of tables",
-             "at least one [[satellites]] table")
-    sats = tuple(_build_satellite(s, k) for k, s in enumerate(sats_raw, start=1))
-    name = _typed(meta.get("name", default_name), _STR, "scenario.name")
-    desc = _typed(meta.get("description", ""), _STR, "scenario.description")
-    epoch = _typed(meta.get("epoch_utc", DEFAULT_EPOCH_UTC), _EPOCH, "scenario.epoch_utc")
-    return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
-                    spacecraft=craft, constellation=const, satellites=sats)
-
-
-# --------------------------------------------------------------------------- overrides
-
-
-def _parse_override_value(text: str, kind: str) -> Any:
-    try:
-        value = tomllib.loads("v = " + text, parse_float=Decimal)["v"]
-    except tomllib.TOMLDecodeError:
-        if kind == _STRLIST:  # --set forces.third_bodies=sun,moon
-            return [x.strip() for x in text.split(",") if x.strip()]
-        return text.strip()
-    if kind in (_STR, _EPOCH) and not isinstance(value, str) and not (kind == _EPOCH and isinstance(value, _dt.date)):
-        return text.strip()  # e.g. --set scenario.name=123 means the string "123"
-    return value
-
-
-def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
-    for item in overrides:
-        if not isinstance(item, str) or "=" not in item:
-            raise ScenarioError("override", item, "is not of the form key=value",
-                                '"section.key=value" or "satellites.N.key=value"')
-        key, text = item.split("=", 1)
-        key = key.strip()
-        parts = key.split(".")
-        if parts[0] == "satellites":
-            sats = raw.get("satellites")
-            n = len(sats) if isinstance(sats, list) else 0
-            if len(parts) != 3:
-                raise ScenarioError(f"override {key}", problem="is not of the form satellites.N.key",
-                                    allowed=f"satellites.N.key with N in 1..{n} and key in {', '.join(_SAT_SCHEMA)}")
-            idx_text, sat_key = parts[1], parts[2]
-            if not idx_text.isdigit() or not 1 <= int(idx_text) <= n:
-                raise ScenarioError(f"override {key}", idx_text, "is not a satellite index",
-                                    f"1..{n} (1-based)" if n else "no satellites defined")
-            if sat_key not in _SAT_SCHEMA:
-                raise ScenarioError(f"override {key}", sat_key, "is not a satellite key", ", ".join(_SAT_SCHEMA))
-            sat = sats[int(idx_text) - 1]
-            _require(isinstance(sat, dict), f"satellites.{idx_text}", sat, "is not a table", "a [[satellites]] table")
-            sat[sat_key] = _parse_override_value(text, _SAT_SCHEMA[sat_key])
-            continue
-        if len(parts) != 2 or parts[0] not in _SCHEMA:
-            allowed = ", ".join(f"{s}.<key>" for s in _SCHEMA) + ", satellites.N.<key>"
-            raise ScenarioError(f"override {key}", problem="is not a known section.key", allowed=allowed)
-        sec, sub = parts
-        if sub not in _SCHEMA[sec]:
-            raise ScenarioError(f"override {key}", sub, f"is not a key of [{sec}]", ", ".join(_SCHEMA[sec]))
-        table = raw.setdefault(sec, {})
-        _require(isinstance(table, dict), sec, table, "is not a table", "a table")
-        table[sub] = _parse_override_value(text, _SCHEMA[sec][sub])
-
-
-# --------------------------------------------------------------------------- public loaders
-
-
-def _builtin_dir():
-    return resources.files("tqdyn") / "scenarios"
-
-
-def builtin_scenarios() -> tuple[str, ...]:
-    """Names of the built-in scenarios (package data ``tqdyn/scenarios/*.toml``), sorted."""
-    return tuple(sorted(p.name[: -len(".toml")] for p in _builtin_dir().iterdir() if p.name.endswith(".toml")))
-
-
-def loads_scenario(text: str, overrides: Sequence[str] = (), *, source: str = "<string>", default_name: str = "scenario") -> Scenario:
-    """Build a :class:`Scenario` from TOML ``text`` (see :func:`load_scenario` for overrides).
-
-    ``source`` names the text in error messages; ``default_name`` is used when
-    the text has no ``scenario.name``.
-    """
-    try:
-        raw = tomllib.loads(text, parse_float=Decimal)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(source, problem=f"invalid TOML: {exc}", allowed="a TOML document (https://toml.io)") from None
-    raw = _resolve_extends(raw, source, ())
-    if isinstance(overrides, str):
-        overrides = (overrides,)
-    _apply_overrides(raw, overrides)
-    return _scenario_from_raw(raw, default_name)
-
-
-def _resolve_extends(raw: dict, source: str, chain: tuple[str, ...]) -> dict:
-    """``[scenario] extends = "<built-in>"``: the built-in scenario's tables,
-    each updated key by key with this file's (``[[satellites]]``, if given,
-    replaces the base's list); ``name`` and ``description`` are this file's."""
-    meta = raw.get("scenario", {})
-    if not isinstance(meta, dict) or "extends" not in meta:
-        return raw
-    base_name = meta["extends"]
-    builtins = builtin_scenarios()
-    _require(isinstance(base_name, str) and base_name in builtins, "scenario.extends", base_name,
-             "is not a built-in scenario", ", ".join(builtins))
-    _require(base_name not in chain, "scenario.extends", base_name, f"extends itself ({' -> '.join(chain)})",
-             "a chain of built-in scenarios without cycles")
-    text = (_builtin_dir() / f"{base_name}.toml").read_text(encoding="utf-8")
-    base = _resolve_extends(tomllib.loads(text, parse_float=Decimal), base_name, chain + (base_name,))
-    merged = {k: (dict(v) if isinstance(v, dict) else v) for k, v in base.items()}
-    for key, value in raw.items():
-        if isinstance(value, dict) and isinstance(merged.get(key), dict):
-            merged[key].update(value)
-        else:
-            merged[key] = value
-    merged["scenario"] = {k: v for k, v in merged["scenario"].items() if k != "extends"}
-    merged["scenario"].setdefault("description", "")
-    for k in ("name", "description"):
-        if k not in meta:
-            merged["scenario"].pop(k, None)
-    return merged
-
-
-def load_scenario(name_or_path: str | os.PathLike | None = None, overrides: Sequence[str] = ()) -> Scenario:
-    """Load a scenario by built-in name or from a ``.toml`` file, apply overrides, validate.
-
-    Parameters
-    ----------
-    name_or_path : str, path or None
-        ``None`` -> ``"tianqin"``.  A built-in name (see
-        :func:`builtin_scenarios`) or a path to a TOML file.  A string that
-        ends in ``.toml`` or contains a path separator is always a path.
-    overrides : sequence of str
-        ``"section.key=value"`` or ``"satellites.N.key=value"`` (N 1-based).
-        ``value`` is read as a TOML value (``50.0``, ``true``, ``"x"``) and
-        otherwise taken as a plain string (``integrator.mode=adaptive``,
-        ``run.duration=90d``).  Applied to the raw table before validation.
-
-    Returns a validated :class:`Scenario`; raises :class:`ScenarioError`.
-    """
-    if name_or_path is None:
-        name_or_path = DEFAULT_SCENARIO
-    builtins = builtin_scenarios()
-    text_name = os.fspath(name_or_path)
-    looks_like_path = (
-        not isinstance(name_or_path, str)
-        or text_name.endswith(".toml")
-        or os.sep in text_name
-        or (os.altsep is not None and os.altsep in text_name)
-    )
-    if not looks_like_path and text_name in builtins:
-        text = (_builtin_dir() / f"{text_name}.toml").read_text(encoding="utf-8")
-        return loads_scenario(text, overrides, source=f"built-in scenario {text_name!r}", default_name=text_name)
-    path = Path(text_name)
-    if not path.is_file():
-        what = "is not a file" if path.exists() else ("does not exist" if looks_like_path else "is neither a built-in scenario nor a file")
-        raise ScenarioError("scenario", text_name, what, f"a path to a .toml file or a built-in scenario: {', '.join(builtins)}")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError("scenario", text_name, f"cannot be read ({exc})", "a readable UTF-8 .toml file") from None
-    return loads_scenario(text, overrides, source=str(path), default_name=path.stem)

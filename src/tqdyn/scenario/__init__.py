@@ -1,0 +1,94 @@
+"""Scenarios: TOML files -> validated, frozen configuration dataclasses.
+
+A scenario fixes everything a tqdyn run needs: the epoch, the initial
+Keplerian elements of the satellites, the force model switches, the
+integrator and the run length.  Numbers are read with
+``tomllib.loads(..., parse_float=decimal.Decimal)`` and kept as ``Decimal``
+so that decimal inputs such as ``raan_deg = 211.6`` stay exact until they are
+converted at extended precision (see :mod:`tqdyn.astro.elements`).
+
+Conventions
+-----------
+* Units: SI (m, s, m^3/s^2) unless the TOML key carries a unit suffix
+  (``a_km``, ``*_deg``); the dataclasses store SI values with a unit suffix
+  in the field name (``a_m``, ``step_s``, ``duration_s``, ``d_tm_m``).
+* Frame: satellite elements are osculating two-body elements in the GCRS
+  (geocentric, ICRF axes), referred to the scenario epoch.
+* Time: ``scenario.epoch_utc`` is a UTC calendar date-time; run durations and
+  steps are TDB seconds after that epoch (see :mod:`tqdyn.astro.timescales`).
+
+TOML layout (every section and key optional except at least one
+``[[satellites]]`` entry with ``a_km``)::
+
+    [scenario]      name, description, epoch_utc, extends (a built-in scenario
+                    whose tables this file updates key by key)
+    [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
+                    precision ("dd" | "float64"), output, output_every
+    [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
+                    tableau ("corrected" | "published"), rtol
+    [forces]        earth_monopole, gm_earth [m^3/s^2]
+    [constellation] pointing ("none" | "global" | "taylor1" | "taylor2" |
+                    "iterative"), control ("on" | "off"), free_tms (bool)
+    [spacecraft]    d_tm [m], d_p [m], tm_axis ("x" | "y" | "z"),
+                    self_gravity ("table-iv" | "off" | array (2, 3) or
+                    (3, 2, 3) [m/s^2] in OA_l), self_gravity_common (array
+                    (3,) or (3, 3) [m/s^2] in S, on both TMs of a satellite)
+    [[satellites]]  name, a_km, e, i_deg, raan_deg, argp_deg, nu_deg
+
+Errors are :class:`ScenarioError` (a ``ValueError``) with one line
+``"<field>: <value> <problem>; allowed: <what is allowed>"``.
+
+Modules: :mod:`tqdyn.scenario.config` (the dataclasses, their validation,
+:meth:`Scenario.to_toml`), :mod:`tqdyn.scenario.loader` (TOML schema,
+overrides, ``extends``, built-in scenarios in ``tqdyn/scenario/builtin/``).
+"""
+
+from __future__ import annotations
+
+# the constants below are public names of the former module tqdyn.scenario
+# (importable from here, not part of __all__)
+from .config import (  # noqa: F401
+    CONTROL_MODES,
+    LIBRATION_MODELS,
+    MAX_EARTH_DEGREE,
+    MAX_MOON_DEGREE,
+    MAX_OCEAN_TIDE_DEGREE,
+    POINTING_LAWS,
+    SELF_GRAVITY_MODELS,
+    THIRD_BODIES,
+    TM_AXES,
+    ConstellationConfig,
+    ForcesConfig,
+    IntegratorConfig,
+    RunConfig,
+    SatelliteConfig,
+    Scenario,
+    ScenarioError,
+    SpacecraftConfig,
+)
+from .loader import (
+    DEFAULT_EPOCH_UTC,
+    DEFAULT_SCENARIO,
+    builtin_scenarios,
+    load_scenario,
+    loads_scenario,
+    parse_duration,
+)
+
+__all__ = [
+    "SatelliteConfig",
+    "IntegratorConfig",
+    "RunConfig",
+    "ForcesConfig",
+    "SpacecraftConfig",
+    "ConstellationConfig",
+    "POINTING_LAWS",
+    "Scenario",
+    "ScenarioError",
+    "builtin_scenarios",
+    "load_scenario",
+    "loads_scenario",
+    "parse_duration",
+    "DEFAULT_SCENARIO",
+    "DEFAULT_EPOCH_UTC",
+]
