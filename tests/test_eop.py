@@ -33,7 +33,8 @@ import numpy as np
 import pytest
 
 from tqdyn.astro.eop import ARCSEC, EOP, tidal_arguments, tidal_eop_corrections
-from tqdyn.readers.eop_c04 import load_eop, parse_eop_c04
+from tqdyn.astro.eop import load_eop
+from tqdyn.readers.eop_c04 import parse_eop_c04
 from tqdyn.readers.iers_tables import load_tidal_eop_terms
 
 UAS = ARCSEC * 1e-6

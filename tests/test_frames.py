@@ -31,7 +31,7 @@ import pytest
 
 from tqdyn.astro import earth_orientation as frames
 from tqdyn.astro.eop import ARCSEC, EOP, tidal_arguments, tidal_eop_corrections
-from tqdyn.readers.eop_c04 import load_eop
+from tqdyn.astro.eop import load_eop
 from tqdyn.readers.iers_tables import load_tidal_eop_terms
 from tqdyn.astro.earth_orientation import earth_orientation, gcrs_to_itrs, itrs_to_gcrs
 from tqdyn.astro.timescales import Epoch, tdb_jd

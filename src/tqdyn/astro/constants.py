@@ -6,6 +6,8 @@ precision code (mpmath, double-double) can convert them without a float64
 rounding step.
 """
 
+import math
+
 __all__ = [
     "GM_EARTH_EGM2008",
     "R_EARTH_EGM2008",
@@ -14,6 +16,8 @@ __all__ = [
     "J2000_JD",
     "J_EARTH_IERS2010",
     "AU_M",
+    "ARCSEC_RAD",
+    "MJD_JD0",
 ]
 
 # Geocentric gravitational constant [m^3/s^2], exact decimal string as published
@@ -41,3 +45,9 @@ J_EARTH_IERS2010 = 9.8e8
 
 # Astronomical unit [m], exact by definition (IAU 2012 Resolution B2).
 AU_M = 149597870700.0
+
+# One second of arc [rad]: pi / (180 * 3600).
+ARCSEC_RAD = math.pi / 648000.0
+
+# Julian date of MJD 0 [d]: MJD = JD - 2400000.5 (IAU 1973).
+MJD_JD0 = 2400000.5

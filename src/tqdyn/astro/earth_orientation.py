@@ -61,9 +61,8 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
-from ..readers.eop_c04 import load_eop
 from ..readers.iers_tables import load_tidal_eop_terms
-from .eop import EOP, tidal_arguments, tidal_eop_corrections
+from .eop import EOP, load_eop, tidal_arguments, tidal_eop_corrections
 from .timescales import Epoch, tdb_jd
 
 __all__ = ["GRID_POINTS", "GRID_STEP_S", "EarthOrientation", "earth_orientation", "gcrs_to_itrs", "itrs_to_gcrs"]
@@ -322,7 +321,7 @@ def earth_orientation(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, u
     t_hi, t_lo : float or array_like [s] -- TDB seconds since the epoch as a
         double-double (broadcast together; ``t_lo`` may be 0).
     eop : :class:`tqdyn.astro.eop.EOP` or None -- EOP table (default: the shipped
-        IERS 14 C04 series, :func:`tqdyn.readers.eop_c04.load_eop`).
+        IERS 14 C04 series, :func:`tqdyn.astro.eop.load_eop`).
     use_eop : bool -- False: no EOP at all (x_p = y_p = dX = dY = 0, UT1 =
         UTC); for quick looks and for dates outside the EOP table.
     tidal_eop : bool -- add the IERS 2010 sub-daily ocean-tide terms

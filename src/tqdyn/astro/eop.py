@@ -2,9 +2,9 @@
 
 What this module provides
 -------------------------
-* :func:`tqdyn.readers.eop_c04.load_eop` -- reader of the IERS EOP 14 C04 daily series
-  (``data/eopc04_14_IAU2000.62-now.txt``, shipped; see ``data/SOURCES.md``)
-  into an :class:`EOP` table: polar motion x_p, y_p and celestial pole
+* :func:`load_eop` -- the IERS EOP 14 C04 daily series
+  (``data/eopc04_14_IAU2000.62-now.txt``, shipped; see ``data/SOURCES.md``;
+  read by :func:`tqdyn.readers.eop_c04.read_eop_c04`) as an :class:`EOP` table: polar motion x_p, y_p and celestial pole
   offsets dX, dY in **rad**, UT1-UTC and LOD in **s**, one row per day at
   0 h UTC (MJD in UTC).
 * :meth:`EOP.at` -- interpolation to any instants (arrays of any shape).
@@ -54,6 +54,7 @@ days of UTC (ERFA quasi-JD convention on leap-second days).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -65,9 +66,12 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ..readers.eop_c04 import read_eop_c04
 from ..readers.iers_tables import TidalEOPTerms
+from .constants import ARCSEC_RAD, MJD_JD0
 
 __all__ = [
+    "load_eop",
     "ARCSEC",
     "EOP",
     "EOPValues",
@@ -76,9 +80,9 @@ __all__ = [
 ]
 
 #: One arcsecond in radians (pi / 648000).
-ARCSEC = math.pi / 648000.0
+ARCSEC = ARCSEC_RAD  # rad per arcsec (astro.constants)
 
-_MJD_JD0 = 2400000.5
+_MJD_JD0 = MJD_JD0
 _DAY = 86400.0
 
 
@@ -97,6 +101,23 @@ class EOPValues(NamedTuple):
     lod: np.ndarray
     dx: np.ndarray
     dy: np.ndarray
+
+
+@functools.lru_cache(maxsize=1)
+def _shipped_eop() -> "EOP":
+    return EOP.from_series(read_eop_c04())
+
+
+def load_eop(path=None) -> "EOP":
+    """The EOP table of an IERS C04 file (x, y, dX, dY in rad; s).
+
+    ``path=None``: the shipped IERS EOP 14 C04 series
+    (``tqdyn/data/eopc04_14_IAU2000.62-now.txt``, 1962-01-01 .. 2024-09-03),
+    read once and cached.  Otherwise a path to a file of the same format.
+    Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for a
+    malformed one (:func:`tqdyn.readers.eop_c04.read_eop_c04`).
+    """
+    return _shipped_eop() if path is None else EOP.from_series(read_eop_c04(path))
 
 
 def _quiet_dat(y, m, d, fd):
@@ -121,7 +142,7 @@ class EOP:
 
     TAI-UTC at the nodes (from ``erfa.dat``) is computed on construction and
     kept privately (it is what removes the leap-second jumps of UT1-UTC).
-    Construct with :func:`tqdyn.readers.eop_c04.load_eop` (or directly from arrays, e.g. in tests).
+    Construct with :func:`load_eop` (or :meth:`from_series`, or directly from arrays, e.g. in tests).
     """
 
     mjd: np.ndarray
@@ -136,6 +157,12 @@ class EOP:
     _dlod: np.ndarray = field(init=False, repr=False)
     _daylen: np.ndarray = field(init=False, repr=False)
     _table: np.ndarray = field(init=False, repr=False)
+
+    @classmethod
+    def from_series(cls, series) -> "EOP":
+        """The table of a daily series read from a file (:class:`tqdyn.readers.eop_c04.EopSeries`)."""
+        return cls(mjd=series.mjd, xp=series.xp, yp=series.yp, dut1=series.dut1, lod=series.lod, dx=series.dx,
+                   dy=series.dy, source=series.source)
 
     def __post_init__(self):
         cols = {}

@@ -55,7 +55,7 @@ from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.pck import IauMoonElements, LunarPaKernel, load_lunar_pa_kernel, read_iau_moon_elements
-from .constants import J2000_JD
+from .constants import ARCSEC_RAD, J2000_JD
 
 __all__ = [
     "ARCSEC_RAD",
@@ -66,7 +66,6 @@ __all__ = [
 ]
 
 #: One arcsecond [rad].
-ARCSEC_RAD = np.pi / 648000.0
 
 #: Days per Julian century.
 _CENTURY_D = 36525.0

@@ -47,13 +47,12 @@ over the 90-day reference run the solid dC21 swings from +1.9e-10 to
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..astro.constants import J2000_JD
+from ..astro.constants import ARCSEC_RAD, J2000_JD
 
 __all__ = [
     "ARCSEC",
@@ -66,7 +65,7 @@ __all__ = [
 ]
 
 #: One arcsecond [rad].
-ARCSEC = math.pi / 648000.0
+ARCSEC = ARCSEC_RAD  # rad per arcsec (astro.constants)
 _MAS = ARCSEC / 1000.0
 _JULIAN_YEAR_D = 365.25
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..astro.tidal_arguments import doodson_multipliers
+from .doodson import doodson_multipliers
 
 __all__ = [
     "FES2004_FILE",

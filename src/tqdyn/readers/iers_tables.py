@@ -18,13 +18,13 @@ with :mod:`tqdyn.astro.tidal_arguments`.
 from __future__ import annotations
 
 import functools
-import math
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..astro.tidal_arguments import delaunay_multipliers, doodson_multipliers
+from ..astro.constants import ARCSEC_RAD
+from .doodson import delaunay_multipliers, doodson_multipliers
 from .files import read_iers_table
 
 __all__ = [
@@ -39,7 +39,7 @@ __all__ = [
 ]
 
 #: One microarcsecond in radians (:data:`tqdyn.astro.eop.ARCSEC` * 1e-6).
-_MICROARCSEC = math.pi / 648000.0 * 1e-6
+_MICROARCSEC = ARCSEC_RAD * 1e-6
 
 _DOODSON_TOKEN = re.compile(r"^\d{1,3},\d{3}$")
 
