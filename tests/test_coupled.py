@@ -338,7 +338,7 @@ def test_ninety_day_acceptance(tmp_path):
     (report.secular_along_track_drift) and 3/2 f T^2 for a constant
     along-track push.  The paper's "< 1 m" is reported, not asserted: tqdyn
     gives 1.47 m for Sat1 (README, docs/report.md)."""
-    from tqdyn.analysis.report import orbit_deviation, secular_along_track_drift
+    from tqdyn.analysis.metrics import orbit_deviation, secular_along_track_drift
 
     every = ["run.output_every=12", "forces.earth_degree=12"]
     _, grav, _ = _run(tmp_path, "g.h5", every + ["constellation.pointing=none", "constellation.control=off"], "90d")

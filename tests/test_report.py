@@ -1,5 +1,5 @@
-"""Tests of tqdyn.analysis.report, tqdyn.analysis.pointing_study, tqdyn.studies
-and the ``tqdyn report`` command.
+"""Tests of tqdyn.analysis.metrics, tqdyn.analysis.pointing_study, tqdyn.workflows.studies,
+tqdyn.workflows.report and the ``tqdyn report`` command.
 
 References:
 * pointing (Fig. 5): first-order aberration estimates written here from the
@@ -24,8 +24,9 @@ import pytest
 from tqdyn import cli
 from tqdyn.formats import trajectory as io
 from tqdyn.workflows import run as runner
+from tqdyn.workflows import report as rp
 from tqdyn.workflows import studies
-from tqdyn.analysis import report as rp
+from tqdyn.analysis import metrics
 from tqdyn.analysis.pointing_study import compare_pointing_laws, pointing_study_of
 from tqdyn.cli.report import report as report_command
 from tqdyn.astro.constants import C_LIGHT
@@ -119,7 +120,7 @@ def test_secular_drift_constant_tangential_push():
     r = a * np.stack([np.cos(ph), np.sin(ph), 0 * ph], -1)[:, None, :]
     v = a * nn * np.stack([-np.sin(ph), np.cos(ph), 0 * ph], -1)[:, None, :]
     acc = f * v / np.linalg.norm(v, axis=-1, keepdims=True)
-    drift = rp.secular_along_track_drift(t, r, v, acc)
+    drift = metrics.secular_along_track_drift(t, r, v, acc)
     assert abs(drift[-1, 0] / (-1.5 * f * t[-1] ** 2) - 1) < 1e-6
 
 
@@ -131,7 +132,7 @@ def test_range_asd_white_noise_level():
     level = 0.3e-12
     sigma = level * np.sqrt(0.5 / dt)
     t = np.arange(n) * dt
-    res = rp.range_asd_in_band(t, np.full(n, 1.7e8), rng.normal(0.0, sigma, n))
+    res = metrics.range_asd_in_band(t, np.full(n, 1.7e8), rng.normal(0.0, sigma, n))
     sel = (res.f > 2e-3) & (res.f < 9e-3)
     assert abs(np.median(res.asd[sel]) / level - 1) < 0.05
     assert res.band[1] == pytest.approx(0.01)
@@ -141,7 +142,7 @@ def test_range_asd_white_noise_level():
 
 def test_flight_direction_is_minus_y_s(runs):
     # the +flight self-gravity of tqdyn.studies is [0, -1e-9, 0] in S: check the sign on a run
-    y = rp.flight_axis_check(io.read_trajectory(runs["dragfree"]))
+    y = metrics.flight_axis_check(io.read_trajectory(runs["dragfree"]))
     assert np.max(y) < -0.9999
     assert studies.FLIGHT_DIRECTION_S == (0.0, -1.0, 0.0)
 
@@ -151,7 +152,7 @@ def test_flight_push_moves_the_orbit_along_track(runs):
     # along the velocity, zero initial offset: y(T) = f (4 (1 - cos nT) / n^2 - 3/2 T^2)
     # (forward first, then behind: -3/2 f T^2 dominates after a few orbits)
     grav = io.read_trajectory(runs["gravity"])
-    dev = rp.orbit_deviation(io.read_trajectory(runs["flight"]), grav)
+    dev = metrics.orbit_deviation(io.read_trajectory(runs["flight"]), grav)
     n = np.sqrt(3.986004415e14 / np.mean(np.linalg.norm(grav["sat/r"], axis=-1), axis=0) ** 3)
     T, f = dev.t[-1], 1e-9
     expected = f * (4 * (1 - np.cos(n * T)) / n ** 2 - 1.5 * T ** 2)

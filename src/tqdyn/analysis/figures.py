@@ -1,11 +1,40 @@
 """Figures of analysis results (matplotlib, imported lazily: an optional
-dependency, `pip install tqdyn[plot]`)."""
+dependency, `pip install tqdyn[plot]`).
+
+The force budget, and the figures of ``tqdyn report``
+(:mod:`tqdyn.workflows.report`): pointing-law errors, control, breathing
+angles, range ASDs, orbit deviations.  Every report figure is written as PNG
+and PDF (:data:`FIGURE_FORMATS`); time axes in days (TDB) since the epoch.
+matplotlib is imported only inside the plotting functions (Agg backend).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from pathlib import Path
+
 import numpy as np
 
-__all__ = ["plot_force_budget"]
+from ..constellation.indices import Sat
+from . import spectra
+from .metrics import BREATHING_BAND_DEG, AsdResult, _common_rows, _t
+from .pointing_study import PointingStudy
+
+__all__ = [
+    "FIGURE_FORMATS",
+    "plot_asd",
+    "plot_breathing",
+    "plot_common_self_gravity",
+    "plot_control",
+    "plot_deviations",
+    "plot_extreme",
+    "plot_force_budget",
+    "plot_pointing",
+]
+
+#: File formats every figure is written in.
+FIGURE_FORMATS = ("png", "pdf")
+_DPI = 130
 
 
 def _pyplot():
@@ -41,3 +70,208 @@ def plot_force_budget(budget, t_s, path, title: str = "") -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def _save(fig, out_dir: Path, stem: str) -> list[Path]:
+    plt = _pyplot()
+    paths = []
+    fig.tight_layout()
+    for ext in FIGURE_FORMATS:
+        p = out_dir / f"{stem}.{ext}"
+        fig.savefig(p, dpi=_DPI)
+        paths.append(p)
+    plt.close(fig)
+    return paths
+
+
+def _stride(n: int, target: int = 4000) -> int:
+    return max(1, n // target)
+
+
+def _days(t):
+    return np.asarray(t) / 86400.0
+
+
+_SAT_COLORS = ("tab:blue", "tab:orange", "tab:green")
+
+
+def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str) -> list[Path]:
+    """Fig. 5: per-beam, X_S and theta errors [rad] of each approximate law vs the iterative law."""
+    plt = _pyplot()
+    laws = list(study.laws)
+    fig, axes = plt.subplots(len(laws), 1, figsize=(8, 2.6 * len(laws) + 0.6), sharex=True, squeeze=False)
+    k = _stride(study.t.size)
+    d = _days(study.t)[::k]
+    for ax, law in zip(axes[:, 0], laws):
+        c = study.laws[law]
+        for s in Sat:
+            for m, what in ((0, f"<-{int(s.k)}"), (1, f"<-{int(s.j)}")):
+                ax.semilogy(d, np.maximum(c.per_beam[::k, s.index, m], 1e-30), lw=0.7, color=_SAT_COLORS[s.index],
+                            ls="-" if m == 0 else "--", label=f"beam Sat{int(s)} {what}")
+        ax.semilogy(d, np.maximum(c.x_s[::k].max(axis=1), 1e-30), color="k", lw=0.9, ls=":", label="X_S (max over sats)")
+        ax.semilogy(d, np.maximum(c.theta[::k].max(axis=1), 1e-30), color="0.45", lw=0.9, ls="-.",
+                    label="theta (max over sats)")
+        ax.set_ylabel("error vs iterative [rad]")
+        ax.set_title(f"{law}: max per beam {c.max_per_beam:.2e} rad, X_S {c.max_x_s:.1e}, theta {c.max_theta:.1e}",
+                     fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0, 0].legend(fontsize=6.5, ncol=4, loc="center right")
+    axes[-1, 0].set_xlabel("time since epoch [days, TDB]")
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) -> list[Path]:
+    """Figs. 7/8: TM suspension acceleration [m/s^2] and angular acceleration
+    [rad/s^2] (components in OA_l) of both TMs of ``sat``, and |A|, |G| of
+    every satellite, against time."""
+    plt = _pyplot()
+    t = _t(traj)
+    k = _stride(t.size)
+    d = _days(t)[::k]
+    A = traj["tm/a_suspension"][::k]
+    W = traj["tm/alpha_suspension"][::k]
+    G = np.linalg.norm(traj["sat/a_dragfree"][::k], axis=-1)
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8.4), sharex=True)
+    comp = ("x", "y", "z")
+    for tm, ls in ((0, "-"), (1, "--")):
+        for q in range(3):
+            axes[0].plot(d, A[:, sat.index, tm, q], ls=ls, lw=0.8, color=f"C{q}", label=f"TM{tm + 1} {comp[q]}")
+            axes[1].plot(d, W[:, sat.index, tm, q], ls=ls, lw=0.8, color=f"C{q}", label=f"TM{tm + 1} {comp[q]}")
+    axes[0].set_ylabel(f"Sat{int(sat)} suspension\nacceleration [m/s$^2$], OA$_l$")
+    axes[1].set_ylabel(f"Sat{int(sat)} TM angular\nacceleration [rad/s$^2$], OA$_l$")
+    for s in Sat:
+        axes[2].semilogy(d, np.linalg.norm(A[:, s.index], axis=-1).max(axis=-1), color=_SAT_COLORS[s.index], lw=0.8,
+                         label=f"max$_l$ |A| Sat{int(s)}")
+        axes[2].semilogy(d, G[:, s.index], color=_SAT_COLORS[s.index], lw=0.8, ls="--", label=f"|G| Sat{int(s)}")
+    axes[2].set_ylabel("[m/s$^2$]")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, ncol=3, loc="best")
+    axes[-1].set_xlabel("time since epoch [days, TDB]")
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_breathing(series: Sequence[tuple[str, np.ndarray, np.ndarray, str]], out_dir: Path, stem: str, title: str,
+                   band: bool = True) -> list[Path]:
+    """Fig. 9: breathing angles [deg] against time; ``series`` of (label, t [s],
+    alpha (N, 3) [rad], line style); the 60 +- 0.1 deg band if ``band``."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.4))
+    for label, t, alpha, ls in series:
+        k = _stride(t.size)
+        for s in Sat:
+            ax.plot(_days(t)[::k], np.degrees(alpha[::k, s.index]), ls=ls, lw=0.9, color=_SAT_COLORS[s.index],
+                    label=f"alpha_{int(s)} {label}")
+    if band:
+        for y in BREATHING_BAND_DEG:
+            ax.axhline(y, color="red", lw=0.8, ls=":")
+        ax.axhspan(*BREATHING_BAND_DEG, color="red", alpha=0.04, label="60 +- 0.1 deg")
+    ax.set_xlabel("time since epoch [days, TDB]")
+    ax.set_ylabel("breathing angle [deg]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_asd(curves: Sequence[tuple[str, AsdResult, dict]], out_dir: Path, stem: str, title: str) -> list[Path]:
+    """Figs. 6/10/11: range ASDs [m/Hz^1/2] with the requirement, the band
+    [0.1 mHz, Nyquist] and the lowest reliable frequency marked."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 5))
+    f_all = np.concatenate([c[1].f for c in curves])
+    f_rel = max(c[1].f_reliable for c in curves)
+    for label, res, style in curves:
+        ax.loglog(res.f, res.asd, label=label, **{"lw": 1.0, **style})
+    fr = np.geomspace(f_all.min(), f_all.max(), 400)
+    ax.loglog(fr, spectra.requirement_asd(fr), color="k", ls="--", lw=1.2,
+              label="requirement 0.3 pm/Hz$^{1/2}$ $\\sqrt{1+(7\\,\\mathrm{mHz}/f)^4}$")
+    ax.axvspan(fr[0], 1e-4, color="0.85", alpha=0.5, lw=0)
+    if f_rel > 1e-4:
+        ax.axvline(f_rel, color="0.4", ls=":", lw=0.8)
+        ax.text(f_rel, ax.get_ylim()[0], " lowest reliable bin", rotation=90, fontsize=7, va="bottom", color="0.3")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("range ASD [m/Hz$^{1/2}$]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7.5)
+    ax.set_title(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_deviations(series: Sequence[tuple[str, np.ndarray, np.ndarray, str, str]], out_dir: Path, stem: str,
+                    title: str, ylabel: str = "|r - r$_{ref}$| [m]", log: bool = False,
+                    hline: tuple[float, str] | None = None, ymin: float | None = None) -> list[Path]:
+    """Deviation-type curves: ``series`` of (label, t [s], y (N,), color, line
+    style); ``hline`` (value, label) draws a reference level; ``ymin`` the
+    lower y limit."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.6))
+    for label, t, y, color, ls in series:
+        k = _stride(t.size)
+        (ax.semilogy if log else ax.plot)(_days(t)[::k], y[::k], color=color, ls=ls, lw=1.0, label=label)
+    if hline is not None:
+        ax.axhline(hline[0], color="red", lw=1.0, ls="-.", label=hline[1])
+    if ymin is not None:
+        ax.set_ylim(bottom=ymin)
+    ax.set_xlabel("time since epoch [days, TDB]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_common_self_gravity(curves: Sequence[tuple[str, str, np.ndarray, np.ndarray, np.ndarray]],
+                             out_dir: Path) -> list[Path]:
+    """Sec. V.B.2 (``common-self-gravity``): per common self-gravity direction
+    the orbit deviation from the gravity orbit [m] and the breathing-angle
+    change [deg], both the maximum over the satellites, against time;
+    ``curves`` of (direction label, e.g. "+x", legend tag, t [s], deviation
+    (N,) [m], angle change (N,) [deg]), in the order of
+    :data:`tqdyn.workflows.studies.SG_DIRECTIONS`."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7.5), sharex=True)
+    for k, (label, tag, t, dev_max, dalpha_max) in enumerate(curves):
+        kk = _stride(t.size)
+        style = {"color": f"C{k // 2}", "ls": "-" if label[0] == "+" else "--", "lw": 1.2}
+        axes[0].semilogy(_days(t)[::kk], np.maximum(dev_max[::kk], 1e-3), label=f"{label}{tag}", **style)
+        axes[1].plot(_days(t)[::kk], dalpha_max[::kk], label=f"{label}{tag}", **style)
+    axes[0].set_ylabel("max over satellites |r - r$_{gravity}$| [m]")
+    axes[1].set_ylabel("max over satellites\n|alpha - alpha$_{gravity}$| [deg]")
+    axes[1].set_xlabel("time since epoch [days, TDB]")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, ncol=3, title="common self-gravity 1e-9 m/s$^2$ along (S frame)", title_fontsize=8)
+    fig.suptitle("Common self-gravity: orbit deviation and breathing-angle change vs the gravity orbit", fontsize=10)
+    return _save(fig, out_dir, "common-self-gravity")
+
+
+def plot_extreme(te, ae, tg, ag, out_dir):
+    """Fig. 9: breathing angles of the extreme case and of the gravity orbit
+    vs the 60 +- 0.1 deg band, and their difference [deg]."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
+    _, ia, ib = _common_rows(te, tg)
+    k = _stride(te.size)
+    for s in Sat:
+        c = _SAT_COLORS[s.index]
+        axes[0].plot(_days(te)[::k], np.degrees(ae[::k, s.index]), color=c, lw=0.9, label=f"alpha_{int(s)} extreme")
+        axes[0].plot(_days(tg)[::k], np.degrees(ag[::k, s.index]), color=c, lw=0.7, ls=":",
+                     label=f"alpha_{int(s)} gravity orbit")
+        axes[1].plot(_days(te[ia])[::k], np.degrees(ae[ia, s.index] - ag[ib, s.index])[::k], color=c, lw=1.0,
+                     label=f"alpha_{int(s)}")
+    for y in BREATHING_BAND_DEG:
+        axes[0].axhline(y, color="red", lw=1.0, ls="-.")
+    axes[0].axhspan(*BREATHING_BAND_DEG, color="red", alpha=0.04, label="60 +- 0.1 deg")
+    axes[0].set_ylabel("breathing angle [deg]")
+    axes[1].set_ylabel("extreme - gravity orbit [deg]")
+    axes[1].set_xlabel("time since epoch [days, TDB]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=7, ncol=4, loc="upper left")
+    axes[1].legend(fontsize=7, ncol=3, loc="upper left")
+    fig.suptitle("Fig. 9: breathing angles, extreme self-gravity 1e-9 m/s$^2$ (Sat1 +flight, Sat2 -flight, "
+                 "Sat3 +flight)", fontsize=10)
+    return _save(fig, out_dir, "fig9-extreme-breathing")

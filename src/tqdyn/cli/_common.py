@@ -1,4 +1,5 @@
-"""What every ``tqdyn`` command shares: exit statuses and the one-line error."""
+"""What the ``tqdyn`` commands share: exit statuses, the one-line error and
+the overrides of the scenario shortcut options (``run``, ``forces``)."""
 
 from __future__ import annotations
 
@@ -20,3 +21,14 @@ def fail(message: str, status: int = EXIT_BAD_INPUT):
     """Print ``tqdyn: error: <message>`` on stderr and exit with ``status``."""
     click.echo(f"tqdyn: error: {message}", err=True)
     sys.exit(status)
+
+
+def _overrides(sets, duration, step, output, precision) -> list[str]:
+    """The ``--set`` overrides of a command followed by those of its shortcut options
+    (``--duration``, ``--step``, ``--output``, ``--precision``) that were given."""
+    over = list(sets)
+    for key, value in (("run.duration", duration), ("integrator.step", step),
+                       ("run.output", output), ("run.precision", precision)):
+        if value is not None:
+            over.append(f"{key}={value}")
+    return over

@@ -1,7 +1,7 @@
 """Command line: ``tqdyn report RUN.h5 [RUN.h5 ...]`` and ``tqdyn report --studies``.
 
 Registered in :mod:`tqdyn.cli` with ``cli.add_command(report)``.  It only
-composes :mod:`tqdyn.analysis.report` and :mod:`tqdyn.studies`:
+composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
 
 * ``tqdyn report RUN.h5 [...] [--out DIR]``: figures (PNG and PDF) of what
   the runs contain and ``DIR/summary.md``;
@@ -70,7 +70,7 @@ def report(runs, out, studies, runs_dir, quick, duration_scale, only, sets, work
     if not runs:
         _fail("RUN.h5: no trajectory file given; allowed: one or more tqdyn trajectory files, or --studies")
     from ..formats import trajectory as io
-    from ..analysis import report as rp
+    from ..workflows import report as rp
 
     try:
         rep = rp.report_runs(runs, out or "tqdyn-report", progress=say)
@@ -94,8 +94,8 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
     from tqdm import tqdm
 
     from ..workflows import studies as st
-    from ..analysis import report as rp
-    from ..workflows.sweep import default_workers
+    from ..workflows import report as rp
+    from ..workflows.sweep.execute import default_workers
 
     if quick and duration_scale is not None:
         _fail("--quick: conflicts with --duration-scale; allowed: one of them")

@@ -1,7 +1,7 @@
 """Command line: ``tqdyn sweep SWEEP.toml [--scheduler ADDRESS] [--workers N]``.
 
 Registered in :mod:`tqdyn.cli` with ``cli.add_command(sweep)``.  It only
-composes :mod:`tqdyn.sweep`: validate the whole sweep (bad input: exit
+composes :mod:`tqdyn.workflows.sweep`: validate the whole sweep (bad input: exit
 status 2, one line ``tqdyn: error: ...`` on stderr, nothing run or written),
 run the members not yet done on Dask with a progress bar on stderr, gather
 them into ``<output_dir>/<name>.nc`` and print a summary on stdout.  Members

@@ -23,7 +23,7 @@ from .. import __version__ as _TQDYN_VERSION
 from ..astro.constants import GM_EARTH_EGM2008
 from ..formats import trajectory as _io
 from ..formats.lisa import _FRAME, _TIME, _TPS_DEFINITION, _uniform_grid, write_lisa_orbits
-from ..lightpath.light_time import light_travel_times_of
+from ..lightpath import light_travel_times_of
 from ..lightpath.proper_time import lisa_orbit_quantities
 
 __all__ = ["LisaExport", "export_lisa"]

@@ -395,7 +395,7 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
     Bad input raises ValueError / FileNotFoundError before anything runs; a
     run that fails does not stop the others (see :attr:`StudyRuns.failures`).
     """
-    from .sweep import default_workers
+    from .sweep.execute import default_workers
 
     t0 = time.perf_counter()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
@@ -440,7 +440,7 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
 def _run_on_dask(pending, n_workers, record) -> None:
     from distributed import as_completed
 
-    from .sweep import dask_client
+    from .sweep.execute import dask_client
 
     with dask_client(None, n_workers, len(pending)) as client:
         futures = {client.submit(_run_one, p.scenario_toml, key=f"tqdyn-study-{p.name}-{p.digest}", pure=False): p

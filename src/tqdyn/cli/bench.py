@@ -1,0 +1,43 @@
+"""Command line: ``tqdyn bench [--duration D] [--step S] [--model kepler|full|coupled|all] [--no-heyoka]``.
+
+Registered in :mod:`tqdyn.cli` with ``cli.add_command(bench)``.  It only
+composes :mod:`tqdyn.workflows.bench` and prints its tables; bad input exits
+with status 2 and one line on stderr.
+"""
+
+from __future__ import annotations
+
+import click
+
+from ._common import fail as _fail
+
+__all__ = ["bench"]
+
+
+@click.command("bench")
+@click.option("--duration", default="90d", show_default=True, help="Propagated span.")
+@click.option("--step", default="50", show_default=True, help="Step / output grid [s].")
+@click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
+@click.option("--model", "which", type=click.Choice(["kepler", "full", "coupled", "all"]), default="all",
+              show_default=True,
+              help="kepler: monopole only; full: the full force model, pure gravity (and the reduced model vs "
+                   "heyoka); coupled: the full coupled run (attitude + drag-free control).")
+def bench(duration, step, no_heyoka, which):
+    """Benchmarks: Kepler (3 TianQin satellites, Earth monopole: tqdyn dd vs
+    float64 vs heyoka real128 on the same grid), the force model (full
+    model dd / float64, reduced model dd vs heyoka real128) and the coupled
+    constellation (dd / float64)."""
+    from ..workflows import bench as _bench
+    from ..scenario import ScenarioError
+
+    try:
+        if which in ("kepler", "all"):
+            click.echo(_bench.format_report(_bench.kepler_benchmark(duration=duration, step=step,
+                                                                    heyoka=not no_heyoka)))
+        if which in ("full", "all"):
+            click.echo(_bench.format_force_report(_bench.force_model_benchmark(duration=duration,
+                                                                               heyoka=not no_heyoka)))
+        if which in ("coupled", "all"):
+            click.echo(_bench.format_coupled_report(_bench.coupled_benchmark(duration=duration)))
+    except (ScenarioError, ValueError) as exc:
+        _fail(str(exc))

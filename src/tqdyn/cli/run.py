@@ -1,0 +1,115 @@
+"""Command line: ``tqdyn run [SCENARIO] [--duration ...] [--set KEY=VALUE ...] [--resume]``.
+
+Registered in :mod:`tqdyn.cli` with ``cli.add_command(run)``.  It only
+composes library calls: it resolves the scenario, checks the output path,
+runs the propagator (:func:`tqdyn.workflows.run.run_to_file`) with a
+progress bar, streams the rows into the HDF5 writer and prints a short
+summary.  Bad input exits with status 2 and one line on stderr (no
+traceback, no partial output file).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from .. import __version__
+from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, _overrides, fail as _fail
+
+__all__ = ["run"]
+
+
+def _format_state_table(scenario, y_dd) -> list[str]:
+    import numpy as np
+
+    lines = []
+    for sat, row in zip(scenario.satellites, y_dd):
+        r = row[0:3, 0] + row[0:3, 1]
+        v = row[3:6, 0] + row[3:6, 1]
+        lines.append(f"  {sat.name:<6} r = [{r[0]: .9e}, {r[1]: .9e}, {r[2]: .9e}] m"
+                     f"  |r| = {np.linalg.norm(r):.6f} m  |v| = {np.linalg.norm(v):.9f} m/s")
+    return lines
+
+
+@click.command("run")
+@click.argument("scenario", required=False)
+@click.option("--duration", help="Propagation span: seconds, or with a unit: 90d, 12h, 30min, 3600s.")
+@click.option("--step", help="Integrator step [s] (fixed mode) or output interval (adaptive mode).")
+@click.option("--output", "-o", help="Output HDF5 trajectory file.")
+@click.option("--precision", type=click.Choice(["dd", "float64"]), help="Arithmetic of the propagation.")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+              help="Override a scenario value, e.g. --set integrator.mode=adaptive or "
+                   "--set satellites.2.nu_deg=151 (repeatable).")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
+@click.option("--checkpoint-every", type=click.IntRange(min=0), default=20000, show_default=True,
+              help="Write a resumable checkpoint every N steps (fixed mode; 0 = never).")
+@click.option("--resume", is_flag=True, help="Continue an interrupted run from its checkpoint (same arguments).")
+def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_every, resume):
+    """Propagate SCENARIO (a built-in name or a TOML file; default: tianqin)
+    and write the trajectory file.  Interrupted runs (Ctrl-C, a crash) keep
+    their last checkpoint; `--resume` continues them to a bit-identical file."""
+    from tqdm import tqdm
+
+    from ..formats import trajectory as io
+    from .. import dynamics
+    from ..workflows import run as runner
+    from ..scenario import ScenarioError, load_scenario
+
+    try:
+        scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
+        io.check_writable(scen.run.output)
+        model = dynamics.check_inputs(scen)
+    except (ScenarioError, io.OutputError, ValueError, FileNotFoundError) as exc:
+        _fail(str(exc))
+    integ = scen.integrator
+    fixed = integ.mode == "fixed"
+    n_total = scen.n_steps
+    c = scen.constellation
+    click.echo(f"tqdyn {__version__}: scenario {scen.name!r}, {len(scen.satellites)} satellite(s), "
+               f"{scen.run.precision} precision, DP87 {integ.mode} "
+               + (f"{integ.step_s} s x {n_total} steps" if fixed else f"rtol {integ.rtol}, output every {integ.step_s} s")
+               + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC"
+               + (f"; pointing {c.pointing}, control {c.control}" + (", free TMs" if c.free_tms else "")
+                  if c.coupled else ""), err=True)
+    state = {"bar": None}
+
+    def progress(n):
+        if state["bar"] is None:
+            state["bar"] = tqdm(total=n_total if fixed else float(scen.run.duration_s),
+                                disable=True if quiet else None, unit="step" if fixed else "s",
+                                unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True, desc="propagating")
+        state["bar"].update(n)
+
+    try:
+        summary = runner.run_to_file(scen, model=model, progress=progress,
+                                     checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
+    except (ValueError, io.OutputError) as exc:
+        if state["bar"] is not None:
+            state["bar"].close()
+        if hasattr(exc, "tqdyn_checkpoint") and not isinstance(exc, io.OutputError):
+            raise  # a failure inside the propagation, not bad input
+        _fail(str(exc))
+    except KeyboardInterrupt as exc:
+        if state["bar"] is not None:
+            state["bar"].close()
+        ckpt = getattr(exc, "tqdyn_checkpoint", None)
+        _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt})"
+              if ckpt else "interrupted; no output file written", _EXIT_INTERRUPTED)
+    if state["bar"] is not None:
+        state["bar"].close()
+    result = summary.result
+    lines = [
+        f"steps: {result.n_steps} accepted" + (f", {result.n_rejected} rejected" if not fixed else "")
+        + f", {result.n_rhs} right-hand-side evaluations",
+        f"wall time: {result.wall_s:.2f} s propagation (+ {summary.compile_s:.2f} s JIT compilation)",
+        f"final states (GCRS, t = {result.t_final[0] + result.t_final[1]:.3f} s TDB after the epoch):",
+        *_format_state_table(scen, result.y_final),
+    ]
+    if result.energy_rel_drift is not None:
+        lines.append("two-body energy drift (relative): "
+                     + ", ".join(f"{s.name} {d:.2e}" for s, d in zip(scen.satellites, result.energy_rel_drift)))
+    for key, text in result.extra.items():
+        lines.append(f"{key}: {text}")
+    lines.append(f"output: {summary.path} ({summary.rows} rows, {summary.size_mb:.1f} MB)")
+    click.echo("\n".join(lines))

@@ -1,0 +1,36 @@
+"""netCDF-4 files (the gathered dataset of a sweep): the xarray engine and an atomic writer."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import secrets
+from pathlib import Path
+
+__all__ = ["netcdf_engine", "write_netcdf"]
+
+_NETCDF_ENGINES = (("h5netcdf", "h5netcdf"), ("netCDF4", "netcdf4"))
+
+
+def netcdf_engine() -> str:
+    """The xarray engine used to write the gathered netCDF-4 file: "h5netcdf"
+    (preferred: pure Python on h5py) or "netcdf4".  ImportError if neither
+    package is installed."""
+    for module, engine in _NETCDF_ENGINES:
+        if importlib.util.find_spec(module) is not None:
+            return engine
+    raise ImportError("writing the sweep's netCDF file needs the h5netcdf package (pip install h5netcdf)")
+
+
+def write_netcdf(dataset, path: str | os.PathLike) -> Path:
+    """Write ``dataset`` atomically as netCDF-4 (engine :func:`netcdf_engine`)
+    to ``path`` (temporary file in the same directory, then renamed).
+    Returns the absolute path."""
+    path = Path(os.path.abspath(os.fspath(path)))
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
+    try:
+        dataset.to_netcdf(tmp, engine=netcdf_engine())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path

@@ -1,0 +1,116 @@
+"""What a report produces: :class:`Report`, the rows of ``summary.md``
+(:class:`SummaryRow`, :func:`format_summary`), the output directory and the
+formatting of the measured values."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...analysis.metrics import _t
+
+__all__ = ["Report", "SummaryRow", "check_out_dir", "format_summary"]
+
+
+@dataclass(frozen=True)
+class SummaryRow:
+    """One line of the summary: ``quantity``, ``paper`` (the paper's value,
+    "-" if the paper has none), ``tqdyn`` (measured), ``notes`` (agreement
+    and explanation)."""
+
+    quantity: str
+    paper: str
+    tqdyn: str
+    notes: str
+
+
+@dataclass
+class Report:
+    """What a report wrote: ``out_dir``; ``figures`` (every PNG / PDF file);
+    ``rows`` (:class:`SummaryRow`); ``summary_path`` (``summary.md``);
+    ``notes`` (things skipped and why); ``values`` (the measured numbers by
+    key, SI units, for tests and scripts)."""
+
+    out_dir: Path
+    figures: list = field(default_factory=list)
+    rows: list = field(default_factory=list)
+    summary_path: Path | None = None
+    notes: list = field(default_factory=list)
+    values: dict = field(default_factory=dict)
+
+
+def format_summary(rows: Sequence[SummaryRow], title: str = "tqdyn report", notes: Sequence[str] = ()) -> str:
+    """The summary as a markdown document (a table of ``rows`` and a list of notes)."""
+    def cell(s):
+        return str(s).replace("|", "\\|").replace("\n", " ")
+
+    out = [f"# {title}", "", "| quantity | paper | tqdyn | agreement / notes |", "|---|---|---|---|"]
+    out += [f"| {cell(r.quantity)} | {cell(r.paper)} | {cell(r.tqdyn)} | {cell(r.notes)} |" for r in rows]
+    if notes:
+        out += ["", "Notes:", ""] + [f"- {n}" for n in notes]
+    return "\n".join(out) + "\n"
+
+
+def check_out_dir(out_dir) -> Path:
+    """Create the output directory ``out_dir`` if needed; ValueError (one
+    line) if it cannot be created or written.  Returns its absolute path."""
+    out = Path(os.path.abspath(os.path.expanduser(os.fspath(out_dir))))
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"--out: {str(out)!r} cannot be created ({exc}); allowed: a writable directory") from None
+    if not os.access(out, os.W_OK):
+        raise ValueError(f"--out: {str(out)!r} is not writable; allowed: a writable directory")
+    return out
+
+
+def _finish(rep: Report, title: str, runs: Sequence[str]) -> None:
+    notes = list(rep.notes) + [f"run {r}" for r in runs]
+    rep.summary_path = rep.out_dir / "summary.md"
+    rep.summary_path.write_text(format_summary(rep.rows, title, notes), encoding="utf-8")
+
+
+# =========================================================================== formatting helpers
+
+
+def _e(x, unit="", digits=2) -> str:
+    if x is None or not np.isfinite(x):
+        return "n/a"
+    return f"{x:.{digits}e}" + (f" {unit}" if unit else "")
+
+
+def _per_sat(values, unit, fmt="{:.2f}") -> str:
+    return " / ".join(fmt.format(v) for v in values) + f" {unit} (Sat1/2/3)"
+
+
+def _order_ok(value, paper, factor=10 ** 0.5 * 3) -> bool:
+    """Same order of magnitude as a paper's "~x" value (within ~1 decade)."""
+    return bool(np.isfinite(value) and paper / factor <= value <= paper * factor)
+
+
+def _asd_verdict(res) -> str:
+    """Agreement text for "ASD under the requirement in band"."""
+    if not np.isfinite(res.max_ratio):
+        return "n/a: run too short for the band"
+    if res.max_ratio < 1:
+        return "agrees: under the requirement in the whole band"
+    return (f"agrees above {res.f_above:.3g} Hz only: below it the orbits' own gravity signal (the Earth's "
+            "static field, the same in pure-gravity orbits, docs/report.md) reaches the requirement")
+
+
+def _span_days(traj) -> float:
+    t = _t(traj)
+    return float(t[-1] - t[0]) / 86400.0
+
+
+def _label_of(path: Path, used: set) -> str:
+    base = path.stem
+    label, k = base, 2
+    while label in used:
+        label, k = f"{base}-{k}", k + 1
+    used.add(label)
+    return label
