@@ -69,7 +69,7 @@ import numpy as np
 from numba import njit
 
 from ..astro.constants import C_LIGHT
-from ..constellation.indices import LINKS
+from ..constellation.indices import LINK_EMITTER, LINK_EMITTER_MOSA, LINK_RECEIVER, LINK_RECEIVER_MOSA
 from ..numerics.hermite import hermite_eval
 from ..numerics.dd import (
     add,
@@ -98,10 +98,8 @@ BODY_LAYOUTS = ("tm", "sat")
 
 # per link (LISA order): receiving / emitting satellite (0-based) and the MOSA (0-based)
 # of each that faces the other one
-_RECV_SAT = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
-_EMIT_SAT = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
-_RECV_MOSA = np.array([ln.receiver.mosa_facing(ln.emitter).index for ln in LINKS], dtype=np.intp)
-_EMIT_MOSA = np.array([ln.emitter.mosa_facing(ln.receiver).index for ln in LINKS], dtype=np.intp)
+_RECV_SAT, _EMIT_SAT = LINK_RECEIVER, LINK_EMITTER
+_RECV_MOSA, _EMIT_MOSA = LINK_RECEIVER_MOSA, LINK_EMITTER_MOSA
 
 
 # ------------------------------------------------------------------ input helpers

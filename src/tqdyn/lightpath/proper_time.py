@@ -37,13 +37,12 @@ import numpy as np
 from numba import njit
 
 from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
-from ..constellation.indices import LINKS
+from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from .light_time import LightTravelTimes
 
 __all__ = ["lisa_orbit_quantities", "proper_time_deviation"]
 
-_RECV = np.array([ln.receiver.index for ln in LINKS], dtype=np.intp)
-_EMIT = np.array([ln.emitter.index for ln in LINKS], dtype=np.intp)
+_RECV, _EMIT = LINK_RECEIVER, LINK_EMITTER
 
 
 # ------------------------------------------------------------------ proper time
