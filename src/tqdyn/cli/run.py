@@ -103,7 +103,8 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
         f"steps: {result.n_steps} accepted" + (f", {result.n_rejected} rejected" if not fixed else "")
         + f", {result.n_rhs} right-hand-side evaluations",
         f"wall time: {result.wall_s:.2f} s propagation (+ {summary.compile_s:.2f} s JIT compilation)",
-        f"final states (GCRS, t = {result.t_final[0] + result.t_final[1]:.3f} s TDB after the epoch):",
+        f"final states ({result.reference.frame}, t = {result.t_final[0] + result.t_final[1]:.3f} s "
+        f"{result.reference.time_scale} after the epoch):",
         *_format_state_table(scen, result.y_final),
     ]
     if result.energy_rel_drift is not None:

@@ -30,7 +30,7 @@ def initial_state(scenario, model: ForceModel | None = None, system: System | No
     system = build_system(scenario, model) if system is None else system
     if not system.free_tms:
         return y
-    model = system.with_inputs(build_force_model(scenario.forces) if model is None else model)
+    model = system.with_inputs(build_force_model(scenario.forces, scenario.reference) if model is None else model)
     cpar = system.cpar.copy()
     cpar[_lay.CP_MODE] = _lay.MODE_COUPLED
     tdat = (model.precompute(Epoch.from_utc(scenario.epoch_utc), np.zeros(1), np.zeros(1))[0]

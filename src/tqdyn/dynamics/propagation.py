@@ -67,7 +67,7 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     """
     precision = precision or scenario.run.precision
     check_precision(precision)
-    model = build_force_model(scenario.forces) if model is None else model
+    model = build_force_model(scenario.forces, scenario.reference) if model is None else model
     system = build_system(scenario, model)
     model = system.with_inputs(model)
     epoch = Epoch.from_utc(scenario.epoch_utc)
@@ -85,6 +85,7 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
         e1 = two_body_energy(result.y_final, model.terms[0].gm)
         with mpmath.workdps(60):
             result.energy_rel_drift = np.array([float((b - a) / abs(a)) for a, b in zip(e0, e1)])
+    result.reference = model.reference
     return result
 
 
@@ -94,7 +95,7 @@ def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:
     ephemeris, EOP or lunar-kernel span, a missing file, a degree above what
     a file holds) raise ValueError / FileNotFoundError before any
     propagation or output starts.  Returns the model."""
-    model = build_force_model(scenario.forces) if model is None else model
+    model = build_force_model(scenario.forces, scenario.reference) if model is None else model
     epoch = Epoch.from_utc(scenario.epoch_utc)
     t_end = float(scenario.run.duration_s)
     model.precompute(epoch, np.array([0.0, t_end]), np.zeros(2))

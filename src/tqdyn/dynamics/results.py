@@ -152,12 +152,15 @@ class Checkpoint:
 class RunResult:
     """Outcome of a propagation.
 
-    t_final: (2,) dd [s TDB since epoch]; y0, y_final: (n_sat, 6, 2) dd GCRS
-    states [m, m/s] (float64 runs have lo = 0); n_steps: accepted steps;
+    t_final: (2,) dd [s since the epoch, in the reference system's time
+    scale]; y0, y_final: (n_body, 6, 2) dd states [m, m/s] in the reference
+    system (float64 runs have lo = 0); n_steps: accepted steps;
     n_rejected: rejected steps (adaptive); n_rhs: right-hand-side
     evaluations; wall_s: wall time of the propagation [s];
     energy_rel_drift: (n_sat,) relative change of the two-body energy
-    v^2/2 - GM/r (only for a pure monopole model, else None).
+    v^2/2 - GM/r (only for a pure monopole model, else None);
+    reference: the :class:`~tqdyn.astro.reference.ReferenceSystem` of the
+    states and times (the force model's).
     """
 
     precision: str
@@ -171,6 +174,7 @@ class RunResult:
     wall_s: float
     energy_rel_drift: np.ndarray | None = None
     extra: dict = field(default_factory=dict)
+    reference: object = None
 
 
 def update_extremes(ext: dict, out_aux: np.ndarray, system) -> None:

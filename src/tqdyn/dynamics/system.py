@@ -102,7 +102,7 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     eph = _ephemeris(f.ephemeris) if bodies else None
     gms = planetary_gm() if bodies else {}
     if law and model is None:
-        model = build_force_model(f)
+        model = build_force_model(f, scenario.reference)
     earth = next((t for t in model.terms if isinstance(t, EarthField)), None) if law else None
     j2k = earth.j2_jerk_coefficient() if earth is not None else 0.0
     cpar = _lay.make_cpar(mode, law=law, control=c.control == "on",

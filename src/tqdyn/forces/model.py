@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
@@ -60,6 +61,8 @@ class ForceModel:
 
     Attributes
     ----------
+    reference: the :class:`~tqdyn.astro.reference.ReferenceSystem` of the
+        positions and accelerations (origin, frame, time scale of t).
     terms: tuple of term objects, in slot order.
     params: (n_params,) float64, the terms' parameters concatenated.
     layout: (n_slots, 3) int64; row s = (enabled, parameter offset, tdat
@@ -67,7 +70,8 @@ class ForceModel:
     n_tdat: total number of time-only input columns.
     """
 
-    def __init__(self, terms):
+    def __init__(self, terms, reference: ReferenceSystem = GEOCENTRIC):
+        self.reference = reference
         terms = tuple(sorted(terms, key=lambda t: _TERM_SLOT[type(t)]))
         slots = [_TERM_SLOT[type(t)] for t in terms]
         if len(set(slots)) != len(slots):
@@ -150,8 +154,12 @@ def _tide_models(forces, eph, rotation) -> tuple:
     return tuple(tides)
 
 
-def build_force_model(forces) -> ForceModel:
-    """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)."""
+def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC) -> ForceModel:
+    """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)
+    in the reference system of the scenario's central body (the terms of
+    this module are the geocentric ones)."""
+    if reference.central_body != "earth":
+        raise ValueError(f"scenario.central_body: {reference.central_body!r} has no force model; allowed: 'earth'")
     terms = []
     if forces.earth_monopole:
         terms.append(EarthMonopole(gm=forces.gm_earth))
@@ -180,7 +188,7 @@ def build_force_model(forces) -> ForceModel:
         terms.append(SunJ2(ephemeris=eph))
     if forces.relativity:
         terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth)))
-    return ForceModel(terms)
+    return ForceModel(terms, reference)
 
 
 @njit(cache=True)

@@ -20,7 +20,7 @@ Conventions
 TOML layout (every section and key optional except at least one
 ``[[satellites]]`` entry with ``a_km``)::
 
-    [scenario]      name, description, epoch_utc, extends (a built-in scenario
+    [scenario]      name, description, epoch_utc, central_body ("earth"), extends (a built-in scenario
                     whose tables this file updates key by key)
     [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
                     precision ("dd" | "float64"), output, output_every

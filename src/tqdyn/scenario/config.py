@@ -18,6 +18,7 @@ from decimal import Decimal, InvalidOperation, localcontext
 from pathlib import Path
 from typing import Any, Sequence
 
+from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008
 from ..astro.timescales import Epoch
 
@@ -442,7 +443,10 @@ class Scenario:
 
     ``epoch_utc``: normalised UTC ``YYYY-MM-DDTHH:MM:SS[.fff]`` (the epoch of
     the satellite elements and t = 0 of the run); ``satellites``: tuple of
-    :class:`SatelliteConfig` (GCRS elements), at least one, unique names.
+    :class:`SatelliteConfig` (elements relative to the central body, in the
+    frame of :attr:`reference`), at least one, unique names;
+    ``central_body``: the origin of the propagation (one of
+    :data:`tqdyn.astro.reference.CENTRAL_BODIES`).
     In fixed mode ``run.duration_s`` is an exact multiple of
     ``integrator.step_s``.
     """
@@ -456,8 +460,10 @@ class Scenario:
     spacecraft: SpacecraftConfig = field(default_factory=SpacecraftConfig)
     constellation: ConstellationConfig = field(default_factory=ConstellationConfig)
     satellites: tuple[SatelliteConfig, ...] = ()
+    central_body: str = "earth"
 
     def __post_init__(self) -> None:
+        _require_choice(self.central_body, "scenario.central_body", CENTRAL_BODIES)
         _require(isinstance(self.name, str) and self.name.strip() != "", "scenario.name", self.name, "is not a non-empty string", "a non-empty string")
         _require(isinstance(self.description, str), "scenario.description", self.description, "is not a string", "a string")
         try:
@@ -496,6 +502,11 @@ class Scenario:
                 )
 
     @property
+    def reference(self) -> ReferenceSystem:
+        """Origin, frame and time scale of the states (:mod:`tqdyn.astro.reference`), from ``central_body``."""
+        return reference_system(self.central_body)
+
+    @property
     def epoch(self) -> Epoch:
         """The scenario epoch as a :class:`tqdyn.astro.timescales.Epoch` (UTC/TAI/TT/TDB two-part JDs)."""
         return Epoch.from_utc(self.epoch_utc)
@@ -519,7 +530,8 @@ class Scenario:
         their exact decimal form (durations and steps in s)."""
         out: list[str] = ["# tqdyn scenario (resolved). Units: SI unless the key name says otherwise.", ""]
         out += ["[scenario]", f"name = {_toml_str(self.name)}", f"description = {_toml_str(self.description)}",
-                f"epoch_utc = {_toml_str(self.epoch_utc)}  # UTC", ""]
+                f"epoch_utc = {_toml_str(self.epoch_utc)}  # UTC",
+                f"central_body = {_toml_str(self.central_body)}", ""]
         r = self.run
         out += ["[run]", f"duration = {_toml_dec(r.duration_s)}  # s (TDB)", f"precision = {_toml_str(r.precision)}",
                 f"output = {_toml_str(r.output)}", f"output_every = {r.output_every}", ""]

@@ -90,7 +90,7 @@ _STRLIST = "list of strings"
 _ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
-    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "extends": _STR},
+    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "central_body": _STR, "extends": _STR},
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
     "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
@@ -208,8 +208,9 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     name = _typed(meta.get("name", default_name), _STR, "scenario.name")
     desc = _typed(meta.get("description", ""), _STR, "scenario.description")
     epoch = _typed(meta.get("epoch_utc", DEFAULT_EPOCH_UTC), _EPOCH, "scenario.epoch_utc")
+    body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
-                    spacecraft=craft, constellation=const, satellites=sats)
+                    spacecraft=craft, constellation=const, satellites=sats, central_body=body)
 
 
 # --------------------------------------------------------------------------- overrides

@@ -61,9 +61,13 @@ def output_attrs(scen) -> dict:
     """Root attributes of the trajectory file of ``scen``."""
     integ = scen.integrator
     c = scen.constellation
+    ref = scen.reference
     return {
         "scenario": scen.to_toml(),
         "epoch_utc": scen.epoch_utc,
+        "origin": ref.origin,
+        "frame": ref.frame,
+        "time_scale": ref.time_scale,
         "precision": scen.run.precision,
         "step_s": float(integ.step_s),
         "integrator": f"dp87-{integ.mode}-{integ.tableau}",

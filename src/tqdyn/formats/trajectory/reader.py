@@ -11,6 +11,7 @@ import numpy as np
 
 from ... import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
+from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS, ReferenceSystem
 from .schema import _COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _fmt_shape, _symbolic
 
 __all__ = ["Trajectory", "read_trajectory"]
@@ -57,6 +58,18 @@ class Trajectory:
         self.scenario_toml = str(attrs.get("scenario", ""))
         self._data = data
         self._n_sat = n_sat
+
+    @property
+    def reference(self) -> ReferenceSystem:
+        """Origin, frame and time scale of the file's vectors and times
+        (root attributes ``origin``, ``frame``, ``time_scale``; files written
+        before version 0.2 have no ``origin``: the geocentre)."""
+        key = (self.attrs.get("origin", GEOCENTRIC.origin), self.attrs.get("frame", GEOCENTRIC.frame),
+               self.attrs.get("time_scale", GEOCENTRIC.time_scale))
+        for r in REFERENCE_SYSTEMS:
+            if (r.origin, r.frame, r.time_scale) == key:
+                return r
+        return ReferenceSystem(*key, description="as recorded in the file")
 
     @property
     def fields(self) -> tuple[str, ...]:

@@ -18,6 +18,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ... import __version__ as _TQDYN_VERSION
+from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS
 
 __all__ = [
     "FORMAT",
@@ -135,8 +136,10 @@ ROOT_ATTRS: dict[str, str] = {
     "tqdyn_version": "str, version of tqdyn that wrote the file",
     "scenario": "str, the resolved scenario as TOML text",
     "epoch_utc": "str, ISO 8601 UTC label of t = 0",
-    "time_scale": 'str, always "TDB"',
-    "frame": 'str, always "GCRS"',
+    "origin": 'str, the central body at the origin of the coordinates: "earth" (absent in files '
+              'written before version 0.2: "earth")',
+    "frame": 'str, the axes and reference system of the vectors: "GCRS"',
+    "time_scale": 'str, the time scale of t: "TDB"',
     "precision": 'str, "dd" | "float64"',
     "step_s": "float, integrator / output step in s",
     "integrator": "str, integrator name",
@@ -151,8 +154,9 @@ _CHOICES = {
     "precision": ("dd", "float64"),
     "pointing": ("global", "taylor1", "taylor2", "iterative", "none"),
     "control": ("on", "off"),
-    "time_scale": ("TDB",),
-    "frame": ("GCRS",),
+    "origin": tuple(sorted({r.origin for r in REFERENCE_SYSTEMS})),
+    "time_scale": tuple(sorted({r.time_scale for r in REFERENCE_SYSTEMS})),
+    "frame": tuple(sorted({r.frame for r in REFERENCE_SYSTEMS})),
 }
 _COORDS = {
     "tm": [1, 2],
@@ -219,8 +223,9 @@ def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
         "tqdyn_version": _TQDYN_VERSION,
-        "time_scale": "TDB",
-        "frame": "GCRS",
+        "origin": GEOCENTRIC.origin,
+        "frame": GEOCENTRIC.frame,
+        "time_scale": GEOCENTRIC.time_scale,
     }
     for key, val in attrs.items():
         if not isinstance(key, str) or not key:
@@ -239,6 +244,11 @@ def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
     for key, allowed in _CHOICES.items():
         if out[key] not in allowed:
             raise ValueError(f"attrs[{key!r}] = {out[key]!r}; allowed: {' | '.join(allowed)}")
+    if (out["origin"], out["frame"], out["time_scale"]) not in {(r.origin, r.frame, r.time_scale)
+                                                                for r in REFERENCE_SYSTEMS}:
+        raise ValueError(f"attrs: origin / frame / time_scale = {out['origin']!r} / {out['frame']!r} / "
+                         f"{out['time_scale']!r} is not a reference system of tqdyn; allowed: "
+                         + " | ".join(f"{r.origin} / {r.frame} / {r.time_scale}" for r in REFERENCE_SYSTEMS))
     for key in ("scenario", "epoch_utc", "integrator", "tqdyn_version"):
         if not isinstance(out[key], str):
             raise ValueError(f"attrs[{key!r}]: must be str, got {type(out[key]).__name__}")
