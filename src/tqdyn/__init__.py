@@ -1,4 +1,34 @@
 """tqdyn: coupled orbit-attitude dynamics of drag-free gravitational-wave
-constellations (TianQin by default) in extended (double-double) precision."""
+constellations (TianQin by default) in extended (double-double) precision.
 
-__version__ = "0.1.0"
+The front door (:mod:`tqdyn.api`)::
+
+    import tqdyn
+    traj = tqdyn.propagate("tianqin", {"run.duration": "2d"})   # in memory
+    ds = traj.to_xarray()
+    asd = tqdyn.range_asd(tqdyn.light_travel_times(traj), "13")
+
+:func:`load_scenario`, :func:`builtin_scenarios`, :func:`propagate`,
+:func:`run`, :func:`open_trajectory`, :func:`light_travel_times`,
+:func:`range_asd`, :func:`requirement_asd`, :func:`breathing_angles` and the
+classes :class:`Scenario`, :class:`Trajectory`, :class:`LightTravelTimes`.
+They are imported on first use, so ``import tqdyn`` stays cheap.
+"""
+
+__version__ = "0.2.0.dev0"
+
+__all__ = ["__version__", "LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory",
+           "breathing_angles", "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory",
+           "propagate", "range_asd", "requirement_asd", "run"]
+
+
+def __getattr__(name):
+    if name in __all__:
+        from . import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'tqdyn' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import pathlib
-from typing import Any
+from typing import Any, Mapping
 
 import h5py
 import numpy as np
@@ -12,13 +12,21 @@ import numpy as np
 from ... import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
 from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS, ReferenceSystem
-from .schema import _COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _fmt_shape, _symbolic
+from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
+                     _symbolic, row_fields)
 
 __all__ = ["Trajectory", "read_trajectory"]
 
 # ---------------------------------------------------------------------------
 # reading
 # ---------------------------------------------------------------------------
+
+
+def _frozen(a) -> np.ndarray:
+    """A read-only float64 copy (the arrays of a :class:`Trajectory` are read-only)."""
+    out = np.array(a, dtype=np.float64)
+    out.setflags(write=False)
+    return out
 
 
 def _native_attr(value):
@@ -32,7 +40,7 @@ def _native_attr(value):
 class Trajectory:
     """A trajectory file read fully into memory (numpy arrays, file closed).
 
-    Create with :func:`read_trajectory`.  Arrays are float64 and read-only,
+    Create with :func:`read_trajectory` (or in memory with :meth:`from_rows`).  Arrays are float64 and read-only,
     shaped ``(N, *trailing)`` for time-dependent fields (``N`` time rows) and
     ``trailing`` for static ones; units, frames and trailing shapes are those of
     :data:`FIELDS` (SI; GCRS / S / OA_l; times in TDB seconds since
@@ -40,8 +48,8 @@ class Trajectory:
 
     Attributes
     ----------
-    path : pathlib.Path
-        File that was read.
+    path : pathlib.Path or None
+        File that was read (None for an in-memory trajectory, :meth:`from_rows`).
     attrs : dict
         Root attributes as native Python str / int / float.
     format_version : int
@@ -50,14 +58,33 @@ class Trajectory:
         The resolved scenario as TOML text (``""`` if the file has none).
     """
 
-    def __init__(self, path: pathlib.Path, attrs: dict, data: dict[str, tuple[np.ndarray, ...]],
+    def __init__(self, path: pathlib.Path | None, attrs: dict, data: dict[str, tuple[np.ndarray, ...]],
                  n_sat: int):
-        self.path = pathlib.Path(path)
+        self.path = None if path is None else pathlib.Path(path)
         self.attrs = attrs
         self.format_version = int(attrs["format_version"])
         self.scenario_toml = str(attrs.get("scenario", ""))
         self._data = data
         self._n_sat = n_sat
+
+    @classmethod
+    def from_rows(cls, rows, attrs: Mapping[str, Any], static: Mapping[str, np.ndarray] | None = None) -> "Trajectory":
+        """An in-memory trajectory (no file, :attr:`path` None) of a propagation's
+        output rows (:class:`tqdyn.dynamics.Rows`, all rows in one block) with
+        the root attributes a file of it would have (validated as the writer
+        validates them) and its static fields (e.g. ``tm/self_gravity``)."""
+        data = {}
+        for path, value in row_fields(rows).items():
+            arrays = value if isinstance(value, tuple) else (value,)
+            data[path] = tuple(_frozen(a) for a in arrays)
+        for path, value in (static or {}).items():
+            _spec(path, "static")
+            data[path] = (_frozen(value),)
+        return cls(None, _check_attrs(attrs), data, int(np.shape(rows.sat_r[0])[1]))
+
+    @property
+    def _where(self) -> str:
+        return "the in-memory trajectory" if self.path is None else repr(str(self.path))
 
     @property
     def reference(self) -> ReferenceSystem:
@@ -97,9 +124,9 @@ class Trajectory:
             return self._data[path]
         except KeyError:
             if path in FIELDS:
-                msg = f"{str(self.path)!r} has no field {path!r}; it has: {', '.join(self.fields)}"
+                msg = f"{self._where} has no field {path!r}; it has: {', '.join(self.fields)}"
             else:
-                msg = f"unknown field {path!r}; fields of {str(self.path)!r}: {', '.join(self.fields)}"
+                msg = f"unknown field {path!r}; fields of {self._where}: {', '.join(self.fields)}"
             raise KeyError(msg) from None
 
     def __getitem__(self, path: str) -> np.ndarray:
@@ -169,7 +196,7 @@ class Trajectory:
         return xr.Dataset(variables, coords=coords, attrs=dict(self.attrs))
 
     def __repr__(self) -> str:
-        return (f"Trajectory({str(self.path)!r}, n_rows={self.n_rows}, n_sat={self._n_sat}, "
+        return (f"Trajectory({self._where}, n_rows={self.n_rows}, n_sat={self._n_sat}, "
                 f"fields={self.fields})")
 
 

@@ -1,0 +1,169 @@
+"""The front door: a scenario, a propagation and its analysis from one import.
+
+::
+
+    import tqdyn
+    traj = tqdyn.propagate("tianqin", {"run.duration": "2d"})   # in memory, no file
+    ds = traj.to_xarray()                                       # dims time, sat, tm, comp
+    lt = tqdyn.light_travel_times(traj)                         # TM-to-TM light paths
+    asd = tqdyn.range_asd(lt, "13")                             # range ASD of link 13
+
+Everything here composes the layers below (docs/design.md): scenarios
+(:mod:`tqdyn.scenario`), the propagation (:mod:`tqdyn.dynamics`), the
+trajectory format (:mod:`tqdyn.formats.trajectory`), light paths
+(:mod:`tqdyn.lightpath`) and spectra (:mod:`tqdyn.analysis.spectra`).  Units
+SI; vectors in the trajectory's reference system (``traj.reference``: GCRS
+for the geocentric scenarios); times in seconds since the scenario epoch.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from . import dynamics
+from .analysis import metrics as _metrics
+from .analysis.spectra import requirement_asd
+from .constellation.indices import Link
+from .formats.trajectory import Trajectory, read_trajectory
+from .lightpath import LightTravelTimes, light_travel_times_of
+from .scenario import Scenario, ScenarioError, builtin_scenarios
+from .scenario import load_scenario as _load_scenario
+from .workflows.run import RunSummary, output_attrs, run_to_file
+
+__all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
+           "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory", "propagate",
+           "range_asd", "requirement_asd", "run"]
+
+
+def _overrides(overrides) -> list[str]:
+    if isinstance(overrides, str):
+        return [overrides]
+    if isinstance(overrides, Mapping):
+        return [f"{key}={_toml_text(value)}" for key, value in overrides.items()]
+    return list(overrides)
+
+
+def _toml_text(value) -> str:
+    """A Python value as the text of a ``--set`` override (TOML)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
+    if isinstance(value, str):
+        return value
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def load_scenario(scenario: str | Scenario | None = None,
+                  overrides: Mapping[str, object] | Sequence[str] = ()) -> Scenario:
+    """A validated scenario: a built-in name (:func:`builtin_scenarios`; None
+    -> ``"tianqin"``), the path of a TOML file, or a :class:`Scenario`
+    (returned as is when there are no overrides).
+
+    overrides : ``{"run.duration": "2d", "satellites.2.nu_deg": 151}`` or
+        ``["run.duration=2d", ...]`` -- any scenario key (docs/scenarios.md),
+        as ``tqdyn run --set`` takes it.
+    Raises :class:`ScenarioError` (one line naming the key, the value and what is allowed).
+    """
+    over = _overrides(overrides)
+    if isinstance(scenario, Scenario):
+        if not over:
+            return scenario
+        from .scenario import loads_scenario
+
+        return loads_scenario(scenario.to_toml(), over, source=f"scenario {scenario.name!r}")
+    return _load_scenario(scenario, over)
+
+
+def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, object] | Sequence[str] = (), *,
+              progress: bool = False) -> Trajectory:
+    """Propagate a scenario in memory and return its trajectory (no file).
+
+    ``scenario``, ``overrides``: as :func:`load_scenario`; the run's span,
+    step, precision and output sampling are the scenario's (``run.*``,
+    ``integrator.*`` keys).  progress: show a progress bar on stderr.
+
+    Returns a :class:`Trajectory` (the object :func:`open_trajectory` returns
+    for a file, with :attr:`~Trajectory.path` None): the same fields, shapes
+    and units as the file ``tqdyn run`` would write (docs/trajectory-format.md),
+    ``to_xarray()`` for an xarray view, ``dd(name)`` for the exact
+    double-double pairs; its attribute ``result`` is the propagation's
+    :class:`tqdyn.dynamics.RunResult` (steps, wall time, final states).
+    Memory: the whole trajectory (~4 kB per row of a coupled run; use
+    ``run.output_every`` for long spans).
+    """
+    scen = load_scenario(scenario, overrides)
+    model = dynamics.check_inputs(scen)
+    dynamics.warm_up(scen.run.precision)  # compile (or load the cached kernels) outside the timed propagation
+    blocks: list = []
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        total = scen.n_steps if scen.integrator.mode == "fixed" else float(scen.run.duration_s)
+        bar = tqdm(total=total, file=sys.stderr, desc="propagating", dynamic_ncols=True)
+    try:
+        result = dynamics.propagate(scen, sink=blocks.append, model=model,
+                                    progress=None if bar is None else bar.update)
+    finally:
+        if bar is not None:
+            bar.close()
+    static = {"tm/self_gravity": dynamics.self_gravity_oa(scen)} if scen.constellation.coupled else None
+    traj = Trajectory.from_rows(dynamics.Rows.concatenate(blocks), output_attrs(scen), static)
+    traj.result = result
+    return traj
+
+
+def run(scenario: str | Scenario | None = None, overrides: Mapping[str, object] | Sequence[str] = (), *,
+        output: str | None = None, checkpoint_every: int = 0, resume: bool = False) -> RunSummary:
+    """Propagate a scenario to its trajectory file, as ``tqdyn run`` does
+    (atomic: no file or a complete one; ``checkpoint_every`` steps and
+    ``resume`` as ``--checkpoint-every`` / ``--resume``).  ``output``: the
+    file (default: the scenario's ``run.output``).  Returns the
+    :class:`~tqdyn.workflows.run.RunSummary` (its ``path``, rows, result)."""
+    over = _overrides(overrides) + ([f"run.output={output}"] if output is not None else [])
+    return run_to_file(load_scenario(scenario, over), checkpoint_every=checkpoint_every, resume=resume)
+
+
+def open_trajectory(path) -> Trajectory:
+    """Read a trajectory file (any format version this tqdyn knows) into memory."""
+    return read_trajectory(path)
+
+
+def light_travel_times(trajectory: Trajectory, *, shapiro: bool = False) -> LightTravelTimes:
+    """The six links' light travel times on the trajectory's time grid: test
+    mass to test mass for coupled runs, satellite centre to centre for
+    pure-gravity runs (solved in double-double on the Hermite dense output;
+    :func:`tqdyn.lightpath.light_travel_times`).  shapiro: add the Earth's
+    Shapiro delay (off by default, as in the paper)."""
+    return light_travel_times_of(trajectory, shapiro=shapiro)
+
+
+def range_asd(light_times: LightTravelTimes, link: str | int | Link = "13") -> _metrics.AsdResult:
+    """Amplitude spectral density of one link's light-path range c tau [m/Hz^1/2].
+
+    link: ``"13"``, ``13`` or ``Link.L13`` (received on satellite 1, emitted
+    by 3).  The ASD is that of the second difference of the range, formed
+    in double-double and divided by the difference filter's gain (Kaiser
+    window, Welch; :func:`tqdyn.analysis.spectra.range_asd`).  Returns an
+    :class:`~tqdyn.analysis.metrics.AsdResult`: ``f`` [Hz], ``asd``, and the
+    largest ratio to the requirement (:func:`requirement_asd`) in band.
+    """
+    try:
+        ln = Link(int(link))
+    except (TypeError, ValueError):
+        raise ValueError(f"link: {link!r} is not a link; allowed: "
+                         f"{', '.join(str(int(x)) for x in Link)}") from None
+    hi, lo = light_times.range
+    t = light_times.t[0] + light_times.t[1]
+    return _metrics.range_asd_in_band(t, hi[:, ln.index], lo[:, ln.index])
+
+
+def breathing_angles(trajectory: Trajectory) -> np.ndarray:
+    """Breathing angles alpha_i [rad], (N, 3) -- the angle at each satellite
+    between its two arms, from the double-double satellite positions (any
+    run, coupled or pure gravity)."""
+    return _metrics.breathing_angles_of(trajectory)
