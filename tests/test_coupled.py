@@ -63,35 +63,7 @@ def _gravity_at(scen, t_pair, positions_dd, velocities):
     return dynamics.evaluate_rhs(y, tdat, model)[:, 3:6]
 
 
-# ---------------------------------------------------------------------------
-# compiled control kernels vs the numpy reference
-
-
-def test_control_kernels_match_numpy():
-    rng = np.random.default_rng(7)
-    craft = Spacecraft(d_tm=0.4, d_p=0.05, tm_axis="y", self_gravity_on=False)
-    theta = np.pi / 3 + 1e-3 * rng.standard_normal(3)
-    th1, th2 = 1e-9 * rng.standard_normal(3), 1e-15 * rng.standard_normal(3)
-    w = np.array([1e-9, -2e-9, 2e-5]) + 1e-10 * rng.standard_normal((3, 3))
-    wd = 1e-13 * rng.standard_normal((3, 3))
-    dg = 1e-10 * rng.standard_normal((3, 2, 3))
-    sg = 1e-10 * rng.standard_normal((3, 2, 3))
-    r0, rho, vel = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 2, 3))
-    g, A, G, alpha = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 3)), np.zeros((3, 2, 3))
-    for i in range(3):
-        housing_geometry(i, theta[i], th1[i], craft.d_p, craft.nominal_housing_centers, craft.theta_nominal,
-                         w, r0, rho, vel)
-        satellite_control(i, dg, sg, w, wd, theta[i], th1[i], th2[i], r0, rho, g, A, G, alpha)
-    np.testing.assert_allclose(r0, craft.housing_centers(theta), rtol=0, atol=1e-16)
-    np.testing.assert_allclose(rho, craft.lever_arms(theta), rtol=0, atol=1e-16)
-    wm, wmd = ctl.mosa_angular_rates(th1, th2)
-    ref_v = np.cross(w[:, None, :], r0) + np.cross(wm, rho)
-    np.testing.assert_allclose(vel, ref_v, rtol=0, atol=1e-21)            # m/s, |vel| ~ 4e-6
-    g_ref = ctl.tm_relative_acceleration(dg, w, wd, wm, wmd, r0, rho, sg)
-    np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-24)              # m/s^2, |g| ~ 1e-10
-    np.testing.assert_allclose(A, ctl.suspension_acceleration(g_ref, theta), rtol=0, atol=1e-23)
-    np.testing.assert_allclose(G, ctl.dragfree_acceleration(g_ref, theta), rtol=0, atol=1e-23)
-    np.testing.assert_allclose(alpha, ctl.tm_angular_acceleration(w, wd, wm, wmd, theta), rtol=0, atol=1e-26)
+# (the compiled control kernels against the numpy modules: tests/test_mirrors.py)
 
 
 # ---------------------------------------------------------------------------
