@@ -22,7 +22,6 @@ from tqdyn import dynamics
 from tqdyn.workflows import run as runner
 from tqdyn.constellation import attitude as att
 from tqdyn.constellation import control as ctl
-from tqdyn.constellation._control_jit import housing_geometry, satellite_control
 from tqdyn.constellation.spacecraft import Spacecraft
 from tqdyn.scenario import load_scenario
 from tqdyn.astro.timescales import Epoch
