@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -116,6 +117,7 @@ def test_derivatives_vs_finite_differences(trajectory):
     assert np.max(np.abs(np.linalg.norm(a.r_dot, axis=-1) - np.abs(a.length_dot))) > 1.0  # m/s
 
 
+@mpmath.workdps(40)
 def test_angles_sum_to_pi_and_dd_arms(trajectory):
     t, R, V, A = trajectory
     g = G.constellation_geometry(R)
@@ -129,7 +131,6 @@ def test_angles_sum_to_pi_and_dd_arms(trajectory):
     assert np.max(np.abs(a_dd - a_64)) < 1e-7
     # dd arm vector against mpmath on a few samples
     import mpmath
-    mpmath.mp.dps = 40
     for n in (0, 700, 1700):
         for ln in LINKS:
             e, r = ln.emitter.index, ln.receiver.index
@@ -199,6 +200,7 @@ def test_by_mosa_layout():
     assert G.by_mosa(np.arange(6.0), axis=-1).shape == (3, 2)
 
 
+@mpmath.workdps(40)
 def test_second_derivatives_vs_mpmath_finite_differences(trajectory):
     """The float64 FD above is round-off limited for the tiny alpha'' (~1e-21
     rad/s^2 on a Kepler orbit).  Reference here: alpha and L evaluated in
@@ -210,7 +212,6 @@ def test_second_derivatives_vs_mpmath_finite_differences(trajectory):
 
     t, R, V, A = trajectory
     g = G.constellation_geometry(R, V, A)
-    mpmath.mp.dps = 40
 
     def pos(n, s):
         return [mpmath.mpf(R[0][n, s, q]) + mpmath.mpf(R[1][n, s, q]) for q in range(3)]

@@ -106,9 +106,7 @@ def test_provider_with_standin():
 
 
 def test_provider_with_real_earth_orientation():
-    frames = pytest.importorskip("tqdyn.astro.earth_orientation")
-    if not hasattr(frames, "earth_orientation"):
-        pytest.skip("tqdyn.frames.earth_orientation not available yet")
+
     t = np.linspace(0.0, 86400.0, 5)
     a = OceanTides()(EPOCH, t)
     b = OceanTides(orientation=standin_orientation)(EPOCH, t)

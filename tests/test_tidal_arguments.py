@@ -47,9 +47,9 @@ DATES = [(2453162.5, 64.184 / 86400), (2447892.5, 0.3), (2451545.0, 0.0), (24532
          (2458849.5, 0.123), (2462502.5, 0.9)]
 
 
+@mpmath.workdps(40)
 def _delaunay_mp(t):
     """TN36 eq. 5.43 in mpmath; t in Julian centuries TT; returns radians mod 2 pi."""
-    mpmath.mp.dps = 40
     t = mpmath.mpf(t)
     arcsec = mpmath.pi / 648000
     series = [
