@@ -234,7 +234,7 @@ def test_p_frame_equals_direct_real_orbit(real_orbit):
 
 
 def test_p_frame_trap_is_resolved_by_the_fd_check(real_orbit):
-    """DESIGN 4b trap: using inertial relative velocities rotated into p instead of the
+    """docs/design.md (Traps) trap: using inertial relative velocities rotated into p instead of the
     p-frame coordinate rates drops T_p_I' (R_i - r_inc), an omega error of order |omega_p|.
     With x_p tied to the plane, p turns only with the plane (precession under the Moon/Sun):
     its in-plane rate, seen here in omega_S, is ~3e-9 rad/s -- 1e8 times the FD tolerance

@@ -2,7 +2,7 @@
 
 Reference values: the analytic two-body solution (mpmath, 50 digits) of the
 tianqin-kepler elements (Table I of the TianQin paper) -- independent of the
-integrator -- and the trajectory-file contract of DESIGN.md section 7.
+integrator -- and the trajectory-file contract of docs/design.md, Contracts (docs/trajectory-format.md).
 """
 
 from __future__ import annotations

@@ -400,7 +400,7 @@ def test_tianqin_kepler_magnitudes(tq_y):
 
 
 def test_vectorised_shapes_and_speed():
-    """(N, 3, ...) inputs with N = 100000: shapes as documented (DESIGN sec. 7) and < 2 s; per-slice equality."""
+    """(N, 3, ...) inputs with N = 100000: shapes as documented (docs/trajectory-format.md) and < 2 s; per-slice equality."""
     import time
     rng = np.random.default_rng(5)
     N = 100_000

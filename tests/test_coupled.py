@@ -4,7 +4,7 @@ References are independent of the compiled right-hand side:
 * the numpy implementations of the attitude (``constellation.attitude``) and
   of the control (``constellation.control``), fed with the propagated states
   and with gravity evaluated separately at the TM positions;
-* the three control conditions themselves (paper sec. IV; DESIGN 4);
+* the three control conditions themselves (paper sec. IV; docs/design.md, Traps 1);
 * finite differences of the output frames;
 * the pure-gravity propagation (control = "off" must reproduce it bit for bit);
 * the free-TM verification mode (TMs as free bodies stay at their EH centers).

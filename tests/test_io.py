@@ -111,7 +111,7 @@ def test_fields_catalogue_matches_contract():
         "tm/alpha_suspension": ("f8", ("sat", "tm", 3)),
         "tm/self_gravity": ("f8", ("sat", "tm", 3)),
     }
-    # DESIGN section 7: every contract field exactly as specified; the rest
+    # docs/trajectory-format.md: every contract field exactly as specified; the rest
     # are documented extensions (never renames or reshapes)
     extensions = {
         "tm/v": ("dd", ("sat", "tm", 3)),

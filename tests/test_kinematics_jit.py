@@ -184,7 +184,7 @@ def test_frames_orthonormal_bisector_normal(law):
     """Reference: the beams written out in mpmath from the exact states (light time solved exactly
     for the iterative law).  Orthonormal, right-handed to 1e-15; X_S bisects the beams, Z_S is
     normal to both, theta is their angle and X_OA1 = cos(theta/2) X + sin(theta/2) Y = b_ik,
-    X_OA2 = b_ij (DESIGN 4): all to 1e-15 rad (float64 rounding of unit vectors)."""
+    X_OA2 = b_ij (docs/design.md, Conventions): all to 1e-15 rad (float64 rounding of unit vectors)."""
     for t in EPOCHS[:2]:
         T, _, _, th = _run(law, t)
         assert np.abs(T @ T.transpose(0, 2, 1) - np.eye(3)).max() < 1e-15
@@ -220,7 +220,7 @@ def test_iterative_light_time_and_beams_against_mpmath():
     (the 1e-20 s one would like is below float64's resolution of tau; its effect on the beam,
     v dtau / L ~ 1e-21 rad, is irrelevant).  Beam direction: measured 1.1e-16 rad (float64
     rounding of a unit vector; the Taylor model error is ~1e-27 rad); tolerance 3e-16 rad.
-    Other laws vs the exact beam (DESIGN 6, paper Fig. 5): measured max taylor2 1.9e-11 rad,
+    Other laws vs the exact beam (docs/design.md, Traps 6; paper Fig. 5): measured max taylor2 1.9e-11 rad,
     taylor1 3.8e-11 rad, global 5.8e-6 rad.
     """
     worst = {"tau": 0.0, "resid": 0.0, "iterative": 0.0, "taylor2": 0.0, "taylor1": 0.0, "global": 0.0}

@@ -1,4 +1,4 @@
-"""The mixed-precision scheme of the force model (DESIGN.md sec. 2).
+"""The mixed-precision scheme of the force model (docs/design.md, Precision policy).
 
 The monopole is always double-double; the Moon and Sun point masses and the
 Earth's degree-2 field (the perturbations above ~1e-7 m/s^2) are evaluated

@@ -199,7 +199,7 @@ def _compare_laws(raw):
 
 
 def test_normalisation_matters(trajectory, beams):
-    # DESIGN 4b: bisector of the unnormalised Taylor vectors n' = n - v_j / c
+    # docs/design.md, Traps: bisector of the unnormalised Taylor vectors n' = n - v_j / c
     t, R, V, A, _ = trajectory
     a = G.arms(R)
     n = G.by_mosa(a.n)

@@ -89,7 +89,7 @@ def test_pointing_study_orders_and_analytic_estimates(runs):
     assert abs(m["global"]["per_beam"] / global_ref - 1) < 0.01
     assert 1e-12 < m["taylor1"]["per_beam"] < 1e-10
     assert abs(m["taylor2"]["per_beam"] / taylor2_ref - 1) < 0.05
-    for law in ("taylor1", "taylor2"):  # DESIGN 4b: cancel in X_S, add in theta
+    for law in ("taylor1", "taylor2"):  # docs/design.md, Traps: cancel in X_S, add in theta
         assert m[law]["x_s"] < 1e-13 < m[law]["per_beam"] < m[law]["theta"]
     # tau ~ L/c costs (n . v) L / c^2 ~ 2e-6 s, not the paper's 1e-7 s
     L = geometry.by_mosa(a.length, axis=-1)[1:]

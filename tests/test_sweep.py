@@ -4,7 +4,7 @@ Reference values, independent of the sweep code:
 * the analytic effect of a constant common self-gravity a = 1e-9 m/s^2 on a
   drag-free satellite: the satellites follow their TMs, so over t = 1 h the
   members "+x" and "-x" differ by 2 * a t^2 / 2 = a t^2 = 1.296e-2 m
-  (DESIGN.md section 6 scales the same effect to ~100 km in 3 months).
+  (docs/design.md scales the same effect to ~100 km in 3 months).
   Corrections: the gravity gradient (n^2 t^2 ~ 5e-3 relative, n^2 =
   GM/r^3 = 4e-10 s^-2) and the turn of the S frame (orbital rate 2e-5
   rad/s, 0.07 rad in 1 h: < 0.3 %), hence a 1 % tolerance;

@@ -8,7 +8,7 @@ in double-double on the Hermite dense output of the emitters' stored
 positions, velocities and accelerations: :func:`tqdyn.lightpath.light_travel_times`
 of the satellite centres).
 
-Three error measures per law, all in rad (DESIGN 4b: the Taylor errors of
+Three error measures per law, all in rad (docs/design.md, Traps: the Taylor errors of
 the two beams of one satellite are nearly equal and opposite, so they almost
 cancel in X_S and add up in the beam angle theta -- report all three):
 

@@ -77,7 +77,7 @@ Pointing laws (beam vectors b_ij, with tau = L_ij / c as in eq. pointing2):
   emission position r_j(t - tau) = r_j - v_j tau, divided by c tau);
 * ``"taylor2"`` -- b_ij = unit(n_ij - v_j / c + a_j L_ij / (2 c^2)).
   The beam vectors are normalised *before* forming the bisector and normal
-  (DESIGN 4b).  Their derivatives are taken analytically from the same
+  (docs/design.md, Traps).  Their derivatives are taken analytically from the same
   expressions, so the rates are consistent with the attitude they produce
   (tested against finite differences of the frames).
 
@@ -319,7 +319,7 @@ class Attitude:
         velocity / acceleration of OA_l, expressed in OA_l:
         T_OA_S (omega_S + phi' e_z) and T_OA_S (omega_dot_S + phi'' e_z +
         omega_S x phi' e_z).  The latter is the angular acceleration a TM kept
-        aligned with OA_l needs (DESIGN 4, ``tm/alpha_suspension``).
+        aligned with OA_l needs (docs/design.md, Conventions; ``tm/alpha_suspension``).
     law, method : str.
     """
 

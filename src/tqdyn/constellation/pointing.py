@@ -25,7 +25,7 @@ paper), under one of the laws
   :mod:`tqdyn.constellation._kinematics_jit`.)
 
 The Taylor vectors n' are *not* unit vectors (their norm differs from 1 by
-~|v|/c ~ 1e-5); they are normalised here before anything else (DESIGN 4b:
+~|v|/c ~ 1e-5); they are normalised here before anything else (docs/design.md, Traps:
 forming the bisector from unnormalised vectors costs ~2e-6 rad).
 
 Array layout: beams are (..., 3, 2, 3) = (time..., satellite i, MOSA l,

@@ -1,6 +1,6 @@
 """Spacecraft architecture: indices, test-mass housings, MOSA pivots, self-gravity.
 
-Conventions (see DESIGN.md sec. 4)
+Conventions (docs/design.md, Conventions)
 ----------------------------------
 * Index enums (satellite, MOSA, link) live in :mod:`tqdyn.constellation.indices`;
   arrays here use the axes (satellite 1..3, tm/MOSA l = 1..2, component).
@@ -20,7 +20,7 @@ Conventions (see DESIGN.md sec. 4)
   TM's own OA_l frame.  Default: Table IV of the paper (the printed
   "4.94^{-11}" means 4.94e-11 m/s^2), the same for the three satellites.
 
-Default architecture (Table III of the paper + DESIGN.md sec. 4): the two EH
+Default architecture (Table III of the paper + docs/design.md, Conventions): the two EH
 centers are collinear with the satellite CoM, d_TM = 0.40 m apart, at
 +/-0.20 m along Y_S (TM_1 at +0.20 m Y_S, on the side of MOSA 1); pivots at the
 EH centers (d_p = 0).  Why Y_S: the S frame of TianQin turns at about the

@@ -21,8 +21,8 @@ fields, ~3.4 MB per day at every 50 s step):
   one-month electrostatic control of Fig. 8.  A 30-day run is the first
   30 days of the 90-day run of the same scenario (same steps).
 
-Sign of the flight direction: with Z_S = n_ij x n_ik / sin(alpha_i) (DESIGN
-4) the satellites' velocity is along **-Y_S**; :data:`FLIGHT_DIRECTION_S`
+Sign of the flight direction: with Z_S = n_ij x n_ik / sin(alpha_i)
+(docs/design.md, Conventions) the satellites' velocity is along **-Y_S**; :data:`FLIGHT_DIRECTION_S`
 holds that.  It is not trusted here: ``tests/test_report.py`` measures
 Y_S . v / |v| on a run and the report prints it from every coupled run.
 The "+flight" common self-gravity of 1e-9 m/s^2 is therefore
