@@ -1,0 +1,8 @@
+"""Astronomy: constants, time scales, reference systems, Earth and Moon orientation, ephemerides, elements.
+
+:mod:`.constants` (values with unit and source), :mod:`.timescales` (UTC ->
+TAI -> TT -> TDB), :mod:`.reference` (origin, frame and time scale of a
+propagation), :mod:`.earth_orientation` and :mod:`.eop` (GCRS <-> ITRS, IERS
+EOP), :mod:`.ephemeris` (JPL DE files), :mod:`.elements` (Keplerian elements
+<-> states in mpmath), :mod:`.lunar_orientation`, :mod:`.tidal_arguments`.
+"""

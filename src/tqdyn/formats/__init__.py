@@ -1,0 +1,3 @@
+"""File formats (I/O only): the trajectory file (:mod:`.trajectory`), run
+checkpoints (:mod:`.checkpoint`), LISA orbit files (:mod:`.lisa`) and the
+netCDF dataset of a sweep (:mod:`.netcdf`)."""
