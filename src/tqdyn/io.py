@@ -7,30 +7,7 @@ names (the same objects, so ``tqdyn.io.OutputError is
 tqdyn.formats.trajectory.OutputError``).
 """
 
-from .formats.trajectory import (
-    FIELDS,
-    FORMAT,
-    FORMAT_VERSION,
-    ROOT_ATTRS,
-    FieldSpec,
-    OutputError,
-    Trajectory,
-    TrajectoryFormatError,
-    TrajectoryWriter,
-    check_writable,
-    read_trajectory,
-)
+from .formats import trajectory as _trajectory
+from .formats.trajectory import *  # noqa: F401,F403  (the same objects)
 
-__all__ = [
-    "FORMAT",
-    "FORMAT_VERSION",
-    "FieldSpec",
-    "FIELDS",
-    "ROOT_ATTRS",
-    "OutputError",
-    "TrajectoryFormatError",
-    "check_writable",
-    "TrajectoryWriter",
-    "Trajectory",
-    "read_trajectory",
-]
+__all__ = list(_trajectory.__all__)

@@ -66,7 +66,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
-from ..readers.eop_c04 import read_eop_c04
+from ..readers.eop_c04 import EopSeries, read_eop_c04
 from ..readers.iers_tables import TidalEOPTerms
 from .constants import ARCSEC_RAD, MJD_JD0
 
@@ -128,8 +128,8 @@ def _quiet_dat(y, m, d, fd):
 
 
 @dataclass(frozen=True, eq=False)
-class EOP:
-    """IERS C04 Earth orientation parameters at daily nodes (0 h UTC).
+class EOP(EopSeries):
+    """IERS C04 Earth orientation parameters at daily nodes (0 h UTC), ready to interpolate.
 
     Attributes (1-D float64 arrays, one element per day, equally spaced)
     ----------
@@ -145,13 +145,6 @@ class EOP:
     Construct with :func:`load_eop` (or :meth:`from_series`, or directly from arrays, e.g. in tests).
     """
 
-    mjd: np.ndarray
-    xp: np.ndarray
-    yp: np.ndarray
-    dut1: np.ndarray
-    lod: np.ndarray
-    dx: np.ndarray
-    dy: np.ndarray
     source: str = "arrays"
     _dat0: np.ndarray = field(init=False, repr=False)
     _dlod: np.ndarray = field(init=False, repr=False)
@@ -161,8 +154,7 @@ class EOP:
     @classmethod
     def from_series(cls, series) -> "EOP":
         """The table of a daily series read from a file (:class:`tqdyn.readers.eop_c04.EopSeries`)."""
-        return cls(mjd=series.mjd, xp=series.xp, yp=series.yp, dut1=series.dut1, lod=series.lod, dx=series.dx,
-                   dy=series.dy, source=series.source)
+        return cls(series.mjd, series.xp, series.yp, series.dut1, series.lod, series.dx, series.dy, series.source)
 
     def __post_init__(self):
         cols = {}

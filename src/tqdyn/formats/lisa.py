@@ -49,24 +49,8 @@ file's attributes too)
   between the test masses (TM of satellite i facing j <- TM of j facing i)
   when the trajectory has them, else between the satellites' centres of
   mass (attribute ``ltt_endpoints``); Earth Shapiro delay only if asked.
-* Proper time: each satellite's clock (centre of mass) with
-  d tau_i / dt = 1 - (GM_E / r_i + v_i^2 / 2) / c^2, GM_E the trajectory's
-  Earth GM, integrated along the orbit with the end-corrected trapezoidal
-  rule (derivative of the integrand from r, v, a; error ~1e-24 s per step)
-  from delta_tau = 0 at the trajectory's first sample (``t_init``).  t is
-  treated as the geocentric coordinate time TCG: the secular rate
-  L_G = 6.969290134e-10 between TCG and TT/TDB, the periodic TDB - TT terms
-  (~1.7 ms, annual) and the tidal potentials of Moon and Sun (~1e-17
-  relative) are NOT applied; they are (nearly) common to the three clocks.
-* ppr = ltt + delta_tau_recv(t) - delta_tau_emit(t - ltt) (delta_tau_emit
-  at the emission time from its Taylor series, error < 1e-21 s);
-  d_ppr = (dtau_r - dtau_e + d_ltt (1 + dtau_e)) / (1 + dtau_r) with
-  dtau = d(delta_tau)/dt, exactly as lisaorbits defines it.
-* tps/*: the coordinate time of proper time tau = t_k is t_k + delta_t with
-  delta_t = -delta_tau(t_k + delta_t) (two iterations); tps/ppr and
-  tps/d_ppr are the TCB-sampled values moved by delta_t with their first
-  derivatives (|delta_t| ~ 5e-4 s after 90 days; the neglected second-order
-  terms are < 1e-19 s).
+* Proper times, ppr and the tps group: as defined (and computed) by
+  :mod:`tqdyn.lightpath.proper_time`.
 * Samples: the trajectory's grid (uniform) minus the leading rows whose
   emission time t - ltt precedes the first sample (normally the first row).
 * Precision: the format stores float64 (ulp of ltt ~ 0.58 s is 1.1e-16 s,

@@ -205,6 +205,17 @@ def _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v):
 
 
 @njit(cache=True)
+def _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D):
+    """The emitter of ``link`` at t - tau (Hermite; into out_r, out_v) and the
+    dd vector D = r_e(t - tau) - r_r(t) (into D); returns (t - tau, |D|), dd."""
+    te = sub(t, tau)
+    _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v)
+    for q in range(3):
+        st(D, sub(ld(out_r, q), ld(rr, q)), q)
+    return te, _norm_dd(D)
+
+
+@njit(cache=True)
 def _solve(t_nodes, Rr, Re, Ve, Ae, c, shap_k, tol, max_iter,
            tau_out, re_out, ve_out, resid_out, shap_out, iters_out):
     """Newton solution of c tau = |r_e(t - tau) - r_r(t)| (+ Shapiro) for every row and link.
@@ -236,11 +247,7 @@ def _solve(t_nodes, Rr, Re, Ve, Ae, c, shap_k, tol, max_iter,
             converged = False
             while it < max_iter:
                 it += 1
-                te = sub(t, tau)
-                _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v)
-                for q in range(3):
-                    st(D, sub(ld(out_r, q), ld(rr, q)), q)
-                dist = _norm_dd(D)
+                te, dist = _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D)
                 dv = 0.0
                 for q in range(3):
                     dv += D[q, 0] * out_v[q, 0]
@@ -257,11 +264,7 @@ def _solve(t_nodes, Rr, Re, Ve, Ae, c, shap_k, tol, max_iter,
             if not converged:
                 failed += 1
             # emitter state and residual at the returned tau
-            te = sub(t, tau)
-            _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v)
-            for q in range(3):
-                st(D, sub(ld(out_r, q), ld(rr, q)), q)
-            dist = _norm_dd(D)
+            te, dist = _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D)
             res = sub(sub(tau, div(dist, c)), shap)
             before = sub(te, t_first)
             if before[0] + before[1] < 0.0:

@@ -45,50 +45,8 @@ overrides, ``extends``, built-in scenarios in ``tqdyn/scenario/builtin/``).
 
 from __future__ import annotations
 
-# the constants below are public names of the former module tqdyn.scenario
-# (importable from here, not part of __all__)
-from .config import (  # noqa: F401
-    CONTROL_MODES,
-    LIBRATION_MODELS,
-    MAX_EARTH_DEGREE,
-    MAX_MOON_DEGREE,
-    MAX_OCEAN_TIDE_DEGREE,
-    POINTING_LAWS,
-    SELF_GRAVITY_MODELS,
-    THIRD_BODIES,
-    TM_AXES,
-    ConstellationConfig,
-    ForcesConfig,
-    IntegratorConfig,
-    RunConfig,
-    SatelliteConfig,
-    Scenario,
-    ScenarioError,
-    SpacecraftConfig,
-)
-from .loader import (
-    DEFAULT_EPOCH_UTC,
-    DEFAULT_SCENARIO,
-    builtin_scenarios,
-    load_scenario,
-    loads_scenario,
-    parse_duration,
-)
+from . import config, loader
+from .config import *  # noqa: F401,F403
+from .loader import *  # noqa: F401,F403
 
-__all__ = [
-    "SatelliteConfig",
-    "IntegratorConfig",
-    "RunConfig",
-    "ForcesConfig",
-    "SpacecraftConfig",
-    "ConstellationConfig",
-    "POINTING_LAWS",
-    "Scenario",
-    "ScenarioError",
-    "builtin_scenarios",
-    "load_scenario",
-    "loads_scenario",
-    "parse_duration",
-    "DEFAULT_SCENARIO",
-    "DEFAULT_EPOCH_UTC",
-]
+__all__ = config.__all__ + loader.__all__

@@ -18,6 +18,7 @@ checkpoint path if the run can be resumed (``--resume``), else None.
 from __future__ import annotations
 
 import time
+import traceback
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -27,7 +28,8 @@ from .. import dynamics
 from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
-__all__ = ["RunSummary", "run_to_file", "output_fields", "output_attrs", "checkpoint_path"]
+__all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
+           "checkpoint_path"]
 
 
 @dataclass(frozen=True)
@@ -148,6 +150,28 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         raise
     ckpt.unlink(missing_ok=True)
     return RunSummary(result=result, path=out_path, rows=rows, compile_s=compile_s)
+
+
+def one_line(exc: BaseException) -> str:
+    """``"<ExceptionType>: <message>"`` on one line (white space folded)."""
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def run_scenario_text(scenario_toml: str, source: str = "scenario") -> dict:
+    """Run one resolved scenario (its TOML text) to its file, as a worker
+    task does: never raises.  Returns ``{"ok": True, "rows", "wall_s",
+    "compile_s"}`` (rows written, propagation and JIT seconds) or ``{"ok":
+    False, "error": one line, "traceback": text}``.  ``source`` names the
+    scenario in error messages."""
+    from ..scenario import loads_scenario
+
+    try:
+        summary = run_to_file(loads_scenario(scenario_toml, source=source))
+    except Exception as exc:  # noqa: BLE001 - reported per task; the others go on
+        return {"ok": False, "error": one_line(exc), "traceback": traceback.format_exc()}
+    return {"ok": True, "rows": int(summary.rows), "wall_s": float(summary.result.wall_s),
+            "compile_s": float(summary.compile_s)}
 
 
 def _resume(ckpt_path, scen, out_path):

@@ -47,7 +47,6 @@ import hashlib
 import math
 import os
 import time
-import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -359,22 +358,11 @@ class StudyRuns:
         return [o for o in self.outcomes.values() if not o.ok]
 
 
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-
-
 def _run_one(scenario_toml: str) -> dict:
-    """Task: run one resolved scenario to its file; never raises."""
-    from . import run as runner
-    from ..scenario import loads_scenario
+    """Task: run one resolved scenario to its file (never raises)."""
+    from .run import run_scenario_text
 
-    t0 = time.perf_counter()
-    try:
-        summary = runner.run_to_file(loads_scenario(scenario_toml, source="study run"))
-    except Exception as exc:  # noqa: BLE001 - reported per run; the others go on
-        return {"ok": False, "error": _one_line(exc), "traceback": traceback.format_exc()}
-    return {"ok": True, "rows": int(summary.rows), "wall_s": time.perf_counter() - t0}
+    return run_scenario_text(scenario_toml, source="study run")
 
 
 def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scale: float = 1.0,
@@ -395,7 +383,8 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
     Bad input raises ValueError / FileNotFoundError before anything runs; a
     run that fails does not stop the others (see :attr:`StudyRuns.failures`).
     """
-    from .sweep.execute import default_workers
+    from .run import one_line
+    from .sweep.execute import default_workers, run_on_dask
 
     t0 = time.perf_counter()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
@@ -407,7 +396,7 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
     try:
         runs_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ValueError(f"runs directory: {str(runs_dir)!r} cannot be created ({_one_line(exc)}); allowed: a "
+        raise ValueError(f"runs directory: {str(runs_dir)!r} cannot be created ({one_line(exc)}); allowed: a "
                          "writable directory") from None
     outcomes: dict[str, RunOutcome] = {}
     for p in plan:
@@ -431,27 +420,7 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
         for p in pending:
             record(p, _run_one(p.scenario_toml))
     elif pending:
-        _run_on_dask(pending, n, record)
+        run_on_dask(_run_one, pending, lambda p: f"tqdyn-study-{p.name}-{p.digest}", None, n, record)
     ordered = {p.name: outcomes[p.name] for p in plan}
     return StudyRuns(studies=names, outcomes=ordered, duration_scale=float(duration_scale), runs_dir=runs_dir,
                      wall_s=time.perf_counter() - t0)
-
-
-def _run_on_dask(pending, n_workers, record) -> None:
-    from distributed import as_completed
-
-    from .sweep.execute import dask_client
-
-    with dask_client(None, n_workers, len(pending)) as client:
-        futures = {client.submit(_run_one, p.scenario_toml, key=f"tqdyn-study-{p.name}-{p.digest}", pure=False): p
-                   for p in pending}
-        try:
-            for fut in as_completed(list(futures)):
-                p = futures[fut]
-                try:
-                    res = fut.result()
-                except Exception as exc:  # noqa: BLE001 - the task could not run (its worker died?)
-                    res = {"ok": False, "error": _one_line(exc)}
-                record(p, res)
-        finally:
-            client.cancel(list(futures))

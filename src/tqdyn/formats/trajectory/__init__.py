@@ -30,32 +30,9 @@ catalogue, root attributes, errors), :mod:`~tqdyn.formats.trajectory.writer`
 :class:`Trajectory`).  Their public names are re-exported here.
 """
 
-from .reader import Trajectory, read_trajectory
-from .schema import (
-    FIELDS,
-    FORMAT,
-    FORMAT_VERSION,
-    ROOT_ATTRS,
-    FieldSpec,
-    OutputError,
-    TrajectoryFormatError,
-    field_path,
-    row_fields,
-)
-from .writer import TrajectoryWriter, check_writable
+from . import reader, schema, writer
+from .reader import *  # noqa: F401,F403
+from .schema import *  # noqa: F401,F403
+from .writer import *  # noqa: F401,F403
 
-__all__ = [
-    "FORMAT",
-    "FORMAT_VERSION",
-    "FieldSpec",
-    "FIELDS",
-    "ROOT_ATTRS",
-    "OutputError",
-    "TrajectoryFormatError",
-    "check_writable",
-    "TrajectoryWriter",
-    "Trajectory",
-    "read_trajectory",
-    "field_path",
-    "row_fields",
-]
+__all__ = schema.__all__ + writer.__all__ + reader.__all__

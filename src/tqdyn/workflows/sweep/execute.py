@@ -16,7 +16,6 @@ import logging
 import os
 import secrets
 import time
-import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,27 +23,21 @@ from typing import Any
 
 from ...formats import trajectory as io
 from ...formats.netcdf import netcdf_engine, write_netcdf
-from ...scenario import loads_scenario
 from .gathering import gather
-from .outcome import MemberOutcome, _one_line
+from ..run import one_line
+from .outcome import MemberOutcome
 from .plan import Member, SweepPlan, plan_sweep
 from .spec import SweepSpec, _err
 
-__all__ = ["SweepResult", "dask_client", "default_workers", "run_sweep"]
+__all__ = ["SweepResult", "dask_client", "default_workers", "run_on_dask", "run_sweep"]
 
 
 def _run_member(scenario_toml: str) -> dict:
-    """Dask task: run one member (its resolved scenario TOML) to its file.
-    Never raises: returns a dict with ``ok`` and the run's numbers or the error."""
-    from .. import run as runner
+    """Dask task: run one member (its resolved scenario TOML) to its file
+    (:func:`tqdyn.workflows.run.run_scenario_text`: never raises)."""
+    from ..run import run_scenario_text
 
-    try:
-        scen = loads_scenario(scenario_toml, source="sweep member")
-        summary = runner.run_to_file(scen)
-    except Exception as exc:  # noqa: BLE001 - reported per member; the others go on
-        return {"ok": False, "error": _one_line(exc), "traceback": traceback.format_exc()}
-    return {"ok": True, "rows": int(summary.rows), "wall_s": float(summary.result.wall_s),
-            "compile_s": float(summary.compile_s)}
+    return run_scenario_text(scenario_toml, source="sweep member")
 
 
 def default_workers() -> int:
@@ -72,7 +65,7 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int):
         try:
             client = Client(scheduler)  # timeout: dask config distributed.comm.timeouts.connect
         except (OSError, TimeoutError, ValueError) as exc:
-            raise _err("scheduler", scheduler, f"cannot be reached ({_one_line(exc)})",
+            raise _err("scheduler", scheduler, f"cannot be reached ({one_line(exc)})",
                        "the address of a running Dask scheduler, e.g. tcp://host:8786") from None
         with client:
             yield client
@@ -86,30 +79,44 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int):
         yield client
 
 
-def _execute(pending: Sequence[Member], scheduler, n_workers, progress) -> list[MemberOutcome]:
+def run_on_dask(task, items: Sequence, key: Callable[[Any], str], scheduler, n_workers: int | None,
+                done: Callable[[Any, dict], None]) -> None:
+    """Run ``task(item.scenario_toml)`` for every item as a Dask task (on
+    the cluster of :func:`dask_client`) and call ``done(item, result)`` as
+    each finishes, in completion order.  ``task`` is a module-level function
+    returning a result dict (e.g. :func:`_run_member`); a task that could not
+    run at all (its worker died, the cluster went away) gives ``{"ok":
+    False, "error": <one line>, "traceback": ""}``.  ``key(item)`` names the
+    task.  Unfinished tasks are cancelled when this returns or raises."""
     from distributed import as_completed
 
-    outcomes: list[MemberOutcome] = []
-    with dask_client(scheduler, n_workers, len(pending)) as client:
-        token = secrets.token_hex(4)
-        futures = {client.submit(_run_member, m.scenario_toml, key=f"tqdyn-member-{m.digest}-{token}", pure=False): m
-                   for m in pending}
+    with dask_client(scheduler, n_workers, len(items)) as client:
+        futures = {client.submit(task, item.scenario_toml, key=key(item), pure=False): item for item in items}
         try:
             for fut in as_completed(list(futures)):
-                m = futures[fut]
                 try:
                     res = fut.result()
                 except Exception as exc:  # noqa: BLE001 - the task could not run (e.g. its worker died)
-                    res = {"ok": False, "error": _one_line(exc), "traceback": ""}
-                if res["ok"]:
-                    out = MemberOutcome(m, "ran", wall_s=res["wall_s"], compile_s=res["compile_s"], rows=res["rows"])
-                else:
-                    out = MemberOutcome(m, "failed", error=res["error"], traceback=res.get("traceback", ""))
-                outcomes.append(out)
-                if progress is not None:
-                    progress(out)
+                    res = {"ok": False, "error": one_line(exc), "traceback": ""}
+                done(futures[fut], res)
         finally:
             client.cancel(list(futures))
+
+
+def _execute(pending: Sequence[Member], scheduler, n_workers, progress) -> list[MemberOutcome]:
+    outcomes: list[MemberOutcome] = []
+
+    def done(m, res):
+        if res["ok"]:
+            out = MemberOutcome(m, "ran", wall_s=res["wall_s"], compile_s=res["compile_s"], rows=res["rows"])
+        else:
+            out = MemberOutcome(m, "failed", error=res["error"], traceback=res.get("traceback", ""))
+        outcomes.append(out)
+        if progress is not None:
+            progress(out)
+
+    token = secrets.token_hex(4)
+    run_on_dask(_run_member, pending, lambda m: f"tqdyn-member-{m.digest}-{token}", scheduler, n_workers, done)
     return outcomes
 
 
@@ -183,7 +190,7 @@ def run_sweep(path_or_spec: str | os.PathLike | SweepSpec | SweepPlan, scheduler
         out_dir.mkdir(parents=True, exist_ok=True)
         io.check_writable(plan.spec.output)
     except (OSError, io.OutputError) as exc:
-        raise _err("sweep.output_dir", str(out_dir), f"is not a writable directory ({_one_line(exc)})",
+        raise _err("sweep.output_dir", str(out_dir), f"is not a writable directory ({one_line(exc)})",
                    "a directory that can be created and written") from None
     outcomes = {m.index: MemberOutcome(m, "done") for m, d in zip(plan.members, plan.done) if d}
     if plan.pending:

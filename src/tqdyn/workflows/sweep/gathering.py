@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 
 from ...formats import trajectory as io
-from .outcome import MemberOutcome, _one_line
+from ..run import one_line
+from .outcome import MemberOutcome
 from .plan import SweepPlan
 from .spec import SweepSpec, _coord_values, _toml_text
 
@@ -90,7 +91,7 @@ def gather(plan: SweepPlan, outcomes: Sequence[MemberOutcome]) -> tuple[Any, lis
         try:
             datasets[m.index] = io.read_trajectory(m.path).to_xarray()
         except (OSError, ValueError) as exc:
-            new = MemberOutcome(m, "failed", error=f"cannot read its trajectory file: {_one_line(exc)}")
+            new = MemberOutcome(m, "failed", error=f"cannot read its trajectory file: {one_line(exc)}")
             outcomes[outcomes.index(o)] = new
             by_index[m.index] = new
     if not datasets:

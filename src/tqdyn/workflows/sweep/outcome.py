@@ -31,8 +31,3 @@ class MemberOutcome:
     def ok(self) -> bool:
         """True if the member's trajectory file is complete."""
         return self.status != "failed"
-
-
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
