@@ -29,7 +29,8 @@ def test_estimate_values():
     ref = 3.0 * math.sqrt(15.0) / 2.0 * 3.986004415e14 / 1e16 * (6378136.3 / 1e8) ** 2 * dc22
     assert a == pytest.approx(ref, rel=1e-12)
     print(f"\natmospheric S2 tide (not modelled): dC22 ~ {dc22:.2e}, acceleration at r = 1e8 m ~ {a:.2e} m/s^2")
-    assert 1e-14 < a < 1e-12
+    # README (force model, budget): ~7e-14 m/s^2 at 1e5 km; measured 7.03e-14 m/s^2, ~3x either side
+    assert 2e-14 < a < 2e-13
     # r^-4 scaling
     assert at.estimate_accel(2e8) == pytest.approx(a / 16.0, rel=1e-12)
 

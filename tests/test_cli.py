@@ -35,15 +35,13 @@ def _no_files(directory) -> list[str]:
     return sorted(os.listdir(directory))
 
 
-def test_run_default_scenario_writes_valid_file(tmp_path, capsys, monkeypatch):
+def test_run_default_scenario_writes_valid_file(default_run):
     """`tqdyn run` with no scenario argument: the built-in tianqin scenario
     (full force model), 10 days at 50 s, written to the default file name in
-    the working directory."""
-    monkeypatch.chdir(tmp_path)
-    status, out, err = _run(["run", "-q"], capsys)
+    the working directory (the session fixture ``default_run``, conftest.py)."""
+    status, out, err, path = default_run
     assert status == 0, err
-    path = tmp_path / "tqdyn-run.h5"
-    assert path.exists()
+    assert path.exists() and path.name == "tqdyn-run.h5"
     assert "wall time" in out and "Sat3" in out
     tr = io.read_trajectory(path)
     scen = load_scenario("tianqin")
@@ -63,6 +61,31 @@ def test_run_default_scenario_writes_valid_file(tmp_path, capsys, monkeypatch):
     a = np.linalg.norm(tr["sat/a_gravity"], axis=-1)
     r = np.linalg.norm(r_hi + r_lo, axis=-1)
     np.testing.assert_allclose(a, float(scen.forces.gm_earth) / r**2, rtol=1e-3)
+
+
+def test_run_default_scenario_printed_numbers(default_run):
+    """The README's `tqdyn run` transcript: 17280 steps, 224641 right-hand-side evaluations (13 per step + 1),
+    17281 rows, and the control maxima it prints, which must be those of the file.  The magnitudes themselves
+    are bounded in tests/test_coupled.py::test_default_run_control_maxima."""
+    status, out, err, path = default_run
+    assert status == 0, err
+    assert "steps: 17280 accepted, 224641 right-hand-side evaluations" in out
+    assert "(17281 rows," in out
+    printed = {}
+    for line in out.splitlines():
+        for key in ("max |G_i| (drag-free)", "max |A_c,l| component (suspension)",
+                    "max |alpha_l| component (TM angular)"):
+            if line.startswith(key + ":"):
+                printed[key] = float(line.split(":")[1].split()[0])
+    tr = io.read_trajectory(path)
+    file_values = {"max |G_i| (drag-free)": np.linalg.norm(tr["sat/a_dragfree"], axis=-1).max(),
+                   "max |A_c,l| component (suspension)": np.abs(tr["tm/a_suspension"]).max(),
+                   "max |alpha_l| component (TM angular)": np.abs(tr["tm/alpha_suspension"]).max()}
+    print(f"\nprinted {printed}; file {file_values}")
+    assert set(printed) == set(file_values), out
+    for key, value in file_values.items():
+        # the run's maxima cover every accepted step's first stage, which are the file's rows; 4 digits printed
+        assert abs(printed[key] / value - 1) < 1e-3, (key, printed[key], value)
 
 
 def test_run_kepler_matches_analytic(tmp_path, capsys):
@@ -187,19 +210,35 @@ def test_bench_short(capsys):
     assert "tqdyn dd" in out and "tqdyn float64" in out and "dd / float64" in out
 
 
+#: README "Force model": `tqdyn forces` for the tianqin scenario, 10 days, max and RMS of |a| [m/s^2]
+README_BUDGET = {
+    "earth_monopole": (3.99e-02, 3.99e-02), "third_body:moon": (2.41e-05, 1.20e-05),
+    "third_body:sun": (6.00e-06, 4.83e-06), "earth_field": (4.90e-07, 3.42e-07),
+    "third_body:venus": (6.26e-10, 5.17e-10), "third_body:jupiter": (3.54e-11, 2.90e-11),
+    "earth_field_indirect": (1.67e-11, 1.38e-11), "relativity": (1.29e-11, 1.01e-11),
+    "solid_tides": (7.67e-12, 4.99e-12), "third_body:saturn": (1.32e-12, 1.22e-12),
+    "ocean_tides": (1.18e-12, 4.82e-13), "third_body:mercury": (6.72e-13, 4.46e-13),
+    "moon_field": (6.48e-13, 2.71e-13), "solid_pole_tide": (2.37e-13, 1.64e-13),
+    "third_body:mars": (9.93e-14, 9.17e-14), "ocean_pole_tide": (3.45e-14, 2.36e-14),
+    "third_body:uranus": (3.25e-14, 2.77e-14), "third_body:neptune": (8.82e-15, 8.39e-15),
+    "sun_j2": (7.95e-17, 7.13e-17),
+}
+
+
 def test_forces_budget_orders(tmp_path, capsys):
-    """`tqdyn forces` on the full model: every term present, with the known
-    orders at r ~ 1e8 m (first principles: GM/r^2 = 4.0e-2; lunar tidal
-    2 GM_m r/d^3 ~ 1e-5; solar ~ 2 GM_s r/AU^3 ~ 6e-6; J2: 1.5 J2 GM R^2/r^4
-    ~ 5e-7; Schwarzschild 3 GM^2/(c^2 r^3) = 5.3e-12 ...), and the plot."""
+    """`tqdyn forces` on the full model over the README's 10 days (every 600 s, ~8 s): every term present, with
+    the known orders at r ~ 1e8 m (first principles: GM/r^2 = 4.0e-2; lunar tidal 2 GM_m r/d^3 ~ 1e-5; solar
+    ~ 2 GM_s r/AU^3 ~ 6e-6; J2: 1.5 J2 GM R^2/r^4 ~ 5e-7; Schwarzschild 3 GM^2/(c^2 r^3) = 5.3e-12 ...), every
+    max and RMS within a factor 3 of the README's table, and the plot."""
     png = tmp_path / "budget.png"
-    status, out, err = _run(["forces", "--duration", "1d", "--every", "3600", "--plot", str(png)], capsys)
+    status, out, err = _run(["forces", "--duration", "10d", "--every", "600", "--plot", str(png)], capsys)
     assert status == 0, err
     rows = {}
     for line in out.splitlines():
         parts = line.split()
         if len(parts) >= 3 and parts[1][0].isdigit():
-            rows[parts[0]] = float(parts[1])
+            rows[parts[0]] = (float(parts[1]), float(parts[2]))
+    print(f"\nforce budget, 10 days: {rows}")
     expected = {  # max |a| [m/s^2]: (low, high), factor-3 brackets around the first-principles orders
         "earth_monopole": (3.9e-2, 4.1e-2), "third_body:moon": (3e-6, 3e-5), "third_body:sun": (2e-6, 2e-5),
         "earth_field": (2e-7, 1e-6), "relativity": (3e-12, 5e-11), "solid_tides": (1e-12, 3e-11),
@@ -207,7 +246,12 @@ def test_forces_budget_orders(tmp_path, capsys):
         "ocean_pole_tide": (3e-15, 3e-13), "sun_j2": (1e-18, 1e-15), "earth_field_indirect": (3e-12, 5e-11),
     }
     for name, (low, high) in expected.items():
-        assert low <= rows[name] <= high, (name, rows[name])
+        assert low <= rows[name][0] <= high, (name, rows[name])
+    assert set(rows) == set(README_BUDGET), sorted(set(rows) ^ set(README_BUDGET))
+    for name, quoted in README_BUDGET.items():
+        for measured, q, what in zip(rows[name], quoted, ("max", "rms")):
+            assert q / 3 < measured < 3 * q, (name, what, measured, q)   # measured: equal to the README's 3 digits
+        assert rows[name][1] <= rows[name][0]
     assert "atmospheric_tides" in out and "NOT modelled" in out
     assert png.exists() and png.stat().st_size > 10_000
 

@@ -8,7 +8,8 @@ References are independent of the compiled right-hand side:
 * finite differences of the output frames;
 * the pure-gravity propagation (control = "off" must reproduce it bit for bit);
 * the free-TM verification mode (TMs as free bodies stay at their EH centers).
-Magnitudes are compared with the paper's (sec. V.B), not tuned to them.
+Magnitudes are compared with the paper's (sec. V.B) and bounded within ~3x of
+the values the README quotes (both sides where a zero would be wrong).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from tqdyn import dynamics
 from tqdyn.workflows import run as runner
 from tqdyn.constellation import attitude as att
 from tqdyn.constellation import control as ctl
-from tqdyn.constellation.spacecraft import Spacecraft
+from tqdyn.constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
 from tqdyn.scenario import load_scenario
 from tqdyn.astro.timescales import Epoch
 
@@ -69,6 +70,15 @@ def _gravity_at(scen, t_pair, positions_dd, velocities):
 # the coupled right-hand side vs the numpy pipeline on propagated states
 
 
+#: compiled vs numpy on an output row: the README's "T_S_I 5e-16, omega 5e-20 rad/s, A and G 2e-25 m/s^2" and
+#: "control conditions 1e-25 m/s^2" are asserted as quoted (measured on rows 0/77/144 of the 2 h run: T_S_I
+#: 2.2e-16, omega 6.8e-21 rad/s, A 1.2e-25, G 5.2e-26, condition (a) 7.8e-26 m/s^2); the others 3-10x above
+#: the measured omega_dot 1.0e-25 rad/s^2, MOSA angle 1.1e-16 rad, EH centre 5.6e-17 m, alpha 1.3e-25 rad/s^2.
+#: a_gravity is the same dd sum rounded once (measured exactly 0): at most 1 ulp of 0.04 m/s^2 (7e-18).
+TOL_ROWS = {"T_S_I": 5e-16, "omega": 5e-20, "omega_dot": 1e-24, "mosa": 5e-16, "tm_r": 3e-16, "a_gravity": 1e-18,
+            "A": 2e-25, "G": 2e-25, "alpha": 1e-24, "cond_a": 1e-25}
+
+
 @pytest.mark.parametrize("row", [0, 77, 144])
 def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
     """Attitude, differential gravity, suspension, G and TM angular
@@ -79,16 +89,15 @@ def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
     v = tr["sat/v"][row]
     a_tot = tr["sat/a_gravity"][row] + tr["sat/a_dragfree"][row]  # what the orbit follows
     ref = att.attitude(r, v, a_tot, law="global")
-    np.testing.assert_allclose(tr["sat/T_S_I"][row], ref.T_S_I, rtol=0, atol=5e-16)  # a few ulp
-    np.testing.assert_allclose(tr["sat/omega"][row], ref.omega, rtol=0, atol=5e-20)       # rad/s, |w| 2e-5
-    np.testing.assert_allclose(tr["sat/omega_dot"][row], ref.omega_dot, rtol=0, atol=1e-24)  # rad/s^2
-    np.testing.assert_allclose(tr["mosa/angle"][row], ref.mosa_angle, rtol=0, atol=5e-16)
+    err = {"T_S_I": np.abs(tr["sat/T_S_I"][row] - ref.T_S_I).max(),                 # 1
+           "omega": np.abs(tr["sat/omega"][row] - ref.omega).max(),                   # rad/s, |w| 2e-5
+           "omega_dot": np.abs(tr["sat/omega_dot"][row] - ref.omega_dot).max(),       # rad/s^2
+           "mosa": np.abs(tr["mosa/angle"][row] - ref.mosa_angle).max()}              # rad
 
     craft = Spacecraft(d_tm=float(scen.spacecraft.d_tm_m), d_p=float(scen.spacecraft.d_p_m))
     r0_I = np.einsum("sji,slj->sli", ref.T_S_I, craft.housing_centers(ref.theta))  # T_I_S r0
     tm_hi, tm_lo = tr.dd("tm/r")
-    np.testing.assert_allclose((tm_hi[row] - r[0][:, None, :]) + (tm_lo[row] - r[1][:, None, :]), r0_I,
-                               rtol=0, atol=1e-15)                                   # m
+    err["tm_r"] = np.abs((tm_hi[row] - r[0][:, None, :]) + (tm_lo[row] - r[1][:, None, :]) - r0_I).max()  # m
     t_pair = tuple(x[row] for x in tr.dd("t"))
     pos = np.concatenate([np.stack(r, axis=-1), np.stack([tm_hi[row], tm_lo[row]], axis=-1).reshape(6, 3, 2)])
     vel = np.concatenate([v, tr["tm/v"][row].reshape(6, 3)])
@@ -96,21 +105,23 @@ def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
     # differential gravity in dd, rounded afterwards (no cancellation)
     dg = (acc[3:, :, 0] - acc[:3, None, :, 0].repeat(2, 1).reshape(6, 3)
           + (acc[3:, :, 1] - acc[:3, None, :, 1].repeat(2, 1).reshape(6, 3))).reshape(3, 2, 3)
-    np.testing.assert_allclose(tr["sat/a_gravity"][row], acc[:3, :, 0] + acc[:3, :, 1], rtol=0, atol=1e-18)
+    err["a_gravity"] = np.abs(tr["sat/a_gravity"][row] - (acc[:3, :, 0] + acc[:3, :, 1])).max()  # m/s^2
     wm, wmd = ctl.mosa_angular_rates(ref.theta_dot, ref.theta_ddot)
     nc = ctl.nominal_control(ref.T_S_I, ref.omega, ref.omega_dot, ref.theta, wm, wmd, dg,
                              Spacecraft(self_gravity=dynamics.self_gravity_oa(scen)))
     # m/s^2; suspension ~1e-10, G ~ 1e-11: agreement at ~1e-16 relative
-    np.testing.assert_allclose(tr["tm/a_suspension"][row], nc.a_suspension, rtol=0, atol=2e-25)
-    np.testing.assert_allclose(tr["sat/a_dragfree"][row], nc.a_dragfree, rtol=0, atol=2e-25)
-    np.testing.assert_allclose(tr["tm/alpha_suspension"][row], nc.alpha_suspension, rtol=0, atol=1e-24)  # as omega_dot
+    err["A"] = np.abs(tr["tm/a_suspension"][row] - nc.a_suspension).max()
+    err["G"] = np.abs(tr["sat/a_dragfree"][row] - nc.a_dragfree).max()
+    err["alpha"] = np.abs(tr["tm/alpha_suspension"][row] - nc.alpha_suspension).max()  # rad/s^2, as omega_dot
     np.testing.assert_array_equal(tr["tm/self_gravity"], dynamics.self_gravity_oa(scen))
 
     # the three control conditions, with the compiled A and G and the reference g
     A_S = np.einsum("slji,slj->sli", ctl.oa_rotation(ref.theta), tr["tm/a_suspension"][row])  # T_S_OA A
     G_S = np.einsum("sij,sj->si", ref.T_S_I, tr["sat/a_dragfree"][row])
-    cond_a = np.abs(A_S + nc.g - G_S[:, None, :]).max()
-    assert cond_a < 1e-25, cond_a                                                   # (a) G = A_l + g_l
+    err["cond_a"] = np.abs(A_S + nc.g - G_S[:, None, :]).max()                      # (a) G = A_l + g_l
+    print(f"\nrow {row}: compiled vs numpy " + ", ".join(f"{k} {x:.1e}" for k, x in err.items()))
+    for k, x in err.items():
+        assert x <= TOL_ROWS[k], (k, x)
     assert np.all(tr["tm/a_suspension"][row][..., 0] == 0.0)                         # (b) no x actuation
     np.testing.assert_array_equal(tr["tm/a_suspension"][row][:, 0, 2], -tr["tm/a_suspension"][row][:, 1, 2])  # (c)
 
@@ -118,8 +129,8 @@ def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
 def test_frames_and_pointing_on_trajectory(table_iv_run):
     _, tr, _ = table_iv_run
     T = tr["sat/T_S_I"]
-    assert np.abs(T @ np.swapaxes(T, -1, -2) - np.eye(3)).max() < 1e-15
-    assert np.abs(np.linalg.det(T) - 1.0).max() < 1e-15
+    err = {"orthonormal": np.abs(T @ np.swapaxes(T, -1, -2) - np.eye(3)).max(),
+           "det": np.abs(np.linalg.det(T) - 1.0).max(), "bisect": 0.0, "normal": 0.0, "alpha": 0.0, "mosa": 0.0}
     hi, lo = tr.dd("sat/r")
     for i in range(3):
         j, k = (i + 1) % 3, (i + 2) % 3
@@ -128,12 +139,19 @@ def test_frames_and_pointing_on_trajectory(table_iv_run):
         nj /= np.linalg.norm(nj, axis=-1, keepdims=True)
         nk /= np.linalg.norm(nk, axis=-1, keepdims=True)
         X, Z = T[:, i, 0], T[:, i, 2]
-        assert np.abs(np.einsum("nq,nq->n", X, nj) - np.einsum("nq,nq->n", X, nk)).max() < 1e-15  # bisects
-        assert np.abs(np.einsum("nq,nq->n", Z, nj)).max() < 1e-15 and np.abs(np.einsum("nq,nq->n", Z, nk)).max() < 1e-15
+        err["bisect"] = max(err["bisect"], np.abs(np.einsum("nq,nq->n", X, nj) - np.einsum("nq,nq->n", X, nk)).max())
+        err["normal"] = max(err["normal"], np.abs(np.einsum("nq,nq->n", Z, nj)).max(),
+                            np.abs(np.einsum("nq,nq->n", Z, nk)).max())
         alpha = np.arccos(np.clip(np.einsum("nq,nq->n", nj, nk), -1, 1))
-        np.testing.assert_allclose(tr["sat/breathing_angle"][:, i], alpha, rtol=0, atol=1e-14)
-        np.testing.assert_allclose(tr["mosa/angle"][:, i, 0], alpha / 2, rtol=0, atol=1e-14)
+        err["alpha"] = max(err["alpha"], np.abs(tr["sat/breathing_angle"][:, i] - alpha).max())   # rad
+        err["mosa"] = max(err["mosa"], np.abs(tr["mosa/angle"][:, i, 0] - alpha / 2).max())        # rad
         np.testing.assert_array_equal(tr["mosa/angle"][:, i, 1], -tr["mosa/angle"][:, i, 0])
+    print("\nframes on the trajectory: " + ", ".join(f"{k} {x:.1e}" for k, x in err.items()))
+    # README: "< 1e-15", asserted as quoted (measured 7.8e-16, 8.9e-16, 4.4e-16, 2.2e-16: a few ulp of O(1))
+    for key in ("orthonormal", "det", "bisect", "normal"):
+        assert err[key] < 1e-15, (key, err[key])
+    # rad; measured 4.4e-16 (breathing angle, arccos of float64 unit vectors) and 2.2e-16 (MOSA angle)
+    assert err["alpha"] < 2e-15 and err["mosa"] < 1e-15, err
 
 
 @pytest.mark.parametrize("law", ["global", "taylor2", "iterative"])
@@ -157,8 +175,11 @@ def test_rates_agree_with_finite_differences(no_sg_run, tmp_path, law):
     W = np.einsum("nsij,nskj->nsik", T[2:-2], dT)
     w_fd = np.stack([W[..., 2, 1], W[..., 0, 2], W[..., 1, 0]], axis=-1)
     err_w = np.abs(w_fd - tr["sat/omega"][2:-2]).max()
-    assert err_w < 1e-17, err_w
     err_wd = np.abs(d5(tr["sat/omega"]) - tr["sat/omega_dot"][2:-2]).max()
+    print(f"\n{law}: omega vs 5-point FD {err_w:.1e} rad/s, omega_dot {err_wd:.1e} rad/s^2")
+    # the README's "< 1e-17 / < 2e-21" (the bound derived above) is asserted as quoted; measured global /
+    # taylor2 / iterative: 5.8e-18 / 7.6e-18 / 6.3e-18 rad/s and 3.1e-22 / 1.5e-21 / 1.5e-21 rad/s^2
+    assert err_w < 1e-17, err_w
     assert err_wd < 2e-21, err_wd
 
 
@@ -172,8 +193,12 @@ def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_ru
     G0 = np.linalg.norm(tr0["sat/a_dragfree"], axis=-1).max()
     al0 = np.abs(tr0["tm/alpha_suspension"]).max()
     print(f"\nno self-gravity, 1 day: max |A| {A0:.2e} m/s^2, max |G| {G0:.2e} m/s^2, max |alpha| {al0:.2e} rad/s^2")
-    # paper: ~1e-13 m/s^2 and ~1e-13 rad/s^2 (Fig. 7); G ~ 1e-13 m/s^2
-    assert 1e-15 < A0 < 1e-12 and 1e-16 < G0 < 1e-12 and 1e-15 < al0 < 1e-12
+    # paper: ~1e-13 m/s^2 and ~1e-13 rad/s^2 (Fig. 7); G ~ 1e-13 m/s^2.  README (1 day): 1.4e-13 / 1.1e-13 m/s^2 /
+    # 3.1e-13 rad/s^2, measured 1.41e-13 / 1.08e-13 / 3.06e-13: bounds ~3x either side (none of them vanishes:
+    # the breathing, rotating frame S and the gravity differences across the 0.4 m TM baseline need actuation)
+    assert 5e-14 < A0 < 4e-13
+    assert 3e-14 < G0 < 3e-13
+    assert 1e-13 < al0 < 1e-12
     _, tr1, _ = table_iv_run
     A1 = np.abs(tr1["tm/a_suspension"]).max()
     A_S = np.einsum("nslji,nslj->nsli", ctl.oa_rotation(2 * tr1["mosa/angle"][..., 0]), tr1["tm/a_suspension"])
@@ -182,8 +207,64 @@ def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_ru
     # paper (Fig. 8, sec. V.B.1): ~1e-10 m/s^2, "differential acceleration between the two TMs less
     # than 1e-10": that is the differential-mode actuation of each TM, A_z = +/- dg_z / 2 (eq:E1/E2).
     # The difference A_1 - A_2 itself exceeds 1e-10: Table IV alone gives z: 1.10e-10 + 5.72e-11.
-    assert 1e-11 < A1 < 1e-10
-    assert 1.67e-10 - 1e-12 < dA < 2e-10
+    # README: 8.4e-11 and 1.75e-10 m/s^2 (measured 8.36e-11, 1.75e-10).  Reference: Table IV's z values,
+    # dg_z / 2 = 8.36e-11 m/s^2, plus the no-self-gravity control (< 4e-13, above) on top.
+    half_dz = (TABLE_IV_SELF_GRAVITY[0, 2] - TABLE_IV_SELF_GRAVITY[1, 2]) / 2
+    assert abs(A1 - half_dz) < 1e-12 and A1 < 1e-10
+    assert 2 * half_dz - 1e-12 < dA < 2e-10
+
+
+def test_default_run_control_maxima(default_run):
+    """The control maxima of the README's `tqdyn run` (tianqin: full model, Table IV, 10 days), from its file.
+    README transcript: max |G_i| 6.428e-11 m/s^2, max |A_c,l| component 8.360e-11 m/s^2, max |alpha_l|
+    component 3.059e-13 rad/s^2.  Measured now: 6.435e-11, 8.362e-11 and 7.363e-13 (the README's alpha is the
+    1-day value of the no-self-gravity run, 3.06e-13; over 10 days alpha grows as |G| does, cf. 7.44e-13 over
+    30 days in docs/report.md)."""
+    status, _, err, path = default_run
+    assert status == 0, err
+    tr = io.read_trajectory(path)
+    G = np.linalg.norm(tr["sat/a_dragfree"], axis=-1).max()
+    A = np.abs(tr["tm/a_suspension"]).max()
+    al = np.abs(tr["tm/alpha_suspension"]).max()
+    print(f"\ndefault run, 10 days: max |G| {G:.3e} m/s^2, max |A| component {A:.3e} m/s^2, "
+          f"max |alpha| component {al:.3e} rad/s^2")
+    # Reference for A: Table IV's z difference, dg_z / 2 = 8.36e-11 m/s^2, plus the tidal control (< 1e-12)
+    half_dz = (TABLE_IV_SELF_GRAVITY[0, 2] - TABLE_IV_SELF_GRAVITY[1, 2]) / 2
+    assert abs(A - half_dz) < 1e-12
+    # G: the common part of the Table IV self-gravity the satellite must follow, ~3x either side of 6.43e-11
+    assert 2e-11 < G < 2e-10
+    # alpha: measured 7.36e-13 rad/s^2, ~3x either side (the rotation of S needs TM angular actuation)
+    assert 2.5e-13 < al < 2.5e-12
+
+
+def test_local_vs_global_pointing_dragfree_difference(tmp_path):
+    """README / docs/report.md point 2: taylor2 and global pointing give drag-free accelerations that differ by a
+    constant 2.39e-15 m/s^2 along Y_S (X_S 4e-18, Z_S 2e-21 m/s^2), whose secular drift, 3/2 dG T^2, moves the
+    orbits apart by 0.217 m in 90 days.  Reference: the tidal model derived there, 3 n^2 (d_TM/2) delta
+    cot(theta/2), with delta the measured angle between the two laws' X_S (the aberration angle, 5.77e-6 rad),
+    n^2 = GM/r^3 and theta the breathing angle.  1 day, cheap force model (the mechanism is the monopole's
+    tide), no self-gravity."""
+    sets = CHEAP + ["spacecraft.self_gravity=off"]
+    _, glob, _ = _run(tmp_path, "global.h5", sets, duration="1d")
+    _, loc, _ = _run(tmp_path, "local.h5", sets + ["constellation.pointing=taylor2"], duration="1d")
+    T = glob["sat/T_S_I"]
+    dG_S = np.einsum("nsij,nsj->nsi", T, loc["sat/a_dragfree"] - glob["sat/a_dragfree"])
+    Xg, Xl = T[:, :, 0], loc["sat/T_S_I"][:, :, 0]
+    delta = np.arctan2(np.linalg.norm(np.cross(Xg, Xl), axis=-1), np.einsum("nsk,nsk->ns", Xg, Xl))
+    r = np.linalg.norm(glob["sat/r"], axis=-1)
+    model = 3 * 3.986004415e14 / r**3 * (0.4 / 2) * delta / np.tan(glob["sat/breathing_angle"] / 2)
+    ratio = dG_S[..., 1] / model
+    drift_90d = 1.5 * dG_S[..., 1].mean() * (90 * 86400.0) ** 2
+    print(f"\nG_taylor2 - G_global in S: Y {dG_S[..., 1].mean():.3e} m/s^2 (model {model.mean():.3e}, ratio "
+          f"{ratio.min():.5f}..{ratio.max():.5f}), |X| {np.abs(dG_S[..., 0]).max():.1e}, "
+          f"|Z| {np.abs(dG_S[..., 2]).max():.1e}; delta {delta.mean():.3e} rad; 3/2 dG (90 d)^2 = {drift_90d:.3f} m")
+    # measured: ratio 0.99989 .. 1.00007; dG_Y 2.389e-15 m/s^2; delta 5.768e-6 rad; 0.217 m
+    assert np.abs(ratio - 1).max() < 1e-3
+    assert 8e-16 < dG_S[..., 1].min() and dG_S[..., 1].max() < 7e-15      # README 2.39e-15, ~3x either side
+    assert 2e-6 < delta.min() and delta.max() < 2e-5                     # README 5.77e-6 rad
+    assert 0.07 < drift_90d < 0.65                                       # README 0.217 m
+    # the other components: README (30 days, full model) 4e-18 and 2e-21; measured here 7.3e-19 and 1.7e-22
+    assert np.abs(dG_S[..., 0]).max() < 2e-17 and np.abs(dG_S[..., 2]).max() < 1e-20
 
 
 # ---------------------------------------------------------------------------
@@ -216,19 +297,30 @@ def test_free_tms_stay_at_their_housing_centers(tmp_path, law):
                       duration="1d")
     off = np.linalg.norm(tr["tm/housing_offset"], axis=-1)
     print(f"\nfree TMs, {law}, 1 day: max |TM - EH center| = {off.max():.2e} m")
-    # m; the target for 10 days is 1e-12 m.  Measured: global 2.6e-16 m; taylor2 9.8e-14 m: its omega_dot
-    # contains the remote jerk / c, and the jerk model leaves out the Earth-rotation jerk of the sectorial
-    # degree-2 terms and the CIP tilt of J2 (~1e-13 m/s^3, ~4e-22 rad/s^2, ~7e-23 m/s^2 at the TM)
-    assert off.max() < (1e-14 if law == "global" else 3e-13)
+    # m; the target for 10 days is 1e-12 m.  Measured: global 2.6e-16 m (README 2.6e-16 m); taylor2 9.8e-14 m: its
+    # omega_dot contains the remote jerk / c, and the jerk model leaves out the Earth-rotation jerk of the sectorial
+    # degree-2 terms and the CIP tilt of J2 (~1e-13 m/s^3, ~4e-22 rad/s^2, ~7e-23 m/s^2 at the TM).  Bounds ~3-10x
+    # either side: an offset of exactly 0 would mean the TMs are not integrated apart from their EH centres, and
+    # taylor2 must show the drift its jerk model leaves.
+    low, high = (3e-17, 1e-15) if law == "global" else (2e-14, 3e-13)
+    assert low < off.max() < high
     assert res.y_final.shape == (9, 6, 2)
 
 
-@pytest.mark.slow
-def test_free_tms_ten_days_full_model(tmp_path):
-    _, tr, _ = _run(tmp_path, "free10.h5", ["constellation.free_tms=true"], duration="10d")
+@pytest.mark.parametrize("law", ["global", "taylor2"])
+def test_free_tms_ten_days_full_model(tmp_path, law):
+    """README: free TMs vs their EH centres over 10 days, full model, Table IV: global 2.0e-15 m, taylor2 3.4e-13 m
+    (target < 1e-12 m).  ~10 s per law: in the default suite."""
+    _, tr, _ = _run(tmp_path, "free10.h5", ["constellation.free_tms=true", f"constellation.pointing={law}"],
+                    duration="10d")
     off = np.linalg.norm(tr["tm/housing_offset"], axis=-1).max()
-    print(f"\nfree TMs, 10 days, full model, Table IV: max |TM - EH center| = {off:.2e} m")
-    assert off < 1e-12
+    print(f"\nfree TMs, {law}, 10 days, full model, Table IV: max |TM - EH center| = {off:.2e} m")
+    if law == "global":
+        assert 3e-16 < off < 1e-14       # measured 1.96e-15 m
+    else:
+        # measured 3.63e-13 m (README 3.4e-13 m); the upper bound is the README's target 1e-12 m (2.8x), the lower
+        # one the drift the taylor2 jerk model must leave (see the 1-day test)
+        assert 1e-13 < off < 1e-12
 
 
 @pytest.mark.parametrize("override, words", [
@@ -297,6 +389,7 @@ def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
     err_T = np.abs(f.T_S_I - tr["sat/T_S_I"][sl]).max()
     err_th = np.abs(0.5 * f.theta - tr["mosa/angle"][sl][..., 0]).max()
     print(f"\n{law}: in-loop vs post-processed attitude {err_T:.1e}, MOSA angle {err_th:.1e} rad")
+    # README "< 6e-16" (measured 4.4e-16 / 4.4e-16 / 5.6e-16 for T_S_I, 2.2e-16 rad for the MOSA angle); ~4x above
     assert err_T < 2e-15 and err_th < 1e-15
 
 
@@ -309,7 +402,7 @@ def test_ninety_day_acceptance(tmp_path):
     (report.secular_along_track_drift) and 3/2 f T^2 for a constant
     along-track push.  The paper's "< 1 m" is reported, not asserted: tqdyn
     gives 1.47 m for Sat1 (README, docs/report.md)."""
-    from tqdyn.analysis.metrics import orbit_deviation, secular_along_track_drift
+    from tqdyn.analysis.metrics import breathing_angles_of, orbit_deviation, secular_along_track_drift
 
     every = ["run.output_every=12", "forces.earth_degree=12"]
     _, grav, _ = _run(tmp_path, "g.h5", every + ["constellation.pointing=none", "constellation.control=off"], "90d")
@@ -321,11 +414,40 @@ def test_ninety_day_acceptance(tmp_path):
     assert np.all(vS[..., 1] < -0.9999)
     d = orbit_deviation(df, grav)
     pred = secular_along_track_drift(d.t, df["sat/r"], df["sat/v"], df["sat/a_dragfree"])
-    print(f"\ndrag-free vs gravity, 90 d: max |dr| {d.norm.max(axis=0)} m; along-track at 90 d {d.along[-1]} m, "
+    dmax = d.norm.max(axis=0)
+    print(f"\ndrag-free vs gravity, 90 d: max |dr| {dmax} m; along-track at 90 d {d.along[-1]} m, "
           f"secular prediction {pred[-1]} m")
-    assert np.all(d.norm.max(axis=0) < 2.0)
+    # README: 1.47 / 0.70 / 0.90 m (Sat1/2/3; the paper's "< 1 m" is not reproduced), secular prediction 1.36 m
+    # for Sat1.  Bounds 3x either side per satellite: the deviation is the along-track drift of a nonzero mean G
+    for s_, quoted in enumerate((1.47, 0.70, 0.90)):
+        assert quoted / 3 < dmax[s_] < 3 * quoted, (s_, dmax[s_])
+    assert 1.36 / 3 < pred[-1, 0] < 3 * 1.36
     np.testing.assert_allclose(d.along[-1], pred[-1], rtol=0.2, atol=0.05)
+    # the mean along-track G of Sat1 (README -6.7e-15 m/s^2, docs/report.md -6.6e-15) and max |G|: 1e-13 on the
+    # first day, 4-5.5e-13 m/s^2 over 90 days as the triangle breathes (README)
+    r, v, G = df["sat/r"], df["sat/v"], df["sat/a_dragfree"]
+    h = np.cross(r, v)
+    t_hat = np.cross(h / np.linalg.norm(h, axis=-1, keepdims=True), r / np.linalg.norm(r, axis=-1, keepdims=True))
+    G_t = np.einsum("nsk,nsk->ns", G, t_hat)
+    G_norm = np.linalg.norm(G, axis=-1)
+    day1 = d.t <= 86400.0
+    print(f"mean along-track G {G_t.mean(axis=0)} m/s^2; max |G| first day {G_norm[day1].max(axis=0)}, "
+          f"90 d {G_norm.max(axis=0)} m/s^2")
+    assert -2e-14 < G_t[:, 0].mean() < -2.2e-15
+    assert np.all(1.4e-13 < G_norm.max(axis=0)) and np.all(G_norm.max(axis=0) < 1.6e-12)
+    assert 3e-14 < G_norm[day1].max() < 4e-13
+    # the pure-gravity breathing angles: README / docs/report.md 59.9369 .. 60.0659 deg; the excursion from 60 deg
+    # (-0.063 / +0.066 deg) within 3x, and inside the +-0.1 deg requirement
+    alpha = np.degrees(breathing_angles_of(grav))
+    print(f"gravity-orbit breathing angles {alpha.min():.4f} .. {alpha.max():.4f} deg")
+    assert -0.1 < alpha.min() - 60 < -0.021 and 0.022 < alpha.max() - 60 < 0.1
     T = d.t[-1]
     f = orbit_deviation(fl, grav)
     print(f"+flight 1e-9 m/s^2, 90 d: |dr| {f.norm[-1] / 1e3} km; 3/2 f T^2 = {1.5e-9 * T**2 / 1e3:.2f} km")
+    # README 90.7 km; reference 3/2 f T^2 (Hill, constant along-track push)
     np.testing.assert_allclose(f.norm[-1], 1.5e-9 * T**2, rtol=0.01)
+    # the same-direction push leaves the breathing angles: docs/report.md "change < 1e-4 deg"
+    np.testing.assert_array_equal(fl["t"], grav["t"])  # the same 600 s output grid
+    dal = np.abs(np.degrees(breathing_angles_of(fl) - breathing_angles_of(grav))).max()
+    print(f"+flight breathing-angle change vs gravity orbit: {dal:.2e} deg")
+    assert dal < 3e-4

@@ -163,13 +163,14 @@ def test_shapes():
 
 
 def test_corrected_b_is_order_8(corrected):
-    """Reference: all 200 order conditions Phi(t) = 1/gamma(t), |t| <= 8."""
-    assert worst(residuals(corrected, "b", 8)) <= mpf("1e-33")
+    """Reference: all 200 order conditions Phi(t) = 1/gamma(t), |t| <= 8.
+    README: "the shipped tableau satisfies them to 5e-41" (measured 5.3e-41)."""
+    assert worst(residuals(corrected, "b", 8)) <= mpf("3e-40")
 
 
 def test_corrected_bhat_is_order_7(corrected):
-    """Reference: all 85 order conditions Phi(t) = 1/gamma(t), |t| <= 7."""
-    assert worst(residuals(corrected, "bhat", 7)) <= mpf("1e-33")
+    """Reference: all 85 order conditions Phi(t) = 1/gamma(t), |t| <= 7 (measured 1.3e-41)."""
+    assert worst(residuals(corrected, "bhat", 7)) <= mpf("3e-40")
 
 
 def test_corrected_c_is_row_sum_of_a(corrected):
@@ -194,26 +195,29 @@ def test_zero_pattern_is_published_one():
 def test_corrections_are_tiny(corrected, published):
     """Reference: published rationals; the correction must not be a new method.
 
-    Relative bound 1e-15, absolute below |value| = 1e-3 (all published nonzero
-    coefficients are larger than 1e-2, so in practice this is relative).
+    README: every coefficient is corrected "by at most 2.2e-17 relative" (measured 2.16e-17): relative bound
+    1e-16, absolute below |value| = 1e-3 (all published nonzero coefficients are larger than 1e-2, so in
+    practice this is relative).  The corrections are not all zero (the published tableau's defect, below,
+    needs them): the largest is above 3e-18.
     """
     pairs = [(p, c) for prow, crow in zip(published["a"], corrected["a"])
              for p, c in zip(prow, crow)]
     for key in ("b", "bhat", "c"):
         pairs += list(zip(published[key], corrected[key]))
     for pub, cor in pairs:
-        assert abs(cor - pub) <= mpf("1e-15") * max(abs(pub), mpf("1e-3"))
+        assert abs(cor - pub) <= mpf("1e-16") * max(abs(pub), mpf("1e-3"))
+    assert max(abs(cor - pub) / abs(pub) for pub, cor in pairs if pub != 0) > mpf("3e-18")
 
 
 def test_published_b_is_order_7_but_not_exactly_order_8(published):
     """Reference: order conditions |t| <= 7 and |t| = 8.
 
-    The published rationals satisfy them only to ~1e-17; this defect is why
-    the corrected tableau is the default.
+    The published rationals satisfy them only to ~6.5e-18 (README; measured: 6.5e-18 for |t| <= 7, 6.4e-18 for
+    |t| = 8); this defect is why the corrected tableau is the default.  Bounds ~3-5x either side.
     """
-    assert worst(residuals(published, "b", 7)) <= mpf("1e-15")
+    assert mpf("1e-18") < worst(residuals(published, "b", 7)) <= mpf("3e-17")
     order8 = worst(residuals(published, "b", 8, min_order=8))
-    assert mpf("1e-20") < order8 < mpf("1e-14")
+    assert mpf("1e-18") < order8 < mpf("3e-17")
 
 
 def test_bhat_is_not_order_8(corrected):

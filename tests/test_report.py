@@ -84,17 +84,19 @@ def test_pointing_study_orders_and_analytic_estimates(runs):
     global_ref = np.max(v_perp) / C_LIGHT
     taylor2_ref = np.max(np.abs(nv) * v_perp) / C_LIGHT ** 2
     print(f"pointing maxima {m}; estimates global {global_ref:.3e}, taylor2 {taylor2_ref:.3e} rad")
-    # the paper's Fig. 5: ~1e-6 rad global, ~1e-11 rad Taylor (orders of magnitude)
-    assert 1e-6 < m["global"]["per_beam"] < 1e-5
+    # the paper's Fig. 5: ~1e-6 rad global, ~1e-11 rad Taylor; README / docs/report.md: 5.77e-6, 3.85e-11,
+    # 1.93e-11 rad (measured on this 6 h run: 5.77e-6, 3.84e-11, 1.92e-11 rad): ~3x either side, plus the estimates
+    assert 2e-6 < m["global"]["per_beam"] < 2e-5
     assert abs(m["global"]["per_beam"] / global_ref - 1) < 0.01
-    assert 1e-12 < m["taylor1"]["per_beam"] < 1e-10
+    assert 1.2e-11 < m["taylor1"]["per_beam"] < 1.2e-10
+    assert abs(m["taylor1"]["per_beam"] / (2 * taylor2_ref) - 1) < 0.05   # docs/report.md point 4: twice taylor2
     assert abs(m["taylor2"]["per_beam"] / taylor2_ref - 1) < 0.05
-    for law in ("taylor1", "taylor2"):  # docs/design.md, Traps: cancel in X_S, add in theta
-        assert m[law]["x_s"] < 1e-13 < m[law]["per_beam"] < m[law]["theta"]
+    for law in ("taylor1", "taylor2"):  # docs/design.md, Traps: cancel in X_S (measured 9.3e-15 / 5.1e-15 rad), add in theta
+        assert m[law]["x_s"] < 5e-14 < m[law]["per_beam"] < m[law]["theta"]
     # tau ~ L/c costs (n . v) L / c^2 ~ 2e-6 s, not the paper's 1e-7 s
     L = geometry.by_mosa(a.length, axis=-1)[1:]
     assert abs(np.max(st.tau_error) / np.max(np.abs(nv) * L / C_LIGHT ** 2) - 1) < 0.02
-    assert st.ltt_residual < 1e-20
+    assert st.ltt_residual < 3e-31   # s; dd rounding of the light time (measured ~4e-32 s)
 
 
 def test_pointing_study_bad_input():
@@ -200,7 +202,11 @@ def test_report_runs_files_and_rows(runs, tmp_path):
         assert any(x.startswith(q) for x in quantities), q
     # no self-gravity: the controls are at the paper's ~1e-13 level (Fig. 7)
     c = rep.values["dragfree/control"]
-    assert 1e-14 < c["max_A"] < 1e-12 and 1e-14 < c["max_G"] < 1e-12 and 1e-14 < c["max_alpha"] < 1e-12
+    print(f"\n6 h, cheap model, no self-gravity: max |A| {c['max_A']:.2e} m/s^2, |G| {c['max_G']:.2e} m/s^2, "
+          f"|alpha| {c['max_alpha']:.2e} rad/s^2")
+    # the paper's ~1e-13 (Fig. 7); measured on these 6 h 9.15e-14 m/s^2, 5.31e-14 m/s^2, 1.29e-13 rad/s^2 (the
+    # README's first-day values: 1.4e-13, 1.1e-13, 3.1e-13): ~3x either side
+    assert 3e-14 < c["max_A"] < 3e-13 and 1.5e-14 < c["max_G"] < 2e-13 and 4e-14 < c["max_alpha"] < 4e-13
 
 
 def test_cli_report_runs(runs, tmp_path, capsys):
@@ -279,3 +285,170 @@ def test_cli_studies_quick(tmp_path, capsys):
     assert code == 0 and "reused" not in err  # quiet
     assert len(list((tmp_path / "s" / "runs").glob("*.h5"))) == len(
         {r for s in studies.STUDIES.values() for r in s.runs})
+
+
+def _band(value, quoted, factor=3.0):
+    """value within a factor ``factor`` of the quoted (README / docs) number, same sign (both sides)."""
+    value, quoted = np.asarray(value, dtype=float), np.asarray(quoted, dtype=float)
+    return bool(np.all(np.sign(value) == np.sign(quoted)) and np.all(np.abs(value) > np.abs(quoted) / factor)
+                and np.all(np.abs(value) < np.abs(quoted) * factor))
+
+
+@pytest.mark.slow
+def test_paper_studies_full_spans(tmp_path):
+    """The numbers of docs/report.md ("Summary (full spans)" and "Where tqdyn differs") and of the README's
+    "Reproducing the paper" table, from the 14 study runs at full spans (``tqdyn report --studies``: 10 min
+    with one worker on the 2-core test machine, the report itself 20 s).  Each quoted number is bounded within a factor 3 either
+    side (a zero would be wrong for every one of them), and where docs/report.md derives a value the
+    derivation is the reference: Hill's equations for the common self-gravity pushes, the secular along-track
+    drift of the stored G, the tidal model of the local-vs-global G, the aberration estimates of the pointing
+    laws.  TQDYN_STUDIES_RUNS_DIR keeps the runs between sessions (complete runs are reused);
+    TQDYN_STUDIES_WORKERS sets the number of worker processes (default: one per core)."""
+    import json
+    import math
+    import os
+
+    runs_dir = os.environ.get("TQDYN_STUDIES_RUNS_DIR") or tmp_path / "runs"
+    workers = int(os.environ.get("TQDYN_STUDIES_WORKERS", "0")) or None
+    res = studies.run_studies(runs_dir, workers=workers)
+    assert not res.failures, [(o.run.name, o.error) for o in res.failures]
+    rep = rp.report_studies({n: res.path(n) for n in res.outcomes}, tmp_path / "out")
+    v = rep.values
+    print("\nstudy values: " + json.dumps(v, default=lambda x: np.asarray(x).tolist(), indent=1))
+
+    # Fig. 5 (30 d): per beam 5.77e-6 / 3.85e-11 / 1.93e-11 rad; global X_S 5.8e-6, theta 1.0e-8; taylor1 X_S
+    # 4.6e-14, theta 7.7e-11; 2nd / 1st order 0.50; tau - L/c 1.93e-6 s (s. tests/test_pointing.py for the
+    # aberration estimates as references)
+    p = v["pointing"]
+    assert _band(p["global"]["per_beam"], 5.77e-6) and _band(p["global"]["x_s"], 5.8e-6)
+    assert _band(p["global"]["theta"], 1.0e-8)
+    assert _band(p["taylor1"]["per_beam"], 3.85e-11) and _band(p["taylor1"]["x_s"], 4.6e-14)
+    assert _band(p["taylor1"]["theta"], 7.7e-11) and _band(p["taylor2"]["per_beam"], 1.93e-11)
+    assert 0.4 < p["taylor2"]["per_beam"] / p["taylor1"]["per_beam"] < 0.6
+    assert _band(v["pointing/tau_error_max"], 1.93e-6)
+    # Fig. 6 / Fig. 10: range ASD / requirement (max in 0.1 .. 10 mHz): the gravity orbits' own signal 2.42 (the
+    # same 2.42 on the Table IV TM-TM light path: the control adds nothing there), differences 1.57e-5
+    # (drag-free - gravity), 1.8e-5 (global - local), 6.76e-4 (light path - instantaneous), 9.34e-4 (TM - Sat)
+    assert _band(v["asd/gravity"], 2.42) and _band(v["asd/light_path"], 2.42)
+    assert abs(v["asd/light_path"] / v["asd/gravity"] - 1) < 0.05
+    assert _band(v["asd/dragfree_minus_gravity"], 1.57e-5) and _band(v["asd/global_minus_local"], 1.8e-5)
+    assert _band(v["asd/lp_minus_inst"], 6.76e-4) and _band(v["asd/tm_minus_sat"], 9.34e-4)
+    # light-time residual (iterative, dd): 2.77e-23 m
+    assert v["lightpath/residual_max"] * C_LIGHT < 3 * 2.77e-23
+    # Fig. 7 (30 d, no self-gravity): |A| 6.56e-13 (first day 1.4e-13) m/s^2, |alpha| 7.44e-13 (3.1e-13) rad/s^2,
+    # |G| 3.52 / 4.40 / 5.22e-13 (first day 1.1e-13) m/s^2; the flight direction is -Y_S on every row
+    c = v["control_no_sg"]
+    assert _band(c["max_A"], 6.56e-13) and _band(c["max_A_day1"], 1.4e-13)
+    assert _band(c["max_alpha"], 7.44e-13) and _band(c["max_alpha_day1"], 3.1e-13)
+    assert _band(c["max_G_per_sat"], [3.52e-13, 4.40e-13, 5.22e-13]) and _band(c["max_G_day1"], 1.1e-13)
+    assert v["flight_axis"][1] < -0.99999
+    # Fig. 8 (30 d, Table IV): |A| per TM 9.20e-11 (< 1e-10, as the paper says), |A_1 - A_2| 1.75e-10 m/s^2
+    # (Table IV's own z difference is 1.67e-10)
+    c = v["control_table_iv"]
+    assert _band(c["max_A"], 9.20e-11) and c["max_A"] < 1e-10
+    assert 1.67e-10 - 1e-12 < c["max_dA"] < 3 * 1.75e-10
+    # Sec. V.A (90 d): drag-free vs gravity max |dr| 1.47 / 0.70 / 0.90 m, along-track at 90 d 1.47 / -0.66 /
+    # -0.74 m measured vs 1.36 / -0.59 / -0.66 m predicted (reference: the secular drift of the stored G,
+    # within the ~10 % first-order theory leaves), max |G| first day 1.0e-13 / 1.2e-14 / 1.1e-13 -> 90 d 4.2e-13 /
+    # 4.4e-13 / 5.5e-13 m/s^2; local (taylor2) pointing 1.68 / 0.51 / 0.68 m
+    d = v["deviation/dragfree-global-90d"]
+    assert _band(d["max"], [1.47, 0.70, 0.90]) and _band(d["end_along"], [1.47, -0.66, -0.74])
+    assert _band(d["pred_end"], [1.36, -0.59, -0.66])
+    np.testing.assert_allclose(d["end_along"], d["pred_end"], rtol=0.2)
+    assert _band(d["G_first_day"], [1.0e-13, 1.2e-14, 1.1e-13]) and _band(d["G_max"], [4.2e-13, 4.4e-13, 5.5e-13])
+    assert _band(v["deviation/dragfree-local-90d"]["max"], [1.68, 0.51, 0.68])
+    # local vs global: 0.217 m per satellite in 90 d; dG along Y_S 2.39e-15 m/s^2 (X_S 4e-18, Z_S 2e-21) =
+    # 3 n^2 (d_TM/2) delta cot(theta/2) with delta = 5.77e-6 rad (reference: that model, and 3/2 dG T^2)
+    lg = v["deviation/local_vs_global"]
+    T = 90 * 86400.0
+    assert _band(lg["max"], [0.217] * 3)
+    np.testing.assert_allclose(lg["max"], 1.5 * lg["model"] * T ** 2, rtol=0.05)
+    assert _band(lg["dG_max"][:, 1], [2.39e-15] * 3)
+    np.testing.assert_allclose(lg["dG_max"][:, 1], lg["model"], rtol=0.01)
+    assert np.all(lg["dG_max"][:, 0] < 3 * 4e-18) and np.all(lg["dG_max"][:, 2] < 3 * 2e-21)
+    assert _band(lg["delta_max"], [5.77e-6] * 3)
+    # Sec. V.B.2 (90 d): 1e-9 m/s^2 common self-gravity: +flight (-y) 90.67 / 90.68 / 90.67 km, along-track
+    # -90.66 .. -90.68 km (falls behind); per direction (max over satellites) +-x 0.784 / 0.786 km, +-y 90.7 km,
+    # +-z 3.32 / 3.39 m.  References (Hill): along-track push 3/2 f T^2 - 4 f (1 - cos nT) / n^2 = 90.69 km,
+    # radial push 2 f T / n = 0.779 km, normal push bounded by 2 f / n^2 = 5 m
+    sg = v["common_sg"]
+    f, n = 1e-9, math.sqrt(3.986004415e14 / 1e8 ** 3)
+    assert _band(sg["-y"]["dev_end"], [90.67e3, 90.68e3, 90.67e3]) and _band(sg["+y"]["dev_end"].max(), 90.7e3)
+    assert _band(sg["-y"]["along_end"], [-90.66e3, -90.68e3, -90.67e3])
+    for label in ("-y", "+y"):
+        np.testing.assert_allclose(sg[label]["dev_end"], f * (1.5 * T ** 2 - 4 * (1 - math.cos(n * T)) / n ** 2),
+                                   rtol=0.01)
+    for label, quoted in (("+x", 784.0), ("-x", 786.0)):
+        assert _band(sg[label]["dev_end"].max(), quoted)
+        np.testing.assert_allclose(sg[label]["dev_end"].max(), 2 * f * T / n, rtol=0.05)
+    for label, quoted in (("+z", 3.32), ("-z", 3.39)):
+        # the normal push does not drift: its 90-day maximum stays at the Hill amplitude 2 f / n^2 = 5.0 m (measured
+        # 5.25 m, 5 % above the first-order value docs/report.md calls a bound)
+        assert _band(sg[label]["dev_end"].max(), quoted) and sg[label]["dev_max"].max() < 1.2 * 2 * f / n ** 2
+    # breathing angles: change < 1e-4 deg ("max 0.0001 deg") in the six runs; the angles 59.9369 .. 60.0659 deg
+    # (the excursions from 60 deg bounded within 3x)
+    assert max(sg[label]["dalpha_max"] for label in sg) < 3e-4
+    lo = min(sg[label]["alpha_range"][0] for label in sg)
+    hi = max(sg[label]["alpha_range"][1] for label in sg)
+    assert _band(lo - 60, 59.9369 - 60) and _band(hi - 60, 60.0659 - 60)
+    # Fig. 9 (90 d): extreme case 59.8953 .. 60.1074 deg, first outside 60 +- 0.1 deg at day 86.0 ("near the end
+    # of 3 months"); change vs gravity 0.0522 / 0.0005 / 0.0517 deg; deviation 90.7 km per satellite; the
+    # gravity orbit alone 59.9369 .. 60.0659 deg
+    ex = v["extreme"]
+    assert _band(ex["range"][0] - 60, 59.8953 - 60) and _band(ex["range"][1] - 60, 60.1074 - 60)
+    assert ex["first_exit_day"] is not None and 80 < ex["first_exit_day"] < 90
+    assert _band(ex["change_max"], [0.0522, 0.0005, 0.0517]) and _band(ex["dev_end"], [90.7e3] * 3)
+    assert _band(ex["gravity_range"][0] - 60, 59.9369 - 60) and _band(ex["gravity_range"][1] - 60, 60.0659 - 60)
+
+
+@pytest.mark.slow
+def test_gravity_orbit_range_asd_is_the_earth_field():
+    """docs/report.md point 6: the Sat1-Sat3 light-path range ASD of the 30-day gravity orbits is 2.4 times the
+    requirement at 0.100 mHz and below it from 0.104 mHz on; it is the orbits' response to the Earth's field:
+    only the Earth's field (static field and tides) gives the same ratio (2.41), only the Moon and the Sun
+    0.011, Kepler alone 1e-9 (at the band's lower edge); the static field truncated at degree 6 0.19, at 8 and
+    12 2.24; Welch segments of 6.3, 12.5 and 25 days give 2.4, 1.9, 2.5 (not window leakage).  Bounds 3x
+    either side; 30-day pure-gravity runs at 50 s through the public API (~80 s in all)."""
+    import tqdyn
+    from tqdyn.analysis import spectra
+    from tqdyn.constellation.indices import Link
+
+    no_bodies = ["forces.third_bodies=[]", "forces.third_bodies_extended=[]", "forces.moon_degree=0",
+                 "forces.sun_j2=false", "forces.relativity=false", "forces.earth_field_indirect=false"]
+    no_tides = ["forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false"]
+    cases = {"full": [], "earth": no_bodies,
+             "moon+sun": [*no_tides, "forces.earth_degree=0", "forces.third_bodies=sun,moon", "forces.moon_degree=0",
+                          "forces.sun_j2=false", "forces.relativity=false", "forces.earth_field_indirect=false"],
+             "kepler": [*no_bodies, *no_tides, "forces.earth_degree=0"],
+             **{f"static-{n}": [*no_bodies, *no_tides, f"forces.earth_degree={n}"] for n in (6, 8, 12)}}
+    asd, lts = {}, {}
+    for name, overrides in cases.items():
+        lts[name] = tqdyn.light_travel_times(tqdyn.propagate("tianqin-gravity", ["run.duration=30d", *overrides]))
+        asd[name] = tqdyn.range_asd(lts[name], "13")
+    print("\n30-day gravity orbits, link 13, ASD / requirement in 0.1 .. 10 mHz: " + ", ".join(
+        f"{k} {a.max_ratio:.3g} at {a.f_at_max:.3g} Hz" for k, a in asd.items()) + f"; full: >= 1 up to "
+        f"{asd['full'].f_above} Hz")
+    full = asd["full"]
+    assert full.band[0] == pytest.approx(1e-4) and _band(full.max_ratio, 2.42) and full.max_ratio > 1
+    assert full.f_at_max == pytest.approx(1e-4) and 1e-4 <= full.f_above < 2e-4   # measured 1.037e-4 Hz
+    assert _band(asd["earth"].max_ratio, 2.41) and abs(asd["earth"].max_ratio / full.max_ratio - 1) < 0.05
+    assert _band(asd["moon+sun"].max_ratio, 0.011)
+    # Kepler: the ratio at the band's lower edge (docs "1e-9"; measured 1.5e-9); its band maximum is the numerical
+    # floor near Nyquist (measured 8.7e-6 at 8.8 mHz)
+    k = asd["kepler"]
+    sel = (k.f >= k.band[0]) & (k.f <= k.band[1])
+    assert _band(k.asd[sel][0] / spectra.requirement_asd(k.f[sel][0]), 1e-9) and k.max_ratio < 3e-5
+    assert _band(asd["static-6"].max_ratio, 0.19)
+    assert _band(asd["static-8"].max_ratio, 2.24) and _band(asd["static-12"].max_ratio, 2.24)
+    # Welch segments of 6.25 (the default, 10800 samples), 12.5 and 25 days: 2.42, 1.94, 2.55 measured
+    lt = lts["full"]
+    i = Link(13).index
+    hi, lo = lt.range[0][:, i], lt.range[1][:, i]
+    ok = np.isfinite(hi)
+    t = (lt.t[0] + lt.t[1])[ok]
+    ratios = []
+    for nperseg, quoted in ((10800, 2.4), (21600, 1.9), (43200, 2.5)):
+        f, a = spectra.range_asd(t, hi[ok], lo[ok], nperseg=nperseg)
+        ratios.append(spectra.band_limited_max_ratio(f, a, 50.0, band=(1e-4, 1e-2))[0])
+        assert _band(ratios[-1], quoted), (nperseg, ratios[-1])
+    assert ratios[0] == pytest.approx(full.max_ratio, rel=1e-9) and max(ratios) / min(ratios) < 1.5
