@@ -65,7 +65,7 @@ Arm vectors are formed from the double-double positions as
   m/s^3 (the Moon's tidal term; vs |J| ~ n^3 r ~ 8e-7 m/s^3); the snap misses
   ~1e-5 n^2 ~ 4e-15 m/s^4: the emission point moves by 4e-15 tau^4/24 ~
   2e-17 m, ~1e-25 rad.  The jerk enters omega_dot through 1/c: a missing
-  4e-10 m/s^3 is 1.2e-18 rad/s^2 of omega_dot that the attitude does not
+  5e-10 m/s^3 is ~2e-18 rad/s^2 of omega_dot that the attitude does not
   have (measured), which is why :mod:`tqdyn.dynamics` passes the Moon, Sun
   and J2 jerk.
 
@@ -316,7 +316,7 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
         [m/s^3, GCRS] beyond the Earth monopole (zeros for a Kepler orbit).
         omega_dot of the local laws contains jerk / c: a jerk left out makes
         omega_dot inconsistent with the attitude (the Moon's tidal jerk,
-        ~4e-10 m/s^3, would be 1.2e-18 rad/s^2).
+        ~5e-10 m/s^3, would be ~2e-18 rad/s^2).
     gm : float -- Earth GM [m^3/s^2], for the remote satellites' monopole
         jerk and snap (Taylor and iterative laws).
     c : float -- speed of light [m/s].

@@ -118,8 +118,8 @@ def _jerk_perturbation(cpar, tdat, fw):
     degree >= 3 (~2e-14), planets, tides, relativity (< 1e-15), G (~1e-17):
     omega_dot is the derivative of omega to ~4e-22 rad/s^2 (measured 1.5e-21
     against 5-point differences, their own error included; the Moon's tidal
-    jerk alone is ~4e-10 m/s^3, 1.2e-18 rad/s^2).  Free TMs under a local
-    law stay within 3.4e-13 m of their EH centers over 10 days (2e-9 m in 2
+    jerk alone is ~5e-10 m/s^3, ~2e-18 rad/s^2).  Free TMs under a local
+    law stay within 3.6e-13 m of their EH centers over 10 days (2e-9 m in 2
     days with the monopole jerk alone).
     """
     v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
