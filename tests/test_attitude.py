@@ -212,7 +212,9 @@ def test_omega_against_finite_differences(real_orbit, law, method):
     att = attitude(r, v, a, law=law, method=method, jerk=jerk)
     om_fd, omd_fd = _fd_omega(att.T_S_I, h)
     assert np.abs(om_fd - att.omega[2:-2]).max() < TOL_FD_OMEGA
-    assert np.abs(omd_fd - att.omega_dot[2:-2]).max() < TOL_FD_OMEGA_DOT
+    # taylor1: plus the neglected perturbation jerk (< ~1e-18 rad/s^2, docstring): measured 1.46e-18
+    # with 14 C04, 1.50e-18 with 20 C04 (the orbit differs by um), global 3.4e-19 .. 4.6e-19
+    assert np.abs(omd_fd - att.omega_dot[2:-2]).max() < TOL_FD_OMEGA_DOT + (1e-18 if law != "global" else 0.0)
     # MOSA rates: FD of theta (same stencils; theta'' rounding 64*2e-16/(12 h^2) ~ 4e-19)
     th = att.theta
     th1 = (th[:-4] - 8 * th[1:-3] + 8 * th[3:-1] - th[4:]) / (12 * h)

@@ -31,7 +31,8 @@ from tqdyn.astro.timescales import Epoch
 #: degree-2 Earth field) for the short checks; the full model is the default
 #: scenario and is exercised by the CLI tests and the benchmarks.
 CHEAP = ["forces.earth_degree=2", "forces.third_bodies=sun,moon", "forces.solid_tides=false",
-         "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.moon_degree=0", "forces.sun_j2=false",
+         "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.atmospheric_tides=false",
+         "forces.moon_degree=0", "forces.sun_j2=false",
          "forces.relativity=false", "forces.earth_field_indirect=false"]
 
 
@@ -75,8 +76,10 @@ def _gravity_at(scen, t_pair, positions_dd, velocities):
 #: 2.2e-16, omega 6.8e-21 rad/s, A 1.2e-25, G 5.2e-26, condition (a) 7.8e-26 m/s^2); the others 3-10x above
 #: the measured omega_dot 1.0e-25 rad/s^2, MOSA angle 1.1e-16 rad, EH centre 5.6e-17 m, alpha 1.3e-25 rad/s^2.
 #: a_gravity is the same dd sum rounded once (measured exactly 0): at most 1 ulp of 0.04 m/s^2 (7e-18).
+# A, cond_a: float64 round-off of ~1e-10 m/s^2 (ulp 1.3e-26) in two operation orders; it moves by 2x with
+# um changes of the orbit (EOP 14 vs 20 C04: A 1.2e-25 vs 2.1e-25, cond_a 0.8e-25 vs 1.1e-25 at row 144)
 TOL_ROWS = {"T_S_I": 5e-16, "omega": 5e-20, "omega_dot": 1e-24, "mosa": 5e-16, "tm_r": 3e-16, "a_gravity": 1e-18,
-            "A": 2e-25, "G": 2e-25, "alpha": 1e-24, "cond_a": 1e-25}
+            "A": 3e-25, "G": 2e-25, "alpha": 1e-24, "cond_a": 2e-25}
 
 
 @pytest.mark.parametrize("row", [0, 77, 144])

@@ -1,9 +1,14 @@
-"""Tests for tqdyn.eop (IERS 14 C04 reader, interpolation, sub-daily EOP terms).
+"""Tests for tqdyn.eop (IERS 14 C04 / 20 C04 / finals2000A readers, interpolation, sub-daily EOP terms).
 
 Independent references used here:
 * The parse check of ``src/tqdyn/data/SOURCES.md`` (2004-06-06, MJD 53162:
   x = -0.074487", y = 0.475665", UT1-UTC = -0.4704721 s, LOD = -0.0002408 s,
   dX = 0.000116", dY = 0.000096"), read off the file by hand.
+* Rows of astropy-iers-data 0.2026.11.2's ``eopc04.1962-now`` (IERS EOP 20
+  C04) and ``finals2000A.all`` copied verbatim into this file, with their
+  values read off by hand (the installed files change weekly, so the parse
+  checks use the copies; the installed files are checked for structure and
+  against the 14 C04 series).
 * A slow exact-rational (``fractions.Fraction``) 4-point Lagrange interpolant
   written here, with its own node selection and TAI-UTC from ``erfa.dat``
   called per calendar date (so the leap-second handling is checked against
@@ -34,7 +39,8 @@ import pytest
 
 from tqdyn.astro.eop import ARCSEC, EOP, tidal_arguments, tidal_eop_corrections
 from tqdyn.astro.eop import load_eop
-from tqdyn.readers.eop_c04 import parse_eop_c04
+from tqdyn.readers.eop_c04 import parse_eop_c04, read_eop_c04_20
+from tqdyn.readers.eop_finals import parse_finals2000a, read_finals2000a
 from tqdyn.readers.iers_tables import load_tidal_eop_terms
 
 UAS = ARCSEC * 1e-6
@@ -100,6 +106,93 @@ def test_missing_and_malformed_files(tmp_path):
     assert e.source == str(ok)
     e2 = parse_eop_c04(text)
     assert np.array_equal(e2.dut1, e.dut1) and e2.source == "text"
+
+
+#: Verbatim rows of IERS EOP 20 C04 (astropy-iers-data 0.2026.11.2, eopc04.1962-now) with its column header;
+#: the last two rows straddle the leap second at the end of 2005-12-31.
+C04_20_TEXT = """\
+# YR  MM  DD  HH       MJD        x(")        y(")  UT1-UTC(s)       dX(")       dY(")  xrt("/day)  yrt("/day)      LOD(s)        x Er        y Er  UT1-UTC Er       dX Er       dY Er      xrt Er      yrt Er      LOD Er
+2004   6   6   0  53162.00   -0.074500    0.475660  -0.4704630    0.000048    0.000116    0.001231    0.001632  -0.0002172    0.000067    0.000057   0.0000091    0.000067    0.000070    0.000121    0.000172   0.0000228
+2004   6   7   0  53163.00   -0.073352    0.477179  -0.4703245   -0.000002    0.000118    0.001327    0.001267  -0.0000516    0.000066    0.000056   0.0000091    0.000068    0.000070    0.000120    0.000170   0.0000228
+2005  12  31   0  53735.00    0.053717    0.384262  -0.6611412    0.000273   -0.000282   -0.001078   -0.000758   0.0000237    0.000068    0.000058   0.0000084    0.000075    0.000076    0.000124    0.000162   0.0000388
+2006   1   1   0  53736.00    0.052632    0.383697   0.3387931    0.000307   -0.000233   -0.000928   -0.000502   0.0001379    0.000070    0.000058   0.0000083    0.000073    0.000076    0.000119    0.000147   0.0000483
+"""
+
+#: Verbatim rows of finals2000A.all (astropy-iers-data 0.2026.11.2): the last measured day, the first two
+#: predictions (with dX, dY), the last prediction (without), the first date-only row.
+FINALS_TEXT = (
+    "261022 61335.00 I  0.149159 0.000041  0.317685 0.000041  I-0.0428601 0.0000203                 P     0.271"
+    "    0.127     0.162    0.159" + " " * 53 + "\n"
+    "261023 61336.00 P  0.148194 0.000600  0.317462 0.000400  P-0.0444801 0.0000297                 P     0.268"
+    "    0.127     0.172    0.159" + " " * 53 + "\n"
+    "261024 61337.00 P  0.147163 0.000891  0.317408 0.000659  P-0.0461706 0.0000359                 P     0.264"
+    "    0.128     0.181    0.160" + " " * 53 + "\n"
+)
+FINALS_TAIL = ("271029 61707.00 P  0.179319 0.017516  0.276208 0.028383  P-0.2081431 0.0254096" + " " * 108 + "\n"
+               "271030 61708.00" + " " * 172 + "\n")
+#: A measured row with LOD and the Bulletin B columns (2004-06-06).
+FINALS_2004 = (" 4 6 6 53162.00 I -0.074537 0.000053  0.475644 0.000057  I-0.4704398 0.0000064 -0.2254 0.0044  I"
+               "     0.082    0.150    -0.099    0.145 -0.074410  0.475460 -0.4705960    -0.150     0.168  \n")
+
+
+def test_parse_c04_20_layout():
+    s = parse_eop_c04(C04_20_TEXT, source="c04-20 rows")
+    assert np.array_equal(s.mjd, [53162.0, 53163.0, 53735.0, 53736.0])
+    assert s.xp[0] == -0.074500 * ARCSEC and s.yp[0] == 0.475660 * ARCSEC
+    assert s.dut1[0] == -0.4704630 and s.lod[0] == -0.0002172  # LOD is column 13 in 20 C04, not 8
+    assert s.dx[0] == 0.000048 * ARCSEC and s.dy[0] == 0.000116 * ARCSEC
+    assert s.dut1[3] == 0.3387931 and s.lod[3] == 0.0001379 and s.predicted is None
+    # the two C04 series agree on 2004-06-06 to their stated errors (ITRF 2014 vs 2020 alignment)
+    assert abs(s.xp[0] - (-0.074487 * ARCSEC)) < 100 * UAS and abs(s.dut1[0] - (-0.4704721)) < 20e-6
+    with pytest.raises(ValueError, match="0 h"):
+        parse_eop_c04(C04_20_TEXT.replace("2004   6   7   0  53163.00", "2004   6   7  12  53163.00"))
+    with pytest.raises(ValueError, match="MJD does not match"):
+        parse_eop_c04(C04_20_TEXT.replace("53163.00", "53164.00"))
+
+
+def test_installed_c04_20():
+    s = read_eop_c04_20()
+    assert s.mjd[0] == 37665.0 and np.all(np.diff(s.mjd) == 1.0)  # 1962-01-01, daily
+    assert s.mjd[-1] >= 61312.0  # 2026-09-29 in the 0.2026.11.2 release; later releases extend it
+    assert "EOP 20 C04" in s.source and "astropy-iers-data" in s.source
+    c14 = load_eop()
+    i, k = np.searchsorted(s.mjd, 53162.0), np.searchsorted(c14.mjd, 53162.0)
+    assert abs(s.xp[i] - c14.xp[k]) < 100 * UAS and abs(s.dut1[i] - c14.dut1[k]) < 20e-6
+
+
+def test_parse_finals2000a_rows():
+    s = parse_finals2000a(FINALS_TEXT, source="finals rows")
+    assert np.array_equal(s.mjd, [61335.0, 61336.0, 61337.0])
+    assert list(s.predicted) == [False, True, True]
+    assert s.xp[0] == 0.149159 * ARCSEC and s.yp[1] == 0.317462 * ARCSEC
+    assert s.dut1[1] == -0.0444801 and s.dut1[2] == -0.0461706
+    assert s.dx[1] == pytest.approx(0.268e-3 * ARCSEC, rel=1e-15) and s.dy[2] == pytest.approx(0.181e-3 * ARCSEC, rel=1e-15)
+    # LOD is blank in these rows: -d(UT1-TAI)/dt from the neighbours (TAI-UTC = 37 s throughout)
+    assert abs(s.lod[1] - (0.0461706 - 0.0428601) / 2) < 1e-14  # (UT1-UTC - 37 s rounds to ~7e-15 s)
+    assert abs(s.lod[0] - (0.0444801 - 0.0428601)) < 1e-14
+    m = parse_finals2000a(FINALS_2004)
+    assert m.mjd[0] == 53162.0 and m.xp[0] == -0.074537 * ARCSEC and m.dut1[0] == -0.4704398
+    assert m.lod[0] == -0.2254e-3 and m.dx[0] == pytest.approx(0.082e-3 * ARCSEC, rel=1e-15) and not m.predicted[0]
+    # the date-only rows after the predictions end the series; dX, dY blank -> 0
+    t = parse_finals2000a(FINALS_TAIL)
+    assert t.mjd.size == 1 and t.dx[0] == 0.0 and t.predicted[0] and t.yp[0] == 0.276208 * ARCSEC
+    with pytest.raises(ValueError, match="consecutive"):
+        parse_finals2000a(FINALS_TEXT.splitlines(True)[0] + FINALS_TEXT.splitlines(True)[2])
+    with pytest.raises(ValueError, match="MJD does not match"):
+        parse_finals2000a(FINALS_TEXT.replace("261023 61336", "261024 61336"))
+    with pytest.raises(ValueError, match="flags"):
+        parse_finals2000a(FINALS_TEXT.replace("61336.00 P", "61336.00 X"))
+
+
+def test_installed_finals2000a():
+    s = read_finals2000a()
+    assert s.mjd[0] == 41684.0 and np.all(np.diff(s.mjd) == 1.0)  # 1973-01-02, daily
+    pred = s.predicted
+    first_p = int(np.argmax(pred))
+    assert not pred[:first_p].any() and pred[first_p:].all()  # measured, then predicted
+    assert 300 <= pred.sum() <= 400  # about a year of Bulletin A predictions
+    assert np.all(np.isfinite(s.lod)) and np.all(np.abs(s.lod) < 5e-3)
+    assert "finals2000A" in s.source
 
 
 # ----------------------------------------------------------------------

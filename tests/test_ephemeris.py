@@ -247,8 +247,10 @@ def test_third_bodies_factory_and_magnitudes_along_tianqin_orbit(eph):
     conjunction on 2004-06-08 (transit of Venus, d = 0.289 au = 4.3e10 m):
     GM r/d^3 = 4e-10 .. 8e-10; Jupiter (d ~ 5.6 au): 2e-11..4e-11 m/s^2.
     Measured maxima: Moon 2.2e-5, Sun 5.9e-6, Venus 6.3e-10, Jupiter 3.5e-11
-    m/s^2.  Assert each within a factor 10 of the estimate GM r/d^3."""
-    tb = third_bodies(eph)
+    m/s^2.  Assert each within a factor 10 of the estimate GM r/d^3.
+    (The ephemeris's own BCRS differences and GMs; the default GCRS
+    transform, 1.5e-8 relative, is tests/test_geocentric.py's.)"""
+    tb = third_bodies(eph, gcrs=False)
     assert isinstance(tb, ThirdBodies)
     assert tb.names == BODIES and tb.n_tdat == 27
     assert "DE421" in tb.source and "gm_de431.tpc" in tb.source

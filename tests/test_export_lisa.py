@@ -8,8 +8,10 @@ at 50 s, with test masses +-0.2 m along the track (their own Kepler orbits).
 References:
 (1) the analytic proper time of a Kepler orbit: with vis-viva,
     (GM/r + v^2/2)/c^2 = (2 GM/r - GM/(2a))/c^2 and int dt/r = (E - E0)/(n a)
-    (E the eccentric anomaly), so delta_tau(t) = -(2 GM (E - E0)/(n a)
-    - GM (t - t0)/(2 a))/c^2 -- for a circular orbit -1.5 GM t/(a c^2);
+    (E the eccentric anomaly); against the coordinate time TT, d tau/dTT =
+    (1 - (GM/r + v^2/2)/c^2)/(1 - L_G) (TT = (1 - L_G) TCG), so delta_tau(t) =
+    [L_G (t - t0) - (2 GM (E - E0)/(n a) - GM (t - t0)/(2 a))/c^2]/(1 - L_G) --
+    for a circular orbit (L_G - 1.5 GM/(a c^2)) t/(1 - L_G);
 (2) finite differences of the exported ltt / ppr for their rates;
 (3) lisaorbits' own iterative light travel time (InterpolatedOrbits,
     Shapiro off) on the same satellite positions;
@@ -27,6 +29,7 @@ import h5py
 import numpy as np
 import pytest
 
+from tqdyn.astro.constants import L_G
 from tqdyn.formats import trajectory as io
 from tqdyn import lightpath as LP
 from tqdyn.cli.export import export
@@ -70,7 +73,8 @@ def _analytic_delta_tau(s, t):
     n = np.sqrt(GM / A_M ** 3)
     E = _kepler(ECC[s], _m0(s), np.asarray(t, float))[3]
     E0 = _kepler(ECC[s], _m0(s), np.zeros(1))[3][0]
-    return -(2 * GM * (E - E0) / (n * A_M) - GM * np.asarray(t) / (2 * A_M)) / C_LIGHT ** 2
+    t = np.asarray(t, float)
+    return (L_G * t - (2 * GM * (E - E0) / (n * A_M) - GM * t / (2 * A_M)) / C_LIGHT ** 2) / (1 - L_G)
 
 
 _ATTRS = {"scenario": f"[forces]\ngm_earth = {GM!r}\n", "epoch_utc": "2004-06-06T00:00:00", "precision": "dd",
@@ -120,7 +124,7 @@ def test_layout(files):
     assert attrs["version"] == "2.3" and isinstance(attrs["version"], str)
     assert attrs["t0"] == STEP and attrs["dt"] == STEP and attrs["size"] == size
     assert isinstance(attrs["t0"], np.floating) and isinstance(attrs["size"], np.integer)  # pytdi asserts np.number
-    assert "GCRS" in attrs["frame"] and "TDB" in attrs["time_scale"] and attrs["gm_earth"] == GM
+    assert "GCRS" in attrs["frame"] and "TT seconds" in attrs["time_scale"] and attrs["gm_earth"] == GM
     assert "test masses" in attrs["ltt_endpoints"] and bool(attrs["ignore_shapiro"])
     assert "satellite centres" in _read(s_sat.path)[0]["ltt_endpoints"]
     for name, shape in (("tcb/x", (3, 3)), ("tcb/n", (6, 3)), ("tcb/ltt", (6,)), ("tcb/delta_tau", (3,)),
@@ -155,7 +159,8 @@ def test_proper_time_vs_analytic(files):
     print(f"\nproper time vs analytic Kepler: {worst:.2e} s (|delta_tau| up to "
           f"{np.max(np.abs(data['tcb/delta_tau'])):.2e} s)")
     assert worst < 1e-19
-    np.testing.assert_allclose(data["tcb/delta_tau"][:, 0], -1.5 * GM / (A_M * C_LIGHT ** 2) * t, rtol=1e-12)
+    np.testing.assert_allclose(data["tcb/delta_tau"][:, 0], (L_G - 1.5 * GM / (A_M * C_LIGHT ** 2)) * t / (1 - L_G),
+                               rtol=1e-12)
     # ppr = ltt + delta_tau_recv(t) - delta_tau_emit(t - ltt), emitter clock from the analytic formula
     ltt = data["tcb/ltt"] + data["tqdyn/ltt_lo"]
     worst = 0.0
@@ -188,13 +193,14 @@ def test_rates_vs_finite_differences(files):
 
 
 def test_tps_sampling(files):
-    # coordinate time t of proper time tau = t_k: for the circular satellites
-    # delta_tau = -K t (K = 1.5 GM/(a c^2)), so t = t_k / (1 - K) and delta_t = K t_k / (1 - K);
+    # coordinate time t of proper time tau = t_k: for the circular satellites delta_tau = -K t
+    # (K = (1.5 GM/(a c^2) - L_G)/(1 - L_G), reference (1)), so t = t_k / (1 - K) and
+    # delta_t = K t_k / (1 - K);
     # the PPR there is ppr(t_k) + delta_t * dppr/dt, dppr/dt from finite differences of tcb/ppr
     _, _, _, s_tm, _ = files
     attrs, data = _read(s_tm.path)
     t = attrs["t0"] + np.arange(attrs["size"]) * attrs["dt"]
-    K = 1.5 * GM / (A_M * C_LIGHT ** 2)
+    K = (1.5 * GM / (A_M * C_LIGHT ** 2) - L_G) / (1 - L_G)
     for s in (0, 1):
         np.testing.assert_allclose(data["tps/delta_t"][:, s], K * t / (1 - K), rtol=1e-9, atol=1e-22)
     shift = data["tps/ppr"] - data["tcb/ppr"]

@@ -197,10 +197,14 @@ def test_without_eop(ep):
     assert earth_orientation(late, t, 0.0, use_eop=False).T_ITRS_GCRS.shape == (50, 3, 3)
 
 
-def test_out_of_eop_span():
+def test_out_of_eop_span(eop):
     late = Epoch.from_utc("2024-09-01T00:00:00")
     with pytest.raises(ValueError, match=r"outside the EOP table span MJD 37665\.\.60556.*2024-09-03"):
-        earth_orientation(late, np.array([0.0, 5 * DAY]), 0.0)
+        earth_orientation(late, np.array([0.0, 5 * DAY]), 0.0, eop)  # the shipped 14 C04 series
+    # the default table ("auto": measured, predicted, long-term model) ends 2099-12-31
+    assert earth_orientation(late, np.array([0.0, 5 * DAY]), 0.0).T_ITRS_GCRS.shape == (2, 3, 3)
+    with pytest.raises(ValueError, match=r"2100-01-0.*outside the EOP table span.*2099-12-31"):
+        earth_orientation(Epoch.from_utc("2099-12-31T00:00:00"), np.array([0.0, 2 * DAY]), 0.0)
     early = Epoch.from_utc("1961-06-01T00:00:00")
     with pytest.raises(ValueError, match="1962-01-01"):
         earth_orientation(early, 0.0, 0.0)

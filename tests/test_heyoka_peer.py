@@ -187,7 +187,7 @@ def test_several_bodies_match_single():
 #: tqdyn's reduced model: the tianqin scenario with everything but the Earth
 #: field (12x12), the Moon and the Sun switched off, EOP off.
 REDUCED = ["forces.earth_degree=12", "forces.third_bodies=sun,moon", "forces.eop=false",
-           "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false",
+           "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.atmospheric_tides=false",
            "forces.moon_degree=0", "forces.sun_j2=false", "forces.relativity=false",
            "forces.earth_field_indirect=false", "constellation.pointing=none", "constellation.control=off"]
 

@@ -126,7 +126,7 @@ def test_fields_catalogue_matches_contract():
         assert len(s.dims) == len(s.shape), f
     assert FIELDS["sat/r"].resolved_shape(1) == (1, 3)
     assert FIELDS["tm/r"].resolved_shape(3) == (3, 2, 3)
-    assert FORMAT == "tqdyn-trajectory" and FORMAT_VERSION == 1
+    assert FORMAT == "tqdyn-trajectory" and FORMAT_VERSION == 2
     assert set(io.__all__) >= {"FIELDS", "FieldSpec", "OutputError", "check_writable",
                                "TrajectoryWriter", "Trajectory", "read_trajectory"}
 
@@ -171,12 +171,13 @@ def test_root_attributes_native_types(tmp_path):
     with h5py.File(path, "r") as h5:
         a = h5.attrs
         assert a["format"] == FORMAT and isinstance(a["format"], str)
-        assert a["format_version"] == 1 and np.issubdtype(type(a["format_version"]), np.integer)
+        assert a["format_version"] == 2 and np.issubdtype(type(a["format_version"]), np.integer)
         assert isinstance(a["step_s"], (float, np.floating)) and a["step_s"] == 50.0
         for k in ("tqdyn_version", "scenario", "epoch_utc", "time_scale", "frame", "precision",
                   "integrator", "pointing", "control"):
             assert isinstance(a[k], str), k
-        assert a["time_scale"] == "TDB" and a["frame"] == "GCRS"
+        assert a["time_scale"] == "TT" and a["frame"] == "GCRS" and a["origin"] == "earth"
+        assert h5["t"].attrs["frame"] == "TT"   # the time field names the file's time scale
         # dd layout: a group with float64 hi/lo; resizable chunked datasets
         assert isinstance(h5["sat/r"], h5py.Group)
         assert h5["sat/r/hi"].dtype == np.float64 and h5["sat/r/lo"].shape == (4, 3, 3)
@@ -184,7 +185,7 @@ def test_root_attributes_native_types(tmp_path):
         assert h5["sat/a_gravity"].chunks is not None and h5["sat/a_gravity"].compression is None
         assert h5["sat/a_gravity"].attrs["units"] == "m/s^2"
     tr = read_trajectory(path)
-    assert tr.format_version == 1
+    assert tr.format_version == 2
     assert tr.scenario_toml == make_attrs()["scenario"]
     assert tr.attrs["pointing"] == "taylor2" and type(tr.attrs["format_version"]) is int
     assert tr.fields == tuple(TWO_BODY)
@@ -637,3 +638,19 @@ def test_xarray_two_body_only(tmp_path):
     ds = read_trajectory(path).to_xarray()
     assert set(ds.data_vars) == {"t_lo", "sat_r", "sat_r_lo", "sat_v", "sat_v_lo", "sat_a_gravity"}
     assert dict(ds.sizes) == {"time": 3, "sat": 1, "comp": 3}
+
+
+def test_reads_format_version_1_files():
+    """A file written by tqdyn 0.1 (tests/fixtures/trajectory-v1-tianqin.h5: the coupled
+    tianqin scenario, 10 minutes, made with the 0.1 release) reads with every field, and its
+    reference system says what its t meant (TT-elapsed seconds labelled TDB)."""
+    from tqdyn.astro.reference import GEOCENTRIC_V1
+
+    path = pathlib.Path(__file__).parent / "fixtures" / "trajectory-v1-tianqin.h5"
+    tr = read_trajectory(path)
+    assert tr.format_version == 1 and tr.attrs["tqdyn_version"] == "0.1.0" and tr.attrs["time_scale"] == "TDB"
+    assert tr.reference is GEOCENTRIC_V1 and "labelled TDB" in tr.reference.description
+    assert tr.n_rows == 13 and tr.n_sat == 3 and "tm/alpha_suspension" in tr.fields
+    assert np.array_equal(tr["t"], np.arange(13) * 50.0)
+    ds = tr.to_xarray()
+    assert ds.time.attrs["frame"] == "TDB" and ds.sat_r.shape == (13, 3, 3)

@@ -4,7 +4,7 @@ frame and time scale as values, not implicit)."""
 
 import pytest
 
-from tqdyn.astro.reference import CENTRAL_BODIES, GEOCENTRIC, reference_system
+from tqdyn.astro.reference import CENTRAL_BODIES, GEOCENTRIC, GEOCENTRIC_V1, reference_system
 from tqdyn.dynamics import propagate
 from tqdyn.forces.model import build_force_model
 from tqdyn.formats.trajectory import Trajectory
@@ -43,8 +43,9 @@ def test_trajectory_records_it(tmp_path):
     out = tmp_path / "k.h5"
     run_to_file(load_scenario("tianqin-kepler", ["run.duration=100s", f"run.output={out}"]))
     tr = read_trajectory(out)
-    assert (tr.attrs["origin"], tr.attrs["frame"], tr.attrs["time_scale"]) == ("earth", "GCRS", "TDB")
+    assert (tr.attrs["origin"], tr.attrs["frame"], tr.attrs["time_scale"]) == ("earth", "GCRS", "TT")
     assert tr.reference is GEOCENTRIC
-    # a file of version 0.1 has no origin attribute: the geocentre
-    old = Trajectory(out, {k: v for k, v in tr.attrs.items() if k != "origin"}, {}, 0)
-    assert old.reference is GEOCENTRIC
+    # a file of format version 1 (tqdyn 0.1) has no origin attribute and t labelled TDB
+    old = Trajectory(out, dict({k: v for k, v in tr.attrs.items() if k != "origin"}, format_version=1,
+                               time_scale="TDB"), {}, 0)
+    assert old.reference is GEOCENTRIC_V1 and old.reference.time_scale == "TDB"

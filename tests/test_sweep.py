@@ -33,18 +33,18 @@ import xarray as xr
 from click.testing import CliRunner
 
 from tqdyn.workflows import sweep as sw
-from tqdyn.workflows.sweep import spec as sw_spec
+from tqdyn.scenario.toml_text import toml_str, toml_value
 from tqdyn.cli.sweep import sweep as sweep_command
 from tqdyn.scenario import loads_scenario
 
 # the paper's full force model switched off but for the Earth monopole (cheap, 1 h)
 _CHEAP = ["run.duration=1h", "forces.earth_degree=0", "forces.earth_field_indirect=false", "forces.third_bodies=[]",
-          "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false",
+          "forces.solid_tides=false", "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.atmospheric_tides=false",
           "forces.moon_degree=0", "forces.sun_j2=false", "forces.relativity=false"]
 
 
 def _toml_list(items) -> str:
-    return "[" + ", ".join(sw_spec._toml_str(s) for s in items) + "]"
+    return "[" + ", ".join(toml_str(s) for s in items) + "]"
 
 
 SIX_DIRECTIONS = f"""
@@ -314,7 +314,7 @@ def test_dry_run_lists_the_product_grid_in_c_order(tmp_path):
                                    (Decimal("1E-9"), 0, Decimal("-2.5")), ((1, 2), (3, 4))])
 def test_override_text_is_toml_of_the_value(value):
     """The override text of a value parses back (tomllib) to the same value."""
-    parsed = tomllib.loads("v = " + sw_spec._toml_text(value), parse_float=Decimal)["v"]
+    parsed = tomllib.loads("v = " + toml_value(value), parse_float=Decimal)["v"]
 
     def norm(x):
         return tuple(norm(e) for e in x) if isinstance(x, (list, tuple)) else x

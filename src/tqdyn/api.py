@@ -31,6 +31,7 @@ from .formats.trajectory import Trajectory, read_trajectory
 from .lightpath import LightTravelTimes, light_travel_times_of
 from .scenario import Scenario, ScenarioError, builtin_scenarios
 from .scenario import load_scenario as _load_scenario
+from .scenario.toml_text import toml_value
 from .workflows.run import RunSummary, output_attrs, run_to_file
 
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
@@ -42,19 +43,8 @@ def _overrides(overrides) -> list[str]:
     if isinstance(overrides, str):
         return [overrides]
     if isinstance(overrides, Mapping):
-        return [f"{key}={_toml_text(value)}" for key, value in overrides.items()]
+        return [f"{key}={toml_value(value)}" for key, value in overrides.items()]
     return list(overrides)
-
-
-def _toml_text(value) -> str:
-    """A Python value as the text of a ``--set`` override (TOML)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
-    if isinstance(value, str):
-        return value
-    return repr(value) if isinstance(value, float) else str(value)
 
 
 def load_scenario(scenario: str | Scenario | None = None,
@@ -112,7 +102,7 @@ def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, ob
         if bar is not None:
             bar.close()
     static = {"tm/self_gravity": dynamics.self_gravity_oa(scen)} if scen.constellation.coupled else None
-    traj = Trajectory.from_rows(dynamics.Rows.concatenate(blocks), output_attrs(scen), static)
+    traj = Trajectory.from_rows(dynamics.Rows.concatenate(blocks), output_attrs(scen, model), static)
     traj.result = result
     return traj
 

@@ -99,7 +99,7 @@ def split_terms(model: ForceModel) -> list[tuple[str, str, str, object]]:
 
 def force_budget(model: ForceModel, epoch, t_hi, t_lo, r, v) -> list[TermBudget]:
     """Budget of every term of ``model`` at the states r, v (n_t, n_sat, 3)
-    [m, m/s, GCRS, float64] at times t_hi + t_lo (n_t,) [s TDB since
+    [m, m/s, GCRS, float64] at times t_hi + t_lo (n_t,) [s TT since
     ``epoch``]."""
     r = np.asarray(r, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)

@@ -4,7 +4,7 @@ dependency, `pip install tqdyn[plot]`).
 The force budget, and the figures of ``tqdyn report``
 (:mod:`tqdyn.workflows.report`): pointing-law errors, control, breathing
 angles, range ASDs, orbit deviations.  Every report figure is written as PNG
-and PDF (:data:`FIGURE_FORMATS`); time axes in days (TDB) since the epoch.
+and PDF (:data:`FIGURE_FORMATS`); time axes in days (TT) since the epoch.
 matplotlib is imported only inside the plotting functions (Agg backend).
 """
 
@@ -116,7 +116,7 @@ def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str) ->
                      fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
     axes[0, 0].legend(fontsize=6.5, ncol=4, loc="center right")
-    axes[-1, 0].set_xlabel("time since epoch [days, TDB]")
+    axes[-1, 0].set_xlabel("time since epoch [days, TT]")
     fig.suptitle(title, fontsize=10)
     return _save(fig, out_dir, stem)
 
@@ -148,7 +148,7 @@ def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) 
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=3, loc="best")
-    axes[-1].set_xlabel("time since epoch [days, TDB]")
+    axes[-1].set_xlabel("time since epoch [days, TT]")
     fig.suptitle(title, fontsize=10)
     return _save(fig, out_dir, stem)
 
@@ -168,7 +168,7 @@ def plot_breathing(series: Sequence[tuple[str, np.ndarray, np.ndarray, str]], ou
         for y in BREATHING_BAND_DEG:
             ax.axhline(y, color="red", lw=0.8, ls=":")
         ax.axhspan(*BREATHING_BAND_DEG, color="red", alpha=0.04, label="60 +- 0.1 deg")
-    ax.set_xlabel("time since epoch [days, TDB]")
+    ax.set_xlabel("time since epoch [days, TT]")
     ax.set_ylabel("breathing angle [deg]")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
@@ -215,7 +215,7 @@ def plot_deviations(series: Sequence[tuple[str, np.ndarray, np.ndarray, str, str
         ax.axhline(hline[0], color="red", lw=1.0, ls="-.", label=hline[1])
     if ymin is not None:
         ax.set_ylim(bottom=ymin)
-    ax.set_xlabel("time since epoch [days, TDB]")
+    ax.set_xlabel("time since epoch [days, TT]")
     ax.set_ylabel(ylabel)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
@@ -240,7 +240,7 @@ def plot_common_self_gravity(curves: Sequence[tuple[str, str, np.ndarray, np.nda
         axes[1].plot(_days(t)[::kk], dalpha_max[::kk], label=f"{label}{tag}", **style)
     axes[0].set_ylabel("max over satellites |r - r$_{gravity}$| [m]")
     axes[1].set_ylabel("max over satellites\n|alpha - alpha$_{gravity}$| [deg]")
-    axes[1].set_xlabel("time since epoch [days, TDB]")
+    axes[1].set_xlabel("time since epoch [days, TT]")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8, ncol=3, title="common self-gravity 1e-9 m/s$^2$ along (S frame)", title_fontsize=8)
@@ -267,7 +267,7 @@ def plot_extreme(te, ae, tg, ag, out_dir):
     axes[0].axhspan(*BREATHING_BAND_DEG, color="red", alpha=0.04, label="60 +- 0.1 deg")
     axes[0].set_ylabel("breathing angle [deg]")
     axes[1].set_ylabel("extreme - gravity orbit [deg]")
-    axes[1].set_xlabel("time since epoch [days, TDB]")
+    axes[1].set_xlabel("time since epoch [days, TT]")
     for ax in axes:
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize=7, ncol=4, loc="upper left")

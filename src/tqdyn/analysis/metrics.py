@@ -4,7 +4,7 @@ requirement and the control maxima.
 
 Conventions: SI units (m, s, m/s^2, rad), GCRS for inertial vectors, S /
 OA_l frames for control quantities as stored in the trajectory
-(:data:`tqdyn.formats.trajectory.FIELDS`), time in TDB seconds since the
+(:data:`tqdyn.formats.trajectory.FIELDS`), time in TT seconds since the
 scenario epoch.  Ranges are formed and differenced in double-double before
 any float64 rounding (:mod:`tqdyn.lightpath`, :mod:`tqdyn.analysis.spectra`);
 the ASDs use the default Kaiser-window Welch estimate of the second dd

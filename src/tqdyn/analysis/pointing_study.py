@@ -23,7 +23,7 @@ Also ``tau_error`` (M, 3, 2) [s]: |L/c - tau_iterative| (L the instantaneous
 arm length), the cost of the approximation tau ~ L/c the global and Taylor
 laws use (~2e-6 s for TianQin, not the paper's 1e-7 s).
 
-Units SI (rad, s); frame GCRS; time TDB seconds since the scenario epoch.
+Units SI (rad, s); frame GCRS; time TT seconds since the scenario epoch.
 The satellites' accelerations that enter ``taylor2`` and the Hermite
 interpolation are their *total* accelerations (gravity plus, when the run's
 drag-free control is on, the drag-free acceleration G_i).
@@ -81,7 +81,7 @@ class LawComparison:
 class PointingStudy:
     """All law comparisons on one time series.
 
-    t : (M,) float64 reception times [s, TDB since the epoch]; laws : law
+    t : (M,) float64 reception times [s, TT since the epoch]; laws : law
     name -> :class:`LawComparison`; tau_error : (M, 3, 2) [s], |L/c -
     tau_iterative|; ltt_residual : largest residual of the light-time equation of the iterative
     light-travel-time solution [s] (its convergence).
@@ -114,7 +114,7 @@ def compare_pointing_laws(t, R, V, A, *, laws=APPROXIMATE_LAWS, stride: int = 1,
 
     Parameters
     ----------
-    t : (N,) grid times [s, TDB since the epoch], dd as a (hi, lo) tuple or
+    t : (N,) grid times [s, TT since the epoch], dd as a (hi, lo) tuple or
         float64; uniformly or non-uniformly spaced, increasing, at least 4 rows.
     R, V : (N, 3, 3) satellite positions [m] and velocities [m/s], GCRS, dd
         (hi, lo) tuples (or float64).

@@ -69,7 +69,7 @@ of DC and are biased (for a differenced series corrected by
 ``|2 sin(pi f dt)|**-n`` the bias is upward): trust ``f > ~26 df`` with
 ``df = fs / nperseg`` (90 days at 50 s: df = 6e-7 Hz, so f > 2e-5 Hz).
 
-Units: time in TDB seconds since the scenario epoch (any uniform sampling),
+Units: time in TT seconds since the scenario epoch (any uniform sampling),
 frequency in Hz, ranges in m, ASDs in (unit of the series)/Hz^1/2.  Arrays are
 1-D with the time axis first (shape (N,)); the frequency arrays are (M,).
 No frame is involved (ranges are scalars).
@@ -178,7 +178,7 @@ class PolynomialTrend:
     """The trend removed by :func:`dd_detrend`.
 
     trend(t) = offset + sum_i coefficients[i] * u**i, u = (t - t0) / t_scale,
-    evaluated in double-double.  t0 [s, TDB since epoch] and t_scale [s, a
+    evaluated in double-double.  t0 [s since the epoch] and t_scale [s, a
     power of two, so that u is formed exactly] map the samples into
     [-1, 1]; offset [unit of the series] and coefficients (degree + 1,)
     [unit of the series] are float64 (least-squares fit; their own rounding
@@ -192,7 +192,7 @@ class PolynomialTrend:
     coefficients: np.ndarray
 
     def evaluate_dd(self, t_hi, t_lo=None) -> tuple[np.ndarray, np.ndarray]:
-        """trend(t) as a dd pair (hi, lo) of (N,) arrays; t TDB s (float64 or a dd pair)."""
+        """trend(t) as a dd pair (hi, lo) of (N,) arrays; t [s since the epoch] (float64 or a dd pair)."""
         th, tl = _pair(t_hi, t_lo, "t")
         uh, ul = self._u(th, tl)
         ph, pl = _dd_polyval(self.coefficients, uh, ul)
@@ -206,7 +206,7 @@ class PolynomialTrend:
 def dd_detrend(t, hi, lo=None, degree: int = 1, *, return_trend: bool = False):
     """Residual of a dd series about a least-squares polynomial in time, subtracted in dd.
 
-    t : (N,) TDB seconds since epoch, float64 or a (t_hi, t_lo) pair.
+    t : (N,) TT seconds since epoch, float64 or a (t_hi, t_lo) pair.
     hi, lo : (N,) float64, the series value hi + lo (e.g. a range [m]); ``hi``
     may also be a (hi, lo) pair with ``lo`` None; ``lo`` None means zero.
     degree : polynomial degree, 0 <= degree <= 20 and < N.
@@ -415,7 +415,7 @@ def range_asd(t, hi, lo=None, *, derivative: int = 0, method: str = "difference"
               window=DEFAULT_WINDOW, detrend="linear", average: str = "mean") -> tuple[np.ndarray, np.ndarray]:
     """ASD of a dd range series (k = 0), of its rate (k = 1) or acceleration (k = 2).
 
-    t : (N,) TDB seconds since epoch, float64 or a (t_hi, t_lo) pair,
+    t : (N,) TT seconds since epoch, float64 or a (t_hi, t_lo) pair,
     uniformly spaced (dt = step).  hi, lo : (N,) float64 range [m], value
     hi + lo (``hi`` may be a (hi, lo) pair).  derivative : k >= 0.
 

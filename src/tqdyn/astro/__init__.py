@@ -2,7 +2,8 @@
 
 :mod:`.constants` (values with unit and source), :mod:`.timescales` (UTC ->
 TAI -> TT -> TDB), :mod:`.reference` (origin, frame and time scale of a
-propagation), :mod:`.earth_orientation` and :mod:`.eop` (GCRS <-> ITRS, IERS
-EOP), :mod:`.ephemeris` (JPL DE files), :mod:`.elements` (Keplerian elements
-<-> states in mpmath), :mod:`.lunar_orientation`, :mod:`.tidal_arguments`.
+propagation), :mod:`.earth_orientation`, :mod:`.eop` and :mod:`.eop_sources`
+(GCRS <-> ITRS, IERS EOP: measured, predicted, long-term model),
+:mod:`.ephemeris` (JPL DE files), :mod:`.elements` (Keplerian elements <->
+states in mpmath), :mod:`.lunar_orientation`, :mod:`.tidal_arguments`.
 """

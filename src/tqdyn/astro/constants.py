@@ -18,6 +18,8 @@ __all__ = [
     "AU_M",
     "ARCSEC_RAD",
     "MJD_JD0",
+    "L_G",
+    "L_B",
 ]
 
 # Geocentric gravitational constant [m^3/s^2], exact decimal string as published
@@ -51,3 +53,11 @@ ARCSEC_RAD = math.pi / 648000.0
 
 # Julian date of MJD 0 [d]: MJD = JD - 2400000.5 (IAU 1973).
 MJD_JD0 = 2400000.5
+
+# Rate of TCG relative to TT [1], defining constant: d(TT)/d(TCG) = 1 - L_G
+# (IAU 2000 Resolution B1.9); L_G c^2 is the potential of the geoid, W_0.
+L_G = 6.969290134e-10
+
+# Rate of TCB relative to TDB [1], defining constant: d(TDB)/d(TCB) = 1 - L_B
+# (IAU 2006 Resolution B3).
+L_B = 1.550519768e-8

@@ -25,23 +25,22 @@ Here the closed form above, the ERA (TN36 eq. 5.15) and the IAU 2006 GMST
 compares them with that ERFA composition, with ``erfa.c2t06a``,
 ``erfa.era00`` and ``erfa.gmst06`` evaluated independently at every instant.
 
-Time scales (input: t = t_hi + t_lo s of TDB after a scenario :class:`Epoch`):
-TT = TDB - (TDB-TT) with ``erfa.dtdb`` at the geocenter; TAI = TT - 32.184 s;
-UT1 = TAI + (UT1-TAI) with UT1-TAI interpolated from the C04 series
-(:mod:`tqdyn.eop`) at the instant's UTC (TAI - (TAI-UTC) from ERFA's
+Time scales (input: t = t_hi + t_lo s of TT after a scenario :class:`Epoch`,
+the geocentric time axis of tqdyn): TT = TT(epoch) + t; TAI = TT - 32.184 s;
+UT1 = TAI + (UT1-TAI) with UT1-TAI interpolated from the EOP table
+(:mod:`tqdyn.astro.eop`, sources :mod:`tqdyn.astro.eop_sources`) at the instant's UTC (TAI - (TAI-UTC) from ERFA's
 leap-second table, ERFA's quasi-JD on leap-second days) -- the same UT1 as
 ERFA's chain ``tttai`` -> ``taiutc`` -> ``utcut1`` with the interpolated
-UT1-UTC (checked in the tests).  All two-part Julian dates keep jd1 = the
-epoch's jd1 (0 h of the epoch date), so jd2 stays small (ulp 1.2 ns at 90 d).
+UT1-UTC (checked in the tests).  Two-part Julian dates keep jd1 on the half
+day (the epoch's jd1 plus whole days) and jd2 within half a day (ulp 2.4 ps).
 
-Speed: the slow series (``erfa.xys06a``: X, Y, s; ``erfa.dtdb``: TDB-TT; the
-sub-daily EOP terms) are evaluated on a uniform grid of step 1 h in t (nodes
+Speed: the slow series (``erfa.xys06a``: X, Y, s; the sub-daily EOP terms) are evaluated on a uniform grid of step 1 h in t (nodes
 t = k h, anchored at the epoch, covering the request plus 5 h margins) and
 interpolated to the instants with 8-point (degree-7) Lagrange interpolation;
 everything else (EOP interpolation, ERA, GMST, s', the matrix) is evaluated
 at every instant.  Interpolation error against direct ERFA evaluation at every
 instant (measured over 2004-2006): < 4e-16 rad in X, Y, s (ERFA's own
-evaluation noise) and < 1e-16 s in TDB-TT; the whole matrix agrees with the
+evaluation noise); the whole matrix agrees with the
 ERFA composition to < 1e-12 rad.  Cost: ~15-20 ms per 53,000 instants
 (2-core Xeon, numba kernels cached).  The last few results are memoised
 (keyed by the epoch, the options and the exact bytes of t_hi, t_lo), because
@@ -61,18 +60,18 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ..numerics.lagrange import MARGIN, POINTS, grid_interp
 from ..readers.iers_tables import load_tidal_eop_terms
-from .eop import EOP, load_eop, tidal_arguments, tidal_eop_corrections
-from .timescales import Epoch, tdb_jd
+from .eop import EOP, tidal_arguments, tidal_eop_corrections
+from .eop_sources import DEFAULT_EOP_SOURCE, eop_table
+from .timescales import Epoch, tt_jd
 
 __all__ = ["GRID_POINTS", "GRID_STEP_S", "EarthOrientation", "earth_orientation", "gcrs_to_itrs", "itrs_to_gcrs"]
 
-#: Grid step [s] of the tabulated slow quantities (X, Y, s, TDB-TT, sub-daily EOP terms).
+#: Grid step [s] of the tabulated slow quantities (X, Y, s, sub-daily EOP terms).
 GRID_STEP_S = 3600.0
 #: Number of points of the Lagrange interpolation on that grid (degree 7).
-GRID_POINTS = 8
-_HALF = GRID_POINTS // 2  # nodes k-3 .. k+4 around the interval [k, k+1)
-_MARGIN = _HALF + 1
+GRID_POINTS = POINTS
 
 _TT_TAI_S = 32.184
 _DAY = 86400.0
@@ -113,53 +112,17 @@ class EarthOrientation:
 
 
 # ----------------------------------------------------------------------
-# interpolation on the uniform grid
-
-
-def _lagrange_denominators() -> np.ndarray:
-    offs = np.arange(-_HALF + 1, _HALF + 1, dtype=np.float64)  # -3..4
-    return np.array([math.prod(float(offs[j] - offs[m]) for m in range(GRID_POINTS) if m != j)
-                     for j in range(GRID_POINTS)])
-
-
-_DENOM = _lagrange_denominators()
-
-
-@njit(cache=True)
-def _grid_interp(u, k0, vals, denom, out):
-    """out[i, c] = 8-point Lagrange interpolant of vals[:, c] (nodes k0, k0+1,
-    ... in units of the grid step) at u[i]: nodes floor(u)-3 .. floor(u)+4."""
-    npts = denom.size
-    half = npts // 2
-    m = vals.shape[1]
-    w = np.empty(npts)
-    for i in range(u.size):
-        kq = math.floor(u[i])
-        x = u[i] - kq
-        for j in range(npts):
-            p = 1.0
-            for q in range(npts):
-                if q != j:
-                    p *= x - (q - half + 1)
-            w[j] = p / denom[j]
-        b = int(kq) - (half - 1) - k0
-        for c in range(m):
-            acc = 0.0
-            for j in range(npts):
-                acc += w[j] * vals[b + j, c]
-            out[i, c] = acc
+# the slow quantities on a uniform grid
 
 
 def _grid_nodes(epoch: Epoch, k: np.ndarray, eop: EOP | None, tides) -> np.ndarray:
-    """Slow quantities at grid nodes t = k h: columns X, Y, s [rad], TDB-TT [s]
-    and, with tides, dx_p, dy_p [rad], dUT1 [s] of the sub-daily EOP terms."""
+    """Slow quantities at grid nodes t = k h [s TT since the epoch]: columns
+    X, Y, s [rad] and, with tides, dx_p, dy_p [rad], dUT1 [s] of the sub-daily
+    EOP terms."""
     t = k.astype(np.float64) * GRID_STEP_S
-    d1, d2 = tdb_jd(epoch, t, 0.0)
-    # geocentric TDB-TT (the topocentric terms vanish for u = v = 0)
-    dtr = erfa.dtdb(d1, d2, 0.0, 0.0, 0.0, 0.0)
-    tt2 = d2 - dtr / _DAY
+    d1, tt2 = tt_jd(epoch, t, 0.0)
     x, y, s = erfa.xys06a(d1, tt2)
-    cols = [x, y, s, dtr]
+    cols = [x, y, s]
     if tides is not None and eop is not None:
         # UT1 at the nodes for GMST (nodes in the margins may lie just outside
         # the EOP span: clamped there, which moves gamma by < 1e-6 rad)
@@ -185,11 +148,11 @@ def _utc_minus_tai(jd1: np.ndarray, tt2: np.ndarray) -> np.ndarray:
 def _interp_grid(t_hi: np.ndarray, t_lo: np.ndarray, epoch, eop, tides) -> np.ndarray:
     """Slow quantities of :func:`_grid_nodes` interpolated to t = t_hi + t_lo (1-D)."""
     u = t_hi / GRID_STEP_S + t_lo / GRID_STEP_S
-    k0 = int(math.floor(u.min())) - _MARGIN
-    k1 = int(math.floor(u.max())) + _MARGIN + 1
+    k0 = int(math.floor(u.min())) - MARGIN
+    k1 = int(math.floor(u.max())) + MARGIN + 1
     vals = _grid_nodes(epoch, np.arange(k0, k1, dtype=np.int64), eop, tides)
     out = np.empty((u.size, vals.shape[1]))
-    _grid_interp(u, k0, vals, _DENOM, out)
+    grid_interp(u, k0, vals, out)
     return out
 
 
@@ -263,16 +226,15 @@ def _compute(epoch: Epoch, t_hi: np.ndarray, t_lo: np.ndarray, eop: EOP | None, 
         return EarthOrientation(np.zeros(shape + (3, 3)), z, z, (z, z), (z, z), z, z, z)
     if not (np.all(np.isfinite(th)) and np.all(np.isfinite(tl))):
         raise ValueError("earth_orientation: non-finite time in t_hi/t_lo")
-    jd1, tdb2 = tdb_jd(epoch, th, tl)
+    jd1, tt2 = tt_jd(epoch, th, tl)
     if eop is not None:
-        # span check first, before any grid work (TT ~ TDB to 2 ms here)
-        mjd_tai = (jd1 - _MJD0) + (tdb2 - _TT_TAI_S / _DAY)
+        # span check first, before any grid work
+        mjd_tai = (jd1 - _MJD0) + (tt2 - _TT_TAI_S / _DAY)
         eop._check_span(eop.mjd_utc_from_tai(np.array([mjd_tai.min(), mjd_tai.max()])))
     if eop is None:
         tides = None
     g = _interp_grid(th, tl, epoch, eop, tides)
-    X, Y, s, dtr = g[:, 0], g[:, 1], g[:, 2], g[:, 3]
-    tt2 = tdb2 - dtr / _DAY
+    X, Y, s = g[:, 0], g[:, 1], g[:, 2]
     if eop is not None:
         mjd_tai = (jd1 - _MJD0) + (tt2 - _TT_TAI_S / _DAY)
         mjd_utc = eop.mjd_utc_from_tai(mjd_tai)
@@ -287,9 +249,9 @@ def _compute(epoch: Epoch, t_hi: np.ndarray, t_lo: np.ndarray, eop: EOP | None, 
         utc_tai = _utc_minus_tai(jd1, tt2)
         ut1_tai = utc_tai.copy()  # UT1 = UTC
     if tides is not None:
-        xp += g[:, 4]
-        yp += g[:, 5]
-        ut1_tai += g[:, 6]
+        xp += g[:, 3]
+        yp += g[:, 4]
+        ut1_tai += g[:, 5]
     ut2 = tt2 + (ut1_tai - _TT_TAI_S) / _DAY
     T = np.empty((n, 3, 3))
     era = np.empty(n)
@@ -313,15 +275,17 @@ _memo_lock = threading.Lock()
 
 def earth_orientation(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, use_eop: bool = True,
                       tidal_eop: bool = True) -> EarthOrientation:
-    """GCRS -> ITRS rotation and Earth rotation angles at t = t_hi + t_lo s of TDB after ``epoch``.
+    """GCRS -> ITRS rotation and Earth rotation angles at t = t_hi + t_lo s of TT after ``epoch``.
 
     Parameters
     ----------
     epoch : :class:`tqdyn.timescales.Epoch` -- the scenario epoch.
-    t_hi, t_lo : float or array_like [s] -- TDB seconds since the epoch as a
+    t_hi, t_lo : float or array_like [s] -- TT seconds since the epoch as a
         double-double (broadcast together; ``t_lo`` may be 0).
-    eop : :class:`tqdyn.astro.eop.EOP` or None -- EOP table (default: the shipped
-        IERS 14 C04 series, :func:`tqdyn.astro.eop.load_eop`).
+    eop : :class:`tqdyn.astro.eop.EOP` or None -- EOP table (default: the
+        table of the default source "auto", :func:`tqdyn.astro.eop_sources.eop_table`:
+        IERS EOP 20 C04, finals2000A measured and predicted values, then the
+        long-term model; the shipped 14 C04 series is ``eop_table("c04-14")``).
     use_eop : bool -- False: no EOP at all (x_p = y_p = dX = dY = 0, UT1 =
         UTC); for quick looks and for dates outside the EOP table.
     tidal_eop : bool -- add the IERS 2010 sub-daily ocean-tide terms
@@ -346,7 +310,7 @@ def earth_orientation(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, u
     th = np.array(th, dtype=np.float64, order="C")  # own contiguous copies (keeps 0-d shape)
     tl = np.array(tl, dtype=np.float64, order="C")
     if use_eop and eop is None:
-        eop = load_eop()
+        eop = eop_table(DEFAULT_EOP_SOURCE)
     if not use_eop:
         eop = None
     tidal_eop = bool(tidal_eop) and eop is not None
@@ -368,7 +332,7 @@ def earth_orientation(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, u
 def gcrs_to_itrs(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, use_eop: bool = True,
                  tidal_eop: bool = True) -> np.ndarray:
     """T_ITRS_GCRS (..., 3, 3): rotation of GCRS vectors into the ITRS at t = t_hi + t_lo
-    [s TDB since ``epoch``]; see :func:`earth_orientation` (same options, read-only array)."""
+    [s TT since ``epoch``]; see :func:`earth_orientation` (same options, read-only array)."""
     return earth_orientation(epoch, t_hi, t_lo, eop, use_eop=use_eop, tidal_eop=tidal_eop).T_ITRS_GCRS
 
 

@@ -13,7 +13,7 @@ Conventions
 * Frame: the frame of the elements; in tqdyn the GCRS (geocentric, ICRF
   axes), so i, raan are measured from the ICRF equator and x axis.
 * Time: ``t`` is elapsed time (s) since the epoch of the elements; the time
-  scale is whatever the caller uses (TDB in tqdyn).
+  scale is whatever the caller uses (TT for tqdyn's geocentric runs).
 * Two-body problem only, elliptic orbits ``0 <= e < 1``.
 """
 

@@ -1,8 +1,12 @@
-"""Earth orientation parameters (EOP): the IERS 14 C04 series and its interpolation.
+"""Earth orientation parameters (EOP): daily tables and their interpolation.
 
 What this module provides
 -------------------------
-* :func:`load_eop` -- the IERS EOP 14 C04 daily series
+* :class:`EOP` -- a daily EOP table ready to interpolate, built from one
+  series or from several combined (:mod:`tqdyn.astro.eop_sources`: IERS EOP
+  20 C04, finals2000A measured and predicted values, the long-term model);
+  :attr:`EOP.segments` says which source gave which rows.
+* :func:`load_eop` -- the shipped IERS EOP 14 C04 daily series
   (``data/eopc04_14_IAU2000.62-now.txt``, shipped; see ``data/SOURCES.md``;
   read by :func:`tqdyn.readers.eop_c04.read_eop_c04`) as an :class:`EOP` table: polar motion x_p, y_p and celestial pole
   offsets dX, dY in **rad**, UT1-UTC and LOD in **s**, one row per day at
@@ -48,6 +52,13 @@ For tqdyn's use (rotating the Earth's gravity field seen from 1e8 m) any of
 these is far below what matters: 1e-9 rad of orientation changes the
 acceleration of the Earth's non-central field at 1e8 m by < 1e-15 m/s^2.
 
+Leap seconds: TAI-UTC comes from ERFA's table, into which
+:mod:`tqdyn.astro.timescales` installs the current IERS table on import.
+Each table checks on construction that UT1-TAI is smooth (|change| < 0.1 s
+per day; the series' UT1-UTC jumps by +1 s at each leap second, less the
+day's LOD): a leap second missing from ERFA's table would show as a 1 s
+jump and is refused.
+
 Units: angles in rad (the file's arcsec times pi/648000), times in s, MJD in
 days of UTC (ERFA quasi-JD convention on leap-second days).
 """
@@ -68,13 +79,17 @@ from numba import njit
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
 from ..readers.eop_c04 import EopSeries, read_eop_c04
 from ..readers.iers_tables import TidalEOPTerms
-from .constants import ARCSEC_RAD, MJD_JD0
+from . import timescales as _timescales  # noqa: F401  (installs the current leap-second table in ERFA)
+from .constants import ARCSEC_RAD, J2000_JD, MJD_JD0
 
 __all__ = [
     "load_eop",
     "ARCSEC",
     "EOP",
     "EOPValues",
+    "EopSegment",
+    "EopSpanError",
+    "mean_pole_iers2010",
     "tidal_arguments",
     "tidal_eop_corrections",
 ]
@@ -101,6 +116,66 @@ class EOPValues(NamedTuple):
     lod: np.ndarray
     dx: np.ndarray
     dy: np.ndarray
+
+
+class EopSegment(NamedTuple):
+    """The rows of an :class:`EOP` table that came from one source.
+
+    label : short name ("c04-20", "finals-measured", "finals-predicted",
+        "long-term", "c04-14", or the table's source for a single series);
+    first, last : MJD [d, UTC] of its first and last daily node;
+    kind : "measured" | "predicted" | "model";
+    description : one line (the file, or the model and its parameters).
+    """
+
+    label: str
+    first: float
+    last: float
+    kind: str
+    description: str
+
+
+class EopSpanError(ValueError):
+    """A date outside an EOP table's span: attributes ``mjd`` (the first
+    offending MJD, UTC), ``span`` (first, last node MJD) and ``table``."""
+
+    def __init__(self, message: str, mjd: float, span: tuple[float, float], table: "EOP"):
+        super().__init__(message)
+        self.mjd = mjd
+        self.span = span
+        self.table = table
+
+
+# IERS 2010 conventional mean pole: TN36 Table 7.7 [mas yr^-k], k = 0..3
+_MP_CUBIC_X = (55.974, 1.8243, 0.18413, 0.007024)
+_MP_CUBIC_Y = (346.346, 1.7896, -0.10729, -0.000908)
+_MP_LINEAR_X = (23.513, 7.6141)
+_MP_LINEAR_Y = (358.891, -0.6287)
+_MP_SWITCH_YEARS = 10.0  # 2010.0 - 2000.0
+_JULIAN_YEAR_D = 365.25
+
+
+def mean_pole_iers2010(tt) -> tuple[np.ndarray, np.ndarray]:
+    """IERS 2010 conventional mean pole (TN36 eq. 7.25, Table 7.7).
+
+    tt: two-part TT Julian date (jd1, jd2) [d], arrays of shape S.
+    Returns (x_bar, y_bar) [rad], float64 S: cubic model before 2010.0,
+    linear from 2010.0 on (the branches join to 1 uas).  Used by the pole
+    tides (:mod:`tqdyn.forces.pole_tides`) and as the polar motion of the
+    long-term EOP model (:mod:`tqdyn.astro.eop_sources`).  Raises
+    ValueError for non-finite dates.
+    """
+    t = ((np.asarray(tt[0], dtype=np.float64) - float(J2000_JD)) + np.asarray(tt[1], dtype=np.float64)) \
+        / _JULIAN_YEAR_D
+    if not np.all(np.isfinite(t)):
+        raise ValueError("mean pole: non-finite date")
+    cubic = t < _MP_SWITCH_YEARS
+    xc = _MP_CUBIC_X[0] + t * (_MP_CUBIC_X[1] + t * (_MP_CUBIC_X[2] + t * _MP_CUBIC_X[3]))
+    yc = _MP_CUBIC_Y[0] + t * (_MP_CUBIC_Y[1] + t * (_MP_CUBIC_Y[2] + t * _MP_CUBIC_Y[3]))
+    xl = _MP_LINEAR_X[0] + _MP_LINEAR_X[1] * t
+    yl = _MP_LINEAR_Y[0] + _MP_LINEAR_Y[1] * t
+    mas = ARCSEC_RAD / 1000.0
+    return np.where(cubic, xc, xl) * mas, np.where(cubic, yc, yl) * mas
 
 
 @functools.lru_cache(maxsize=1)
@@ -139,6 +214,10 @@ class EOP(EopSeries):
     lod : excess length of day [s].
     dx, dy : celestial pole offsets dX, dY w.r.t. IAU 2006/2000A [rad].
     source : where the table came from (file path, the shipped file, or "arrays").
+    predicted : None, or a bool array: True where the row is a prediction.
+    segments : tuple of :class:`EopSegment` (which source gave which rows, in
+        order, covering every node); default: one "measured" segment named
+        after ``source`` (or, with ``predicted``, its measured and predicted runs).
 
     TAI-UTC at the nodes (from ``erfa.dat``) is computed on construction and
     kept privately (it is what removes the leap-second jumps of UT1-UTC).
@@ -146,6 +225,8 @@ class EOP(EopSeries):
     """
 
     source: str = "arrays"
+    predicted: np.ndarray | None = None
+    segments: tuple = ()
     _dat0: np.ndarray = field(init=False, repr=False)
     _dlod: np.ndarray = field(init=False, repr=False)
     _daylen: np.ndarray = field(init=False, repr=False)
@@ -154,7 +235,8 @@ class EOP(EopSeries):
     @classmethod
     def from_series(cls, series) -> "EOP":
         """The table of a daily series read from a file (:class:`tqdyn.readers.eop_c04.EopSeries`)."""
-        return cls(series.mjd, series.xp, series.yp, series.dut1, series.lod, series.dx, series.dy, series.source)
+        return cls(series.mjd, series.xp, series.yp, series.dut1, series.lod, series.dx, series.dy, series.source,
+                   getattr(series, "predicted", None))
 
     def __post_init__(self):
         cols = {}
@@ -190,11 +272,44 @@ class EOP(EopSeries):
             a = np.ascontiguousarray(a)
             a.setflags(write=False)
             object.__setattr__(self, name, a)
+        # leap seconds: UT1-TAI must be smooth (ERFA's table and the series agree)
+        ut1_tai = cols["dut1"] - dat0[:-1]
+        jump = np.abs(np.diff(ut1_tai))
+        if jump.size and jump.max() > 0.1:
+            i = int(np.argmax(jump))
+            raise ValueError(
+                f"EOP {self.source}: UT1-TAI changes by {ut1_tai[i + 1] - ut1_tai[i]:+.4f} s from MJD "
+                f"{mjd[i]:.0f} to {mjd[i + 1]:.0f} ({_mjd_iso(mjd[i + 1])}): the series' leap seconds "
+                f"disagree with ERFA's leap-second table (TAI-UTC {dat0[i]:.0f} -> {dat0[i + 1]:.0f} s)")
+        self._init_segments(mjd)
         # columns interpolated together: xp, yp, UT1-TAI, lod, dx, dy
         tab = np.stack([cols["xp"], cols["yp"], cols["dut1"] - dat0[:-1], cols["lod"], cols["dx"], cols["dy"]],
                        axis=1)
         tab.setflags(write=False)
         object.__setattr__(self, "_table", tab)
+
+    def _init_segments(self, mjd: np.ndarray) -> None:
+        pred = self.predicted
+        if pred is not None:
+            pred = np.array(pred, dtype=bool)
+            if pred.shape != mjd.shape:
+                raise ValueError(f"EOP.predicted: shape {pred.shape}, expected {mjd.shape}")
+            pred.setflags(write=False)
+            object.__setattr__(self, "predicted", pred)
+        segs = tuple(EopSegment(*s) for s in self.segments)
+        if not segs:
+            flags = np.zeros(mjd.size, dtype=bool) if pred is None else pred
+            cut = np.nonzero(np.diff(flags.astype(np.int8)))[0] + 1
+            starts = np.concatenate([[0], cut])
+            ends = np.concatenate([cut - 1, [mjd.size - 1]])
+            segs = tuple(EopSegment(self.source + (" (predicted)" if flags[a] else ""), float(mjd[a]),
+                                    float(mjd[b]), "predicted" if flags[a] else "measured", self.source)
+                         for a, b in zip(starts, ends))
+        ok = (segs[0].first == mjd[0] and segs[-1].last == mjd[-1]
+              and all(b.first == a.last + 1.0 for a, b in zip(segs, segs[1:])))
+        if not ok:
+            raise ValueError("EOP.segments: must cover the nodes in order, without gaps or overlaps")
+        object.__setattr__(self, "segments", segs)
 
     # ------------------------------------------------------------------
     @property
@@ -209,10 +324,11 @@ class EOP(EopSeries):
         ok = (mjd >= lo) & (mjd <= hi)
         if not np.all(ok):
             v = float(mjd[~ok].flat[0])
-            raise ValueError(
+            raise EopSpanError(
                 f"EOP: date MJD {v:.6f} (UTC, {_mjd_iso(v)}) is outside the EOP table span "
-                f"MJD {lo:.0f}..{hi:.0f} ({_mjd_iso(lo)} .. {_mjd_iso(hi)}) of {self.source}; "
-                f"beyond it run without EOP (scenario: forces.eop = false)")
+                f"MJD {lo:.0f}..{hi:.0f} ({_mjd_iso(lo)} .. {_mjd_iso(hi)}) of {self.source}; allowed: "
+                f"dates in that span (scenario: forces.eop = \"auto\" extends the measured series with "
+                f"predictions and a long-term model; false runs without EOP)", v, (lo, hi), self)
 
     def _day_index(self, mjd: np.ndarray) -> np.ndarray:
         return np.clip(np.floor(mjd - self.mjd[0]).astype(np.int64), 0, self.mjd.size - 1)

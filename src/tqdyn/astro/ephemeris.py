@@ -369,6 +369,15 @@ class Ephemeris:
             out.append(key)
         return tuple(out)
 
+    def _flat_dates(self, jd1, jd2) -> tuple[tuple[int, ...], np.ndarray, np.ndarray]:
+        """(shape S, jd1, jd2 flattened and contiguous) of two-part TDB
+        dates broadcast against each other, checked against the span."""
+        jd1, jd2 = np.broadcast_arrays(np.asarray(jd1, dtype=np.float64), np.asarray(jd2, dtype=np.float64))
+        j1 = np.ascontiguousarray(jd1.reshape(-1))
+        j2 = np.ascontiguousarray(jd2.reshape(-1))
+        self._check_span(j1, j2)
+        return jd1.shape, j1, j2
+
     def geocentric_states(self, bodies, jd1, jd2, *, velocity: bool = True):
         """Geocentric states of several bodies at once (the Earth chain is
         evaluated once for all of them).
@@ -393,11 +402,7 @@ class Ephemeris:
         Raises ValueError for an unknown body or a date outside ``span_jd``.
         """
         names = self.validate_bodies(bodies)
-        jd1, jd2 = np.broadcast_arrays(np.asarray(jd1, dtype=np.float64), np.asarray(jd2, dtype=np.float64))
-        shape = jd1.shape
-        j1 = np.ascontiguousarray(jd1.reshape(-1))
-        j2 = np.ascontiguousarray(jd2.reshape(-1))
-        self._check_span(j1, j2)
+        shape, j1, j2 = self._flat_dates(jd1, jd2)
         n = j1.shape[0]
         pos = np.empty((n, len(names), 3))
         vel = np.empty((n, len(names), 3)) if velocity else pos  # pos: unused placeholder
@@ -415,6 +420,18 @@ class Ephemeris:
         pos = pos.reshape(shape + (len(names), 3))
         vel = vel.reshape(shape + (len(names), 3)) if velocity else None
         return pos, vel
+
+    def earth_barycentric(self, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
+        """Barycentric position [m] and velocity [m/s] of the Earth (the chain
+        (0->3) + (3->399)), ICRF axes, BCRS (TDB-compatible), at the two-part
+        TDB Julian dates jd1, jd2 (broadcast to shape S): two arrays S + (3,)."""
+        shape, j1, j2 = self._flat_dates(jd1, jd2)
+        n = j1.shape[0]
+        base_p = np.empty((n, 2, 3))
+        base_v = np.empty((n, 2, 3))
+        self._pairs[_EARTH_CHAIN[1]].evaluate(j1, j2, True, base_p, base_v, 0, base_p, base_v, 0, 0.0)
+        self._pairs[_EARTH_CHAIN[0]].evaluate(j1, j2, True, base_p, base_v, 1, base_p, base_v, 0, 1.0)
+        return base_p[:, 1].reshape(shape + (3,)), base_v[:, 1].reshape(shape + (3,))
 
     def geocentric(self, body, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
         """Geocentric position [m] and velocity [m/s] of ``body``.

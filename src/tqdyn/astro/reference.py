@@ -10,16 +10,20 @@ scenario names the central body (``scenario.central_body``); the reference
 system follows from it, the force model carries it and the trajectory file
 records it (root attributes ``origin``, ``frame``, ``time_scale``).
 
-Version 0.2 has one: :data:`GEOCENTRIC`.  Its time axis is the one version
-0.1 used -- TT-elapsed seconds labelled TDB, the JPL ephemerides read at
-TDB(epoch) + t (docs/design.md, "Time axis").
+Version 0.2 has one: :data:`GEOCENTRIC`, whose coordinate time is TT (the
+geocentric equations of motion and EGM2008's GM are TT-compatible): t is
+seconds of TT since the epoch's TT, the JPL ephemerides are read at TDB(TT)
+(:func:`tqdyn.astro.timescales.tdb_jd`).  Trajectory files of format version
+1 (tqdyn 0.1) are geocentric with ``time_scale = "TDB"``: their t is
+TT-elapsed seconds labelled TDB, and the ephemerides of that version were
+read at TDB(epoch) + t (:data:`GEOCENTRIC_V1`, docs/design.md).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CENTRAL_BODIES", "GEOCENTRIC", "REFERENCE_SYSTEMS", "ReferenceSystem", "reference_system"]
+__all__ = ["CENTRAL_BODIES", "GEOCENTRIC", "GEOCENTRIC_V1", "REFERENCE_SYSTEMS", "ReferenceSystem", "reference_system"]
 
 
 @dataclass(frozen=True)
@@ -45,10 +49,16 @@ class ReferenceSystem:
         return self.central_body
 
 
-#: The geocentric system of TianQin: GCRS, Earth-centred, ICRF axes.
+#: The geocentric system of TianQin: GCRS, Earth-centred, ICRF axes, TT.
 GEOCENTRIC = ReferenceSystem(
+    central_body="earth", frame="GCRS", time_scale="TT",
+    description="geocentric GCRS (origin the geocentre, ICRF axes, TT-compatible); t in TT seconds since the "
+                "epoch, the JPL ephemerides at TDB(TT)")
+#: What a trajectory file of format version 1 (tqdyn 0.1) is relative to.
+GEOCENTRIC_V1 = ReferenceSystem(
     central_body="earth", frame="GCRS", time_scale="TDB",
-    description="geocentric GCRS (origin the geocentre, ICRF axes); t in seconds since the epoch, labelled TDB")
+    description="format version 1 (tqdyn 0.1): geocentric GCRS; t is TT-elapsed seconds since the epoch labelled "
+                "TDB, the ephemerides were read at TDB(epoch) + t (25 us/day off near 2004)")
 
 #: Every reference system tqdyn propagates in.
 REFERENCE_SYSTEMS = (GEOCENTRIC,)

@@ -13,19 +13,31 @@ Conventions
   equator all zero).  At the geocenter the topocentric terms of ``dtdb`` are
   multiplied by those distances and vanish, so the UT1 argument ``ut`` has no
   effect; UTC's fraction of the day is passed for it.
-* Durations are SI seconds of TDB after the scenario epoch; tqdyn's dynamics
-  is geocentric (GCRS position, ICRF axes) and uses TDB as its time argument.
+* The geocentric time axis: t is SI seconds of TT after the scenario epoch's
+  TT (TT is the coordinate time of the TT-compatible GCRS, in which the
+  geocentric equations of motion and EGM2008's GM hold); the JPL ephemerides
+  are read at TDB(TT) (:func:`tdb_jd`).  Version 0.1 read them at
+  TDB(epoch) + t instead (25 us/day off near 2004).
 
-Leap seconds: ERFA's table is used as shipped with pyerfa.  For dates after
-the last tabulated leap second (2017-01-01, TAI-UTC = 37 s) ERFA holds
-TAI-UTC at its last value and flags the year as "dubious"; tqdyn accepts that
-(no further leap second has been announced; the CGPM decided in 2022 to
-abolish them by 2035) and suppresses ERFA's "dubious year" warning.  Dates
-before 1960-01-01, where UTC is not defined, are rejected.
+Leap seconds: on import this module merges the IERS leap-second table
+``Leap_Second.dat`` of the installed ``astropy-iers-data`` package (released
+weekly, with the date until which it guarantees no further leap second)
+into ERFA's table (:func:`install_leap_seconds`, ``erfa.leap_seconds.update``:
+the union of both, so ERFA's pre-1972 UTC drifts stay), so that TAI-UTC
+here, in ERFA and in the EOP series (whose UT1-UTC jumps by +1 s at each
+leap second) agree, whichever is newer (tests/test_leap_seconds.py).  For
+dates after the last leap second (2017-01-01, TAI-UTC = 37 s) TAI-UTC is
+held at its last value: past the table's expiry date that is an assumption
+(:func:`leap_seconds_note`; the CGPM decided in 2022 to stop leap seconds by
+2035) and ERFA flags the year as "dubious"; tqdyn suppresses ERFA's "dubious
+year" warning.  Dates before 1960-01-01, where UTC is not defined, are
+rejected.
 """
 
 from __future__ import annotations
 
+import datetime as _dt
+import math
 import re
 import warnings
 from dataclasses import dataclass
@@ -34,10 +46,13 @@ from typing import NamedTuple
 import erfa
 import numpy as np
 
-from .constants import DAY_S
 from ..numerics.dd import np_two_prod, np_two_sum
+from ..numerics.lagrange import MARGIN, grid_interp
+from ..readers.leap_seconds import LeapSeconds, read_leap_seconds
+from .constants import DAY_S
 
-__all__ = ["Epoch", "UTCFields", "parse_utc", "tdb_jd"]
+__all__ = ["Epoch", "UTCFields", "install_leap_seconds", "installed_leap_seconds", "leap_seconds_note",
+           "parse_utc", "tdb_jd", "tdb_minus_tt", "tt_jd"]
 
 _ISO_FORMAT = "YYYY-MM-DDTHH:MM:SS[.fff] (UTC; 'T' or a space between date and time; optional trailing 'Z')"
 
@@ -48,6 +63,60 @@ _ISO_RE = re.compile(
 )
 
 _FIRST_UTC_YEAR = 1960  # UTC (and erfa.dat) start on 1960-01-01
+
+
+# --------------------------------------------------------------------------- leap seconds
+
+_LEAP: dict = {"table": None, "error": None}
+
+
+class _Expiring(np.ndarray):
+    """A structured leap-second array with the ``expires`` attribute erfa.leap_seconds reads."""
+
+
+def install_leap_seconds(table: LeapSeconds | None = None) -> LeapSeconds:
+    """Merge a leap-second table into ERFA's (``erfa.leap_seconds.update``).
+
+    ``table=None``: the ``Leap_Second.dat`` of the installed astropy-iers-data
+    package (:func:`tqdyn.readers.leap_seconds.read_leap_seconds`); done once
+    on import of this module.  ERFA keeps the union of its own table and
+    ``table`` (leap seconds only ever get added) and the later of the two
+    expiry dates.  Returns the table; raises ``ValueError`` if it
+    contradicts ERFA's (a TAI-UTC step other than 1 s).
+    """
+    if table is None:
+        table = read_leap_seconds()
+    arr = np.zeros(table.mjd.size, dtype=erfa.dt_eraLEAPSECOND)
+    arr["year"], arr["month"], arr["tai_utc"] = table.year, table.month, table.tai_utc
+    arr = arr.view(_Expiring)
+    if table.expires is not None:
+        arr.expires = _dt.datetime.combine(table.expires, _dt.time())
+    erfa.leap_seconds.update(arr)
+    _LEAP["table"], _LEAP["error"] = table, None
+    return table
+
+
+def installed_leap_seconds() -> LeapSeconds | None:
+    """The leap-second table installed into ERFA (None: ERFA's own table,
+    because the package file could not be read)."""
+    return _LEAP["table"]
+
+
+def leap_seconds_note() -> str:
+    """One line: where TAI-UTC comes from, its last step and until when it is known."""
+    table = _LEAP["table"]
+    last = erfa.leap_seconds.get()[-1]
+    step = f"last leap second {int(last['year']):04d}-{int(last['month']):02d}-01 (TAI-UTC = {last['tai_utc']:g} s)"
+    if table is None:
+        return f"leap seconds: ERFA's built-in table, {step} ({_LEAP['error'] or 'no IERS file installed'})"
+    exp = erfa.leap_seconds.expires
+    return f"leap seconds: {table.source}, {step}, valid until {exp:%Y-%m-%d} (TAI-UTC held after it)"
+
+
+try:
+    install_leap_seconds()
+except (FileNotFoundError, ValueError) as _exc:  # pragma: no cover - package missing or corrupt
+    _LEAP["error"] = str(_exc)
 
 
 class UTCFields(NamedTuple):
@@ -175,30 +244,9 @@ class Epoch:
         return cls(f.iso, as_pair(utc), as_pair(tai), as_pair(tt), as_pair(tdb))
 
 
-def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Two-part TDB Julian date of ``t = t_hi + t_lo`` seconds of TDB after ``epoch``.
-
-    Parameters
-    ----------
-    epoch : Epoch
-        Reference instant (its ``tdb`` pair is used).
-    t_hi, t_lo : float or array_like
-        Elapsed TDB time in s as a double-double (``t_lo`` may be 0); arrays
-        broadcast against each other.
-
-    Returns
-    -------
-    jd1, jd2 : np.ndarray (float64, broadcast shape of t_hi and t_lo)
-        ``jd1 = epoch.tdb[0]`` exactly; ``jd2 = epoch.tdb[1] + (t_hi + t_lo)/86400``
-        in days, formed with error-free transformations (no large float such
-        as the full JD is ever formed) so that the only error is the final
-        rounding of ``jd2``: at most half an ulp of ``jd2``.
-
-    Resolution: ulp(jd2) * 86400 s, i.e. 19 ps for |jd2| < 2 d, 1.2 ns near
-    90 d (|jd2| in [64, 128) d: ulp = 2**-46 d), 4.9 ns near one year and 20 ns
-    at 5 years.  This is for ephemeris/time-scale arguments only; tqdyn's
-    integrators carry t itself in double-double.
-    """
+def _after(pair, t_hi, t_lo) -> tuple[np.ndarray, np.ndarray]:
+    """Two-part JD of ``t = t_hi + t_lo`` seconds after the JD ``pair`` (same
+    time scale): jd1 = pair[0] + whole days (exact), |jd2| <= 0.5 + |pair[1]|."""
     t_hi = np.asarray(t_hi, dtype=np.float64)
     t_lo = np.asarray(t_lo, dtype=np.float64)
     t_hi, t_lo = np.broadcast_arrays(t_hi, t_lo)
@@ -207,7 +255,70 @@ def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
     p, pe = np_two_prod(q_hi, day)  # p + pe == q_hi * 86400 exactly
     rem = ((t_hi - p) - pe) + t_lo  # t_hi - p is exact (Sterbenz)
     q_lo = rem / day
-    s, se = np_two_sum(np.float64(epoch.tdb[1]), q_hi)
-    jd2 = s + (se + q_lo)
-    jd1 = np.full(jd2.shape, epoch.tdb[0], dtype=np.float64)
-    return jd1, np.asarray(jd2, dtype=np.float64)
+    s, se = np_two_sum(np.float64(pair[1]), q_hi)
+    n = np.floor(s + 0.5)  # whole days, moved into jd1
+    jd2 = (s - n) + (se + q_lo)  # s - n is exact (|s - n| <= 0.5)
+    jd1 = np.float64(pair[0]) + n  # exact: (half-)integers far below 2**52
+    return np.asarray(jd1, dtype=np.float64), np.asarray(jd2, dtype=np.float64)
+
+
+def tt_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Two-part TT Julian date of the instant ``t = t_hi + t_lo`` seconds of TT after ``epoch``.
+
+    The geocentric time axis of tqdyn: t is TT (the coordinate time of the
+    TT-compatible GCRS) counted from the epoch's TT.  Returns (jd1, jd2) [d],
+    float64 arrays of the broadcast shape of t_hi and t_lo: jd1 the epoch's
+    jd1 plus whole days (exact), jd2 within about half a day, formed with
+    error-free transformations, so the only error is the final rounding of
+    jd2: <= 2.8e-17 d = 2.4 ps whatever the span.
+    """
+    return _after(epoch.tt, t_hi, t_lo)
+
+
+#: Step [h] of the tabulated TDB - TT (its shortest periods, lunar terms of
+#: ~14 d, are interpolated by the 8-point Lagrange polynomial to < 1e-18 s).
+_DTDB_STEP_H = 1.0
+_J2000_TT = 2451545.0
+
+
+def tdb_minus_tt(jd1, jd2) -> np.ndarray:
+    """TDB - TT [s] at the geocentre at TT instants (jd1, jd2) (any shape).
+
+    ``erfa.dtdb`` (Fairhead & Bretagnon 1990, the series of SOFA/ERFA;
+    geocentric: the topocentric terms vanish) evaluated on an hourly grid of
+    TT and interpolated (:func:`tqdyn.numerics.lagrange.grid_interp`; error
+    < 1e-18 s against ``erfa.dtdb`` at every instant, which costs ~5 us per
+    instant).  ERFA's date argument is TDB; evaluating it at TT (< 2 ms off)
+    changes the result by < 1e-15 s.
+    """
+    jd1 = np.asarray(jd1, dtype=np.float64)
+    jd2 = np.asarray(jd2, dtype=np.float64)
+    jd1, jd2 = np.broadcast_arrays(jd1, jd2)
+    shape = jd1.shape
+    if jd1.size == 0:
+        return np.zeros(shape)
+    u = (((jd1 - _J2000_TT) + jd2) * (24.0 / _DTDB_STEP_H)).ravel()
+    k0 = int(math.floor(u.min())) - MARGIN
+    k1 = int(math.floor(u.max())) + MARGIN + 1
+    k = np.arange(k0, k1, dtype=np.int64)
+    hours = k * _DTDB_STEP_H
+    node1 = _J2000_TT + np.floor(hours / 24.0)
+    node2 = (hours - 24.0 * np.floor(hours / 24.0)) / 24.0
+    vals = np.asarray(erfa.dtdb(node1, node2, 0.0, 0.0, 0.0, 0.0), dtype=np.float64)[:, None]
+    out = np.empty((u.size, 1))
+    grid_interp(u, k0, vals, out)
+    return out[:, 0].reshape(shape)
+
+
+def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Two-part TDB Julian date of the instant ``t = t_hi + t_lo`` seconds of TT after ``epoch``.
+
+    The argument of the JPL ephemerides for the geocentric time axis: the
+    TT instant :func:`tt_jd` plus (TDB - TT) at the geocentre
+    (:func:`tdb_minus_tt`).  Returns (jd1, jd2) [d] of the broadcast shape
+    of t_hi and t_lo (jd1 as :func:`tt_jd`'s; resolution 2.4 ps).  Against
+    pyerfa's ``tttdb(tt1, tt2, dtdb(tt1, tt2, ...))`` at every instant:
+    < 1e-12 s (tests/test_timescales.py).
+    """
+    jd1, jd2 = tt_jd(epoch, t_hi, t_lo)
+    return jd1, jd2 + tdb_minus_tt(jd1, jd2) / float(DAY_S)

@@ -31,7 +31,7 @@ def export(run_file, out_file, fmt, shapiro):
     lisainstrument and pytdi): satellite states, light travel times between
     the test masses (satellite centres for runs without test masses),
     proper times and proper pseudoranges.  The frame stays tqdyn's GCRS and
-    the time TDB seconds since the epoch; the file's attributes say how each
+    the time TT seconds since the epoch; the file's attributes say how each
     quantity is defined.
     """
     if fmt is None:
@@ -48,7 +48,7 @@ def export(run_file, out_file, fmt, shapiro):
     except KeyboardInterrupt:
         _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     head = (f"LISA orbit file {summary.path}: {summary.size} samples from t0 = {summary.t0:g} s every "
-            f"{summary.dt:g} s (TDB since the epoch, GCRS)")
+            f"{summary.dt:g} s (TT since the epoch, GCRS)")
     click.echo("\n".join([
         head,
         f"light travel times: {summary.note}; {summary.ltt_range[0]:.9f} .. {summary.ltt_range[1]:.9f} s"

@@ -28,7 +28,6 @@ def forces(scenario, duration, every, plot_path, sets):
 
     from .. import dynamics
     from ..analysis.budget import force_budget
-    from ..forces import atmospheric_tides
     from ..scenario import ScenarioError, load_scenario
     from ..astro.timescales import Epoch
 
@@ -46,6 +45,10 @@ def forces(scenario, duration, every, plot_path, sets):
         _fail(str(exc))
     blocks = []
     click.echo(f"propagating {scen.name!r} for {scen.run.duration_s} s and sampling every {every} s ...", err=True)
+    from ..workflows.run import eop_warning
+
+    if note := eop_warning(scen, model):
+        click.echo(f"tqdyn: warning: {note}", err=True)
     dynamics.propagate(scen, sink=blocks.append, model=model)
     rows = dynamics.Rows.concatenate(blocks)
     t_hi, t_lo = rows.t
@@ -57,8 +60,6 @@ def forces(scenario, duration, every, plot_path, sets):
              f"  {'term':<22} {'max':>10} {'rms':>10}  source"]
     for b in sorted(budget, key=lambda b: -b.max):
         lines.append(f"  {b.name:<22} {b.max:>10.2e} {b.rms:>10.2e}  {b.source}")
-    lines.append(f"  {atmospheric_tides.NAME:<22} {'~' + format(atmospheric_tides.estimate_accel(1.0e8), '.0e'):>10} "
-                 f"{'':>10}  NOT modelled: {atmospheric_tides.SOURCE}")
     click.echo("\n".join(lines))
     if plot_path:
         from ..analysis.figures import plot_force_budget

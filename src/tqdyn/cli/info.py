@@ -15,12 +15,12 @@ __all__ = ["info"]
 
 @click.command("info")
 def info():
-    """Versions, built-in scenarios, integrator tableaux, force models and
-    their sources."""
+    """Versions, built-in scenarios, integrator tableaux, force models, their
+    sources, and the Earth-orientation sources with their spans."""
     import platform
     from importlib import resources
 
-    from ..forces import atmospheric_tides
+    from ..astro.eop_sources import describe_sources
     from ..forces.model import describe_terms
     from ..numerics import _dp87_tableau
     from ..scenario import builtin_scenarios
@@ -33,7 +33,8 @@ def info():
 
     lines = [f"tqdyn {__version__} (Python {platform.python_version()}, {platform.machine()})",
              "libraries: " + ", ".join(f"{m} {version(m)}" for m in
-                                       ("numpy", "numba", "mpmath", "erfa", "h5py", "xarray", "heyoka")),
+                                       ("numpy", "numba", "mpmath", "erfa", "h5py", "xarray", "heyoka",
+                                        "astropy_iers_data")),
              "built-in scenarios: " + ", ".join(builtin_scenarios()),
              "precision: dd (compiled double-double, ~32 digits, FMA two-product) | float64",
              "integrator: Prince-Dormand RK8(7)13M, fixed step or adaptive (embedded 7th order), "
@@ -43,13 +44,12 @@ def info():
              "force models:"]
     for name, description, source in describe_terms():
         lines.append(f"  {name:<20} {description} [{source}]")
-    lines.append(f"  {atmospheric_tides.NAME:<20} {atmospheric_tides.DESCRIPTION}: ~"
-                 f"{atmospheric_tides.estimate_accel(1.0e8):.0e} m/s^2 at 1e5 km [{atmospheric_tides.SOURCE}]")
     data = resources.files("tqdyn") / "data"
     lines.append(f"shipped data ({data}; provenance in SOURCES.md):")
     for entry in sorted(p.name for p in data.iterdir() if p.name != "SOURCES.md"):
         lines.append(f"  {entry}")
     lines.append("ephemeris: DE421 from the skyfield-data package (any JPL DE file by path: forces.ephemeris)")
+    lines += describe_sources()
     lines += [
         "constellation (coupled dynamics, [constellation] / [spacecraft] in a scenario):",
         "  pointing laws: global (instantaneous plane) | taylor1, taylor2 (light-time Taylor expansion) |"

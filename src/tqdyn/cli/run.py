@@ -72,6 +72,9 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
                + f", {scen.run.duration_s} s from {scen.epoch_utc} UTC"
                + (f"; pointing {c.pointing}, control {c.control}" + (", free TMs" if c.free_tms else "")
                   if c.coupled else ""), err=True)
+    note = runner.eop_warning(scen, model)
+    if note:
+        click.echo(f"tqdyn: warning: {note}", err=True)
     state = {"bar": None}
 
     def progress(n):

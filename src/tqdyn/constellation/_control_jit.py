@@ -9,7 +9,7 @@ the tests compare these kernels with.
 
 Frames: S (satellite), OA_l (MOSA/TM l: X_S rotated by +theta/2 for l = 1,
 -theta/2 for l = 2 about Z_S), GCRS.  Units SI.  Time scale: instantaneous
-(TDB in tqdyn).
+(TT in tqdyn).
 """
 
 from __future__ import annotations

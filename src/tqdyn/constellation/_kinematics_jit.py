@@ -9,7 +9,7 @@ operations is kept; results agree with the numpy reference to rounding).
 
 Conventions
 -----------
-SI units; GCRS components; TDB (the kernel itself has no time argument: all
+SI units; GCRS components; TT (the kernel itself has no time argument: all
 inputs are the satellites' states at one epoch t).  Satellite axis = 0-based
 ``Sat.index``; for satellite i, (i, j, k) is the even permutation,
 j = (i + 1) % 3, k = (i + 2) % 3 (see :mod:`tqdyn.constellation.indices`).
@@ -330,7 +330,7 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
         [rad/s], theta_ddot [rad/s^2]); theta = angle between the two beams
         (the breathing angle alpha_i for the global law).
 
-    All inputs refer to one epoch t (TDB).  Returns None.  Raises ValueError on
+    All inputs refer to one epoch t (TT).  Returns None.  Raises ValueError on
     an unknown law or wrong shapes, RuntimeError if the light time of the
     iterative law does not converge (non-finite input).
     """

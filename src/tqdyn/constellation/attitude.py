@@ -88,7 +88,7 @@ N): positions ``r`` (..., 3, 3) = (..., satellite 1..3, xyz) in m, GCRS; or a
 pair ``(hi, lo)`` of such float64 arrays (double-double; the satellite
 differences are then formed with the low parts, so arm vectors keep full
 float64 precision).  ``v`` (m/s), ``a`` (m/s^2), ``jerk`` (m/s^3), ``snap``
-(m/s^4) likewise, GCRS.  All at the same epochs (TDB seconds; the time scale
+(m/s^4) likewise, GCRS.  All at the same epochs (TT seconds; the time scale
 only matters through the caller's epochs).  Outputs are float64: frames are
 unit vectors, float64 is at the 1e-16 rad level.
 """
@@ -235,7 +235,7 @@ def beam_vectors(r, v=None, a=None, *, law="global", jerk=None, snap=None, c=C_L
     Parameters
     ----------
     r, v, a : (..., 3, 3) positions [m], velocities [m/s], accelerations
-        [m/s^2] of satellites 1..3, GCRS, at the same epochs (TDB).  Each may be
+        [m/s^2] of satellites 1..3, GCRS, at the same epochs (TT).  Each may be
         a (hi, lo) pair.  ``v`` / ``a`` may be None (fewer derivatives).
     law : "global" | "taylor1" | "taylor2" (see module docstring).
     jerk, snap : (..., 3, 3) m/s^3, m/s^4, GCRS -- needed for the second
@@ -437,7 +437,7 @@ def attitude(r, v=None, a=None, *, law="global", method="direct", jerk=None, sna
     ----------
     r : (..., 3, 3) m, GCRS -- satellite positions (satellite axis = Sat.index),
         float64 or a (hi, lo) pair of float64 arrays.  Leading axes ``...``
-        (e.g. N epochs, TDB) are broadcast through.
+        (e.g. N epochs, TT) are broadcast through.
     v : (..., 3, 3) m/s, GCRS, optional -- needed for omega (all laws) and for
         the frames themselves under the Taylor laws.
     a : (..., 3, 3) m/s^2, GCRS, optional -- needed for omega_dot (global law),

@@ -3,7 +3,7 @@
 All functions are vectorised numpy: leading axes ``(...)`` are free (in tqdyn
 ``(N, 3)`` = time, satellite), then ``2`` = TM / MOSA l, then ``3`` =
 component.  Units SI (m/s^2, rad/s, rad/s^2, rad); time scale irrelevant
-(instantaneous relations; tqdyn uses TDB).  Frames: S = nominal satellite
+(instantaneous relations; tqdyn uses TT).  Frames: S = nominal satellite
 frame, OA_l = MOSA/TM frame (X_S rotated by +theta/2 for l = 1, -theta/2 for
 l = 2 about Z_S, see :mod:`tqdyn.constellation.spacecraft`), GCRS inertial.
 
@@ -265,7 +265,7 @@ def nominal_control(T_S_I, omega_S, omega_dot_S, theta, omega_mosa, omega_dot_mo
 
     Any leading axes (...) instead of (N, 3) work the same way (the
     satellite axis must be present, length 3, for the per-satellite
-    self-gravity).  Time scale: instantaneous (TDB in tqdyn).
+    self-gravity).  Time scale: instantaneous (TT in tqdyn).
     """
     sc = Spacecraft() if spacecraft is None else spacecraft
     T = _f64(T_S_I, "T_S_I", (3, 3))

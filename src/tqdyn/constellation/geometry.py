@@ -9,7 +9,7 @@ order 12, 23, 31, 13, 32, 21 (axis of length 6, ``Link.index``); link ab
 (receiver a, emitter b) carries the arm vector r_ab = R_b - R_a pointing
 from the receiver to the emitter, i.e. the direction the receiving telescope
 faces in the instantaneous ("global") geometry.  All quantities are at one
-common coordinate time t (TDB) -- no light travel time here (see
+common coordinate time t (TT) -- no light travel time here (see
 :mod:`tqdyn.constellation.pointing`).
 
 Precision: positions may be given in double-double (trailing axis of length
@@ -107,7 +107,7 @@ class Arms:
     """Arm vectors of the six links (LISA order) and their time derivatives.
 
     Shapes (... = leading time axes): vectors (..., 6, 3), scalars (..., 6);
-    GCRS components, SI units, all at the same coordinate time (TDB).
+    GCRS components, SI units, all at the same coordinate time (TT).
     Derivative fields are None when the corresponding input was not given.
 
     r [m]: R_emitter - R_receiver;  length [m]: L = |r|;  n: r / L (unit);
@@ -144,7 +144,7 @@ def arms(R, V=None, A=None) -> Arms:
     (hi, lo) tuple; V: velocities [m/s] (same forms, optional); A:
     accelerations [m/s^2] (float64 (..., 3, 3) or dd, optional, needs V).
     Axis -2 is the satellite (1, 2, 3), the last the component; all at one
-    coordinate time (TDB).  Returns :class:`Arms` with per-link arrays
+    coordinate time (TT).  Returns :class:`Arms` with per-link arrays
     (..., 6, 3) / (..., 6) in LISA link order.
     """
     r = _differences(*_split_positions(R))
@@ -282,7 +282,7 @@ class Geometry:
 def constellation_geometry(R, V=None, A=None) -> Geometry:
     """Arms, breathing angles and incenter (with derivatives as far as V, A
     allow) of the states R [m], V [m/s], A [m/s^2], GCRS, shapes (..., 3, 3)
-    (R, V may be dd), all at one coordinate time (TDB)."""
+    (R, V may be dd), all at one coordinate time (TT)."""
     a = arms(R, V, A)
     alpha, ad, add = breathing_angles(a)
     return Geometry(a, alpha, ad, add, incenter(R, a, V, A))

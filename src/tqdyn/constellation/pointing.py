@@ -5,7 +5,7 @@ For satellite i (even permutation (i, j, k), see
 positions of the remote satellites j and k at their emission times.  This
 module returns, for every satellite and MOSA, the unit vector from the
 receiver's position r_i(t0) towards the emitter's position (GCRS, SI,
-coordinate time TDB; no aberration by the receiver's own velocity, as in the
+coordinate time TT; no aberration by the receiver's own velocity, as in the
 paper), under one of the laws
 
 * ``global``    -- instantaneous positions (paper eq. geometrypointing):
@@ -105,7 +105,7 @@ def beam_directions(law: str, R, V=None, A=None, *, light_times=None) -> Beams:
     travel times of the satellite centres on the same N times
     (:func:`tqdyn.lightpath.light_travel_times` of (t, R, V, A), a
     :class:`~tqdyn.lightpath.LightTravelTimes`; rows whose emission precedes
-    the grid are NaN).  Times are TDB.  Returns :class:`Beams` with n (N, 3, 2, 3).
+    the grid are NaN).  Times are TT.  Returns :class:`Beams` with n (N, 3, 2, 3).
     """
     if law not in LAWS:
         raise ValueError(f"pointing law {law!r} is not allowed; allowed: {', '.join(LAWS)}")

@@ -31,7 +31,7 @@ def _dd_of(x: Fraction) -> tuple[float, float]:
 
 
 def _node_tdat(model, epoch, times) -> np.ndarray:
-    """Time-only inputs at exact times (list of Fractions, s TDB since epoch): (len, n_tdat)."""
+    """Time-only inputs at exact times (list of Fractions, s TT since epoch): (len, n_tdat)."""
     if not model.time_dependent:
         return np.zeros((len(times), 0))
     pairs = np.array([_dd_of(t) for t in times])

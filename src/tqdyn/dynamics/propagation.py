@@ -52,7 +52,7 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
 
     precision: "dd" | "float64" (default: the scenario's run.precision).
     sink(rows): receives output rows every chunk -- a dict with "t" (hi, lo)
-    (m,) [s TDB since epoch], "sat/r" and "sat/v" (hi, lo) (m, n_sat, 3)
+    (m,) [s TT since epoch], "sat/r" and "sat/v" (hi, lo) (m, n_sat, 3)
     [m, m/s, GCRS], "sat/a_gravity" (m, n_sat, 3) float64 [m/s^2] -- on the
     output grid (every run.output_every-th step; the adaptive mode samples
     the fixed grid k * integrator.step_s by dense output).
@@ -98,5 +98,9 @@ def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:
     model = build_force_model(scenario.forces, scenario.reference) if model is None else model
     epoch = Epoch.from_utc(scenario.epoch_utc)
     t_end = float(scenario.run.duration_s)
+    if getattr(model, "eop", None) is not None:  # one line naming forces.eop if its table is too short
+        from ..astro.eop_sources import check_coverage, run_span_mjd
+
+        check_coverage(model.eop, model.eop_source, *run_span_mjd(epoch, t_end))
     model.precompute(epoch, np.array([0.0, t_end]), np.zeros(2))
     return model

@@ -1,7 +1,7 @@
 """The right-hand side of the propagated system.
 
 State layout: y (n_body, 6[, 2]) with rows (x, y, z, vx, vy, vz) [m, m/s],
-GCRS, geocentric, TDB; trailing axis 2 in dd mode (see :mod:`tqdyn.precision`).
+GCRS, geocentric, t in TT; trailing axis 2 in dd mode (see :mod:`tqdyn.numerics.dd`).
 
 Two systems share one compiled entry point, :func:`system_rhs`, selected by
 ``cpar[CP_MODE]``:
@@ -300,7 +300,7 @@ def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
 
     y, k: (n_body, 6[, 2]) state and derivative (m, m/s; m/s, m/s^2; GCRS);
     tdat: (n_tdat,) float64 time-only inputs of the force model at the
-    instant of y (TDB); params, layout: the force model's; cpar: (CP_LEN,)
+    instant of y (TT since the epoch); params, layout: the force model's; cpar: (CP_LEN,)
     constellation parameters (:func:`make_cpar`); aux: (AUX_LEN,) float64
     diagnostics written by the coupled modes; gw, fw: scratch
     (:func:`workspace`).

@@ -54,7 +54,7 @@ class System:
 class _SystemInputs:
     """A force model whose time-only inputs are followed by the coupled
     system's: geocentric GCRS position [m] and velocity [m/s] of the Moon and
-    the Sun (TDB), :data:`tqdyn.dynamics.layout.N_SYSTEM_TDAT` columns starting at
+    the Sun (at TDB(t)), :data:`tqdyn.dynamics.layout.N_SYSTEM_TDAT` columns starting at
     the force model's ``n_tdat`` (= ``cpar[CP_TD]``).  Everything else is the
     force model's."""
 

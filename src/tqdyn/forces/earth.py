@@ -121,7 +121,7 @@ class EarthField:
     tides : tuple of callables
         Coefficient-correction providers (epoch, t_hi, t_lo) -> (dC, dS),
         float64 arrays (*shape(t_hi), k+1, k+1), fully normalised, ITRS,
-        at t = t_hi + t_lo [s TDB since epoch].  Each must expose its degree
+        at t = t_hi + t_lo [s TT since epoch].  Each must expose its degree
         k as an attribute ``degree`` (or ``nmax``), unless ``tide_degree``
         is given.
     rotation : callable, optional
@@ -224,7 +224,7 @@ class EarthField:
         return 1.5 * (-np.sqrt(5.0) * float(m.C[2, 0])) * float(m.gm) * float(m.radius) ** 2
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """Time-only inputs at t = t_hi + t_lo [s TDB since epoch]: float64
+        """Time-only inputs at t = t_hi + t_lo [s TT since epoch]: float64
         (*shape, n_tdat) = [T_ITRS_GCRS row-major (9), dC, dS (each the
         packed lower triangle, dC_nm at n (n+1)/2 + m, (nt+1)(nt+2)/2
         values; the sum of all tide providers)], shape = broadcast shape of

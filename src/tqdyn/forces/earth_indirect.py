@@ -65,7 +65,7 @@ class EarthFieldIndirect:
         return np.zeros(0)
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """sum_b (GM_b / GM_E) g(s_b) at t = t_hi + t_lo [s TDB since
+        """sum_b (GM_b / GM_E) g(s_b) at t = t_hi + t_lo [s TT since
         epoch]: float64 (*shape(t_hi), 3) [m/s^2, GCRS]."""
         shape = np.broadcast_shapes(np.shape(t_hi), np.shape(t_lo))
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)

@@ -13,7 +13,7 @@ with the same interface:
 * ``n_tdat`` and ``precompute(epoch, t_hi, t_lo)`` -> float64 array
   (..., n_tdat) of its *time-only* inputs (ephemeris positions, rotation
   matrices, tidal corrections ...) at propagation times t = t_hi + t_lo
-  [s of TDB since the epoch].  The propagator calls it once per chunk of
+  [s of TT since the epoch].  The propagator calls it once per chunk of
   steps for all stage times (the DP87 nodes t_n + c_i h are known in
   advance), so no Python runs inside the compiled loop.
 
@@ -68,10 +68,15 @@ class ForceModel:
     layout: (n_slots, 3) int64; row s = (enabled, parameter offset, tdat
         column offset) of slot s.
     n_tdat: total number of time-only input columns.
+    eop: the :class:`~tqdyn.astro.eop.EOP` table the Earth's orientation
+        uses (None: no EOP); eop_source: its name ("auto", "c04-14", ...,
+        "off", or "custom" for a table passed to :func:`build_force_model`).
     """
 
-    def __init__(self, terms, reference: ReferenceSystem = GEOCENTRIC):
+    def __init__(self, terms, reference: ReferenceSystem = GEOCENTRIC, eop=None, eop_source: str = "off"):
         self.reference = reference
+        self.eop = eop
+        self.eop_source = eop_source
         terms = tuple(sorted(terms, key=lambda t: _TERM_SLOT[type(t)]))
         slots = [_TERM_SLOT[type(t)] for t in terms]
         if len(set(slots)) != len(slots):
@@ -94,7 +99,7 @@ class ForceModel:
         return self.n_tdat > 0
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """Time-only inputs of every enabled term at times t_hi + t_lo [s TDB
+        """Time-only inputs of every enabled term at times t_hi + t_lo [s TT
         since epoch]; returns float64 (*shape(t_hi), n_tdat)."""
         cols = [term.precompute(epoch, t_hi, t_lo) for term in self.terms]
         return np.concatenate(cols, axis=-1) if cols else np.zeros(np.shape(t_hi) + (0,))
@@ -107,11 +112,12 @@ class ForceModel:
 def describe_terms() -> list[tuple[str, str, str]]:
     """(name, description, source) of every force term tqdyn can evaluate,
     including the tide models summed into the Earth field."""
+    from .atmospheric_tides import AtmosphericTides
     from .ocean_tides import OceanTides
     from .pole_tides import OceanPoleTide, SolidPoleTide
     from .solid_tides import SolidTides
 
-    classes = list(_TERM_SLOT) + [SolidTides, OceanTides, SolidPoleTide, OceanPoleTide]
+    classes = list(_TERM_SLOT) + [SolidTides, OceanTides, SolidPoleTide, OceanPoleTide, AtmosphericTides]
     return [(cls.name, cls.description, cls.source) for cls in classes]
 
 
@@ -122,22 +128,26 @@ def _ephemeris(name_or_path: str):
     return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
 
 
-def _no_eop_rotation(epoch, t_hi, t_lo):
-    """T_ITRS_GCRS without EOP (no polar motion, UT1 = UTC, no pole offsets)."""
-    from ..astro.earth_orientation import earth_orientation
+class _Orientation:
+    """Earth orientation with one EOP table (None: no EOP), as a picklable
+    callable (epoch, t_hi, t_lo) -> EarthOrientation; ``.rotation`` gives
+    the T_ITRS_GCRS provider of the Earth field."""
 
-    return earth_orientation(epoch, t_hi, t_lo, use_eop=False).T_ITRS_GCRS
+    def __init__(self, eop):
+        self.eop = eop
 
-
-def _tide_models(forces, eph, rotation) -> tuple:
-    """The tide providers switched on in ``forces`` (coefficient corrections
-    summed into the Earth field)."""
-    orientation = None
-    if rotation is not None:
+    def __call__(self, epoch, t_hi, t_lo):
         from ..astro.earth_orientation import earth_orientation
 
-        def orientation(epoch, t_hi, t_lo):
-            return earth_orientation(epoch, t_hi, t_lo, use_eop=False)
+        return earth_orientation(epoch, t_hi, t_lo, self.eop, use_eop=self.eop is not None)
+
+    def rotation(self, epoch, t_hi, t_lo):
+        return self(epoch, t_hi, t_lo).T_ITRS_GCRS
+
+
+def _tide_models(forces, eph, orientation) -> tuple:
+    """The tide providers switched on in ``forces`` (coefficient corrections
+    summed into the Earth field)."""
     tides = []
     if forces.solid_tides:
         from .solid_tides import SolidTides
@@ -151,13 +161,24 @@ def _tide_models(forces, eph, rotation) -> tuple:
         from .pole_tides import OceanPoleTide, SolidPoleTide
 
         tides += [SolidPoleTide(orientation=orientation), OceanPoleTide(orientation=orientation)]
+    if forces.atmospheric_tides:
+        from .atmospheric_tides import AtmosphericTides
+
+        # all of the file (degree 8), referred to the static field's GM and radius (EGM2008)
+        tides.append(AtmosphericTides(orientation=orientation))
     return tuple(tides)
 
 
-def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC) -> ForceModel:
+_FROM_CONFIG = object()
+
+
+def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM_CONFIG) -> ForceModel:
     """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)
     in the reference system of the scenario's central body (the terms of
-    this module are the geocentric ones)."""
+    this module are the geocentric ones).  ``eop``: the EOP table of
+    ``forces.eop`` (:func:`tqdyn.astro.eop_sources.eop_table`) unless an
+    :class:`~tqdyn.astro.eop.EOP` table (or None: no EOP) is given, e.g. to
+    compare sources."""
     if reference.central_body != "earth":
         raise ValueError(f"scenario.central_body: {reference.central_body!r} has no force model; allowed: 'earth'")
     terms = []
@@ -166,9 +187,17 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC) -> ForceM
     needs_ephemeris = (forces.third_bodies or forces.relativity or forces.moon_degree or forces.sun_j2
                        or forces.solid_tides or forces.earth_field_indirect)
     eph = _ephemeris(forces.ephemeris) if needs_ephemeris else None
-    rotation = None if forces.eop else _no_eop_rotation
+    if eop is _FROM_CONFIG:
+        from ..astro.eop_sources import eop_table
+
+        source = forces.eop
+        eop = eop_table(source) if forces.earth_degree else None
+    else:
+        source = "custom" if eop is not None else "off"
+    orientation = _Orientation(eop)
+    rotation = orientation.rotation
     if forces.earth_degree:
-        terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, rotation),
+        terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, orientation),
                                 rotation=rotation, extended_degree2=forces.earth_degree2_extended))
     if forces.earth_field_indirect:
         from ..astro.ephemeris import planetary_gm
@@ -181,14 +210,15 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC) -> ForceM
     if forces.third_bodies:
         from .third_body_ephemeris import third_bodies
 
-        terms.append(third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended))
+        terms.append(third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended,
+                                  gcrs=forces.third_bodies_gcrs))
     if forces.moon_degree:
         terms.append(MoonField(degree=forces.moon_degree, libration=forces.moon_libration, ephemeris=eph))
     if forces.sun_j2:
         terms.append(SunJ2(ephemeris=eph))
     if forces.relativity:
         terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth)))
-    return ForceModel(terms, reference)
+    return ForceModel(terms, reference, eop=eop, eop_source=source if eop is not None else "off")
 
 
 @njit(cache=True)

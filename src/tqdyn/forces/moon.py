@@ -193,7 +193,7 @@ class MoonField:
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         """[Moon position (3) [m, GCRS], T_PA_GCRS row-major (9), the field's
         acceleration of the Earth (3) [m/s^2, GCRS]] at t = t_hi + t_lo [s
-        TDB since epoch]: float64 (*shape(t_hi), 15).  ValueError outside
+        TT since epoch]: float64 (*shape(t_hi), 15).  ValueError outside
         the ephemeris or (de421) the lunar kernel span."""
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
         eph = _default_ephemeris() if self.ephemeris is None else self.ephemeris

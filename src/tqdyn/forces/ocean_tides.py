@@ -82,7 +82,7 @@ def ocean_tide_coefficients(beta, model: OceanTideModel):
 class OceanTides:
     """FES2004 ocean tides (TN36 sec. 6.3) as a Stokes-coefficient provider.
 
-    ``provider(epoch, t_hi, t_lo)`` (t = t_hi + t_lo [s TDB since epoch],
+    ``provider(epoch, t_hi, t_lo)`` (t = t_hi + t_lo [s TT since epoch],
     shape S) returns (dC, dS), float64 S + (nmax+1, nmax+1) [n, m]:
     dimensionless corrections to the fully normalised Stokes coefficients
     (ITRS; FES2004 is normalised like EGM2008 and independent of the field's
@@ -123,7 +123,7 @@ class OceanTides:
         return ocean_tide_coefficients(beta, self.model)
 
     def __call__(self, epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
-        """(dC, dS), float64 S + (nmax+1, nmax+1), at t = t_hi + t_lo [s TDB
+        """(dC, dS), float64 S + (nmax+1, nmax+1), at t = t_hi + t_lo [s TT
         since epoch]."""
         from .solid_tides import _resolve_orientation
 

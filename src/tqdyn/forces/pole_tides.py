@@ -52,7 +52,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..astro.constants import ARCSEC_RAD, J2000_JD
+from ..astro.constants import ARCSEC_RAD
+from ..astro.eop import mean_pole_iers2010  # the IERS 2010 mean pole (also the long-term EOP model)
 
 __all__ = [
     "ARCSEC",
@@ -66,44 +67,11 @@ __all__ = [
 
 #: One arcsecond [rad].
 ARCSEC = ARCSEC_RAD  # rad per arcsec (astro.constants)
-_MAS = ARCSEC / 1000.0
-_JULIAN_YEAR_D = 365.25
-
-# TN36 Table 7.7 [mas yr^-k], k = 0..3
-_CUBIC_X = (55.974, 1.8243, 0.18413, 0.007024)
-_CUBIC_Y = (346.346, 1.7896, -0.10729, -0.000908)
-_LINEAR_X = (23.513, 7.6141)
-_LINEAR_Y = (358.891, -0.6287)
-_SWITCH_YEARS = 10.0  # 2010.0 - 2000.0
 
 # TN36 eq. 6.22 and 6.24 (m in arcsec)
 _SOLID_SCALE, _SOLID_RATIO = -1.333e-9, 0.0115
 _OCEAN_C_SCALE, _OCEAN_C_RATIO = -2.1778e-10, 0.01724
 _OCEAN_S_SCALE, _OCEAN_S_RATIO = -1.7232e-10, 0.03365
-
-
-def _years_since_2000(tt) -> np.ndarray:
-    jd1 = np.asarray(tt[0], dtype=np.float64)
-    jd2 = np.asarray(tt[1], dtype=np.float64)
-    return ((jd1 - float(J2000_JD)) + jd2) / _JULIAN_YEAR_D
-
-
-def mean_pole_iers2010(tt) -> tuple[np.ndarray, np.ndarray]:
-    """IERS 2010 conventional mean pole (TN36 eq. 7.25, Table 7.7).
-
-    tt: two-part TT Julian date (jd1, jd2) [d], arrays of shape S.
-    Returns (x_bar, y_bar) [rad], float64 S: cubic model before 2010.0,
-    linear from 2010.0 on.  Raises ValueError for non-finite dates.
-    """
-    t = _years_since_2000(tt)
-    if not np.all(np.isfinite(t)):
-        raise ValueError("mean pole: non-finite date")
-    cubic = t < _SWITCH_YEARS
-    xc = _CUBIC_X[0] + t * (_CUBIC_X[1] + t * (_CUBIC_X[2] + t * _CUBIC_X[3]))
-    yc = _CUBIC_Y[0] + t * (_CUBIC_Y[1] + t * (_CUBIC_Y[2] + t * _CUBIC_Y[3]))
-    xl = _LINEAR_X[0] + _LINEAR_X[1] * t
-    yl = _LINEAR_Y[0] + _LINEAR_Y[1] * t
-    return np.where(cubic, xc, xl) * _MAS, np.where(cubic, yc, yl) * _MAS
 
 
 def wobble(xp, yp, tt) -> tuple[np.ndarray, np.ndarray]:
@@ -156,7 +124,7 @@ class _PoleTide:
 
     def __call__(self, epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
         """(dC, dS), float64 S + (3, 3) [n, m] (only [2, 1] non-zero), at
-        t = t_hi + t_lo [s TDB since epoch]."""
+        t = t_hi + t_lo [s TT since epoch]."""
         from .solid_tides import _resolve_orientation
 
         t_hi, t_lo = np.broadcast_arrays(np.asarray(t_hi, np.float64), np.asarray(t_lo, np.float64))

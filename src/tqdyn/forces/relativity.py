@@ -19,9 +19,10 @@ Choices (each a field of :class:`Relativity`):
 * GM_E = 3.986004415e14 m^3/s^2 (EGM2008, TT-compatible, the value of the
   central term); GM_S from the ephemeris' GM file (DE430/431,
   TDB-compatible); c = 299792458 m/s.  Eq. (10.12) belongs to the GCRS,
-  whose time coordinate is TCG; tqdyn integrates in TDB with TT/TDB-
-  compatible GMs, which rescales the correction by relative amounts of
-  order L_G ~ 7e-10 or L_B ~ 1.6e-8, i.e. < 1e-18 m/s^2 here.
+  whose time coordinate is TCG; tqdyn integrates in TT (the TT-compatible
+  GCRS) with TT- and TDB-compatible GMs, which rescales the correction by
+  relative amounts of order L_G ~ 7e-10 or L_B ~ 1.6e-8, i.e. < 1e-18 m/s^2
+  here.
 * Direction of J (``j_axis``): ``"cip"`` (default) -- the Celestial
   Intermediate Pole, i.e. the Earth's rotation axis, in the GCRS
   (IAU 2006/2000A via ``erfa.xy06``, without the EOP celestial-pole offsets
@@ -60,7 +61,7 @@ from numba import njit
 
 from ..astro.constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J_EARTH_IERS2010
 from ..astro.ephemeris import Ephemeris, default_ephemeris, planetary_gm
-from ..astro.timescales import tdb_jd
+from ..astro.timescales import tdb_jd, tt_jd
 
 __all__ = [
     "Relativity",
@@ -160,7 +161,7 @@ def cip_direction(epoch, t_hi, t_lo=0.0) -> np.ndarray:
     """Unit vector of the Celestial Intermediate Pole in the GCRS,
     (X, Y, sqrt(1 - X^2 - Y^2)) with X, Y from ``erfa.xy06`` (IAU 2006
     precession + IAU 2000A nutation; no EOP dX, dY), at t = t_hi + t_lo
-    [s TDB since ``epoch``] (TT = TDB for this purpose: < 2 ms).
+    [s TT since ``epoch``].
 
     Evaluated at nodes <= 0.5 d apart spanning the times and interpolated
     linearly (< 1e-8 rad).  Returns float64 (*broadcast shape of t_hi, t_lo, 3).
@@ -176,7 +177,7 @@ def cip_direction(epoch, t_hi, t_lo=0.0) -> np.ndarray:
     t0, t1 = float(flat.min()), float(flat.max())
     n_nodes = max(2, int(math.ceil((t1 - t0) / _CIP_NODE_SPACING)) + 1)
     nodes = np.linspace(t0, t0 + max(t1 - t0, 1.0), n_nodes)
-    x, y = erfa.xy06(np.full(n_nodes, epoch.tt[0]), epoch.tt[1] + nodes / DAY_S)
+    x, y = erfa.xy06(*tt_jd(epoch, nodes))
     out[:, 0] = np.interp(flat, nodes, x)
     out[:, 1] = np.interp(flat, nodes, y)
     out[:, 2] = np.sqrt(1.0 - out[:, 0] ** 2 - out[:, 1] ** 2)
@@ -247,7 +248,7 @@ class Relativity:
                         dtype=np.float64)
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """Time-only inputs at t = t_hi + t_lo [s TDB since ``epoch``]:
+        """Time-only inputs at t = t_hi + t_lo [s TT since ``epoch``]:
         float64 (*broadcast shape of t_hi, t_lo, 9) = Sun's geocentric GCRS
         position [m] and velocity [m/s] (zeros if de Sitter is off), unit
         vector of J in the GCRS (zeros if Lense-Thirring is off)."""

@@ -263,7 +263,7 @@ class SolidTides:
     """Solid Earth tides (TN36 sec. 6.2, steps 1 and 2) as a Stokes-coefficient
     provider for the Earth field term.
 
-    Calling ``provider(epoch, t_hi, t_lo)`` (t = t_hi + t_lo [s TDB since
+    Calling ``provider(epoch, t_hi, t_lo)`` (t = t_hi + t_lo [s TT since
     ``epoch``], arrays of shape S) returns (dC, dS), float64 S + (5, 5),
     indexed [n, m], n <= 4: dimensionless corrections to the fully
     normalised Stokes coefficients of the static field (ITRS, reference
@@ -347,7 +347,7 @@ class SolidTides:
         return dc, ds
 
     def __call__(self, epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
-        """(dC, dS), float64 S + (5, 5) [n, m], at t = t_hi + t_lo [s TDB since
+        """(dC, dS), float64 S + (5, 5) [n, m], at t = t_hi + t_lo [s TT since
         epoch] (S = broadcast shape of t_hi, t_lo)."""
         from ..astro.timescales import tdb_jd
 

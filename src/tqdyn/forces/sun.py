@@ -200,7 +200,7 @@ class SunJ2:
         return np.concatenate([[gm, float(self.j2) * float(self.radius) ** 2], sun_pole()])
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """The Sun's geocentric GCRS position [m] at t = t_hi + t_lo [s TDB
+        """The Sun's geocentric GCRS position [m] at t = t_hi + t_lo [s TT
         since epoch]: float64 (*shape(t_hi), 3)."""
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
         eph = _default_ephemeris() if self.ephemeris is None else self.ephemeris

@@ -20,7 +20,7 @@ largest third-body term at 1e5 km (the Moon, ~1e-5 m/s^2) is exact to
 
 The bodies' positions are time-only inputs: a ``position`` callable
 (epoch, t_hi, t_lo) -> (..., 3) geocentric GCRS positions [m] at the times
-t = t_hi + t_lo [s TDB since the epoch] (an ephemeris), evaluated by the
+t = t_hi + t_lo [s TT since the epoch] (an ephemeris), evaluated by the
 propagator once per chunk for all stage times.
 """
 
@@ -163,7 +163,7 @@ class ThirdBodies:
                      for k, (n, g) in enumerate(zip(self.names, self.gms)))
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        """Body positions at t_hi + t_lo [s TDB since epoch], flattened to
+        """Body positions at t_hi + t_lo [s TT since epoch], flattened to
         (*shape(t_hi), 3 n) float64 [m]."""
         pos = np.asarray(self.position(epoch, t_hi, t_lo), dtype=np.float64)
         expected = np.shape(t_hi) + (len(self.names), 3)

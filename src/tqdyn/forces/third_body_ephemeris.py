@@ -2,20 +2,28 @@
 
 :func:`third_bodies` builds a :class:`tqdyn.forces.third_body.ThirdBodies`
 term (Battin's cancellation-free direct-minus-indirect acceleration) for a
-list of bodies of :data:`tqdyn.ephemeris.BODIES`: positions from
-:meth:`tqdyn.ephemeris.Ephemeris.geocentric_states` (geocentric, ICRF axes =
-GCRS, TDB), GMs from :func:`tqdyn.ephemeris.planetary_gm` (DE430/DE431
-values; the planets as whole systems at their barycenters).
+list of bodies of :data:`tqdyn.astro.ephemeris.BODIES`: positions from
+:meth:`tqdyn.astro.ephemeris.Ephemeris.geocentric_states` at the geocentre's
+TDB (:func:`tqdyn.astro.timescales.tdb_jd`), GMs from
+:func:`tqdyn.astro.ephemeris.planetary_gm` (DE430/DE431 values; the planets
+as whole systems at their barycenters).  By default (``gcrs``) both are
+transformed from the ephemeris's TDB-compatible BCRS to the TT-compatible
+GCRS of the dynamics (:func:`tqdyn.astro.geocentric.bcrs_to_gcrs`,
+1.5e-8 relative; the Sun and the Moon always enter the Earth's barycentric
+acceleration and potential there).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..astro.ephemeris import BODIES, Ephemeris, default_ephemeris, planetary_gm
+from ..astro.geocentric import TDB_TO_TT_SCALE, bcrs_to_gcrs
 from ..astro.timescales import tdb_jd
+from ..numerics.lagrange import MARGIN, grid_interp
 from .third_body import ThirdBodies
 
 __all__ = ["EphemerisPositions", "third_bodies"]
@@ -25,24 +33,60 @@ __all__ = ["EphemerisPositions", "third_bodies"]
 class EphemerisPositions:
     """Position provider of :class:`ThirdBodies`: a picklable callable
     (epoch, t_hi, t_lo) -> (*shape(t_hi), n_bodies, 3) float64 geocentric
-    GCRS positions [m] of ``names`` at t = t_hi + t_lo [s TDB since epoch]
-    (:func:`tqdyn.timescales.tdb_jd`, then the ephemeris)."""
+    positions [m] of ``names`` at t = t_hi + t_lo [s TT since epoch]: the
+    ephemeris at the geocentre's TDB (:func:`tqdyn.astro.timescales.tdb_jd`),
+    transformed to the TT-compatible GCRS when ``gcrs`` (else the BCRS
+    differences, TDB-compatible, as in tqdyn 0.1)."""
 
     ephemeris: Ephemeris
     names: tuple[str, ...]
+    gcrs: bool = True
 
     def __call__(self, epoch, t_hi, t_lo=0.0) -> np.ndarray:
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
         pos, _ = self.ephemeris.geocentric_states(self.names, jd1, jd2, velocity=False)
-        return pos
+        if not self.gcrs:
+            return pos
+        # X = K (r + delta): the 1PN part delta (<= 1.5e-8 r; periods >= 27 d)
+        # on an hourly TT grid, interpolated (error ~ (2 pi h / 27 d)^8 / 8! delta < 1e-19 m)
+        u = (np.asarray(t_hi, dtype=np.float64) + np.asarray(t_lo, dtype=np.float64)) / _GRID_S
+        u = np.broadcast_to(u, pos.shape[:-2]).ravel()
+        if u.size == 0:
+            return TDB_TO_TT_SCALE * pos
+        k0 = int(math.floor(u.min())) - MARGIN
+        k1 = int(math.floor(u.max())) + MARGIN + 1
+        delta = self.correction(epoch, np.arange(k0, k1, dtype=np.float64) * _GRID_S)
+        out = np.empty((u.size, delta.shape[1] * 3))
+        grid_interp(u, k0, delta.reshape(delta.shape[0], -1), out)
+        return TDB_TO_TT_SCALE * (pos + out.reshape(pos.shape))
+
+    def correction(self, epoch, t) -> np.ndarray:
+        """delta = X / K - r [m] (m, n_bodies, 3) at t (m,) [s TT since epoch]:
+        the 1PN terms of :func:`tqdyn.astro.geocentric.bcrs_to_gcrs` (the Sun
+        and the Moon always enter the Earth's potential and acceleration)."""
+        jd1, jd2 = tdb_jd(epoch, t)
+        bodies = self.names + tuple(b for b in ("sun", "moon") if b not in self.names)
+        pos, vel = self.ephemeris.geocentric_states(bodies, jd1, jd2, velocity=True)
+        _, v_earth = self.ephemeris.earth_barycentric(jd1, jd2)
+        gm = planetary_gm()
+        x = bcrs_to_gcrs(pos, vel, v_earth, np.array([gm[b] for b in bodies]))
+        n = len(self.names)
+        return x[:, :n] / TDB_TO_TT_SCALE - pos[:, :n]
 
 
-def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=()) -> ThirdBodies:
+#: Step [s] of the grid of the 1PN correction.
+_GRID_S = 3600.0
+
+
+def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=(), gcrs: bool = True) -> ThirdBodies:
     """Third-body term for ``names`` (default: all of
     :data:`tqdyn.ephemeris.BODIES`) with positions from ``ephemeris``
     (``None``: the shipped DE421, :func:`tqdyn.ephemeris.default_ephemeris`)
     and GMs [m^3/s^2] from ``data/gm_de431.tpc``; the bodies named in
     ``extended`` (and in ``names``) are evaluated in extended precision.
+    ``gcrs``: positions and GMs in the TT-compatible GCRS (the GMs times
+    :data:`tqdyn.astro.geocentric.TDB_TO_TT_SCALE`); False: as the ephemeris
+    gives them.
 
     Returns a ThirdBodies (parameters [n, gm_1..gm_n]; time-only inputs: the
     3 n geocentric GCRS coordinates [m] per instant).  Raises ValueError for
@@ -60,9 +104,10 @@ def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=()) 
     gm = planetary_gm()
     return ThirdBodies(
         names=names,
-        gms=tuple(gm[n] for n in names),
-        position=EphemerisPositions(eph, names),
+        gms=tuple(gm[n] * (TDB_TO_TT_SCALE if gcrs else 1.0) for n in names),
+        position=EphemerisPositions(eph, names, gcrs),
         source=(f"JPL {eph.name} ({eph.path}) via jplephem; GM: tqdyn/data/gm_de431.tpc "
-                f"(DE430/DE431; planets as systems at their barycenters)"),
+                f"(DE430/DE431; planets as systems at their barycenters)"
+                + ("; BCRS -> TT-compatible GCRS (1PN)" if gcrs else "; BCRS differences, TDB-compatible")),
         extended=tuple(n for n in names if n in extended),
     )

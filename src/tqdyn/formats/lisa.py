@@ -43,7 +43,7 @@ file's attributes too)
 --------------------------------------------------------------------------
 * Frame: the GCRS (geocentric, ICRF axes) of tqdyn -- NOT the BCRS of LISA
   orbit files.  The group name ``tcb`` is kept because readers look for it.
-* Coordinate time: tqdyn's t, TDB seconds since the trajectory's
+* Coordinate time: tqdyn's t, TT seconds since the trajectory's
   ``epoch_utc`` (``t0`` is therefore a few seconds, not a TCB date).
 * ltt: solved iteratively in double-double by :mod:`tqdyn.lightpath`
   between the test masses (TM of satellite i facing j <- TM of j facing i)
@@ -92,12 +92,11 @@ _UNIFORM_TOL_S = 1e-6  # max deviation of a grid time from t0 + k dt [s]
 
 # reserved root attributes (set by the writer) and their meaning
 _TPS_DEFINITION = (
-    "proper time of each satellite's centre of mass: d tau/dt = 1 - (GM_E/r + v^2/2)/c^2 along the tqdyn orbit "
-    "(GM_E = attribute gm_earth), t taken as the geocentric coordinate time (TCG); not applied: the TCG - TT/TDB "
-    "rate L_G = 6.969290134e-10, the periodic TDB - TT terms, the tidal potentials of Moon and Sun; "
-    "delta_tau = 0 at t_init")
+    "proper time of each satellite's centre of mass against the coordinate time TT: d tau/dTT = (1 - (GM_E/r + "
+    "v^2/2)/c^2) / (1 - L_G), L_G = 6.969290134e-10, along the tqdyn orbit (GM_E = attribute gm_earth); not "
+    "applied: the tidal potentials of Moon and Sun (~1e-17); delta_tau = 0 at t_init")
 _FRAME = "GCRS (geocentric, ICRF axes) of tqdyn -- not the BCRS of LISA orbit files; group 'tcb' kept for readers"
-_TIME = ("tqdyn coordinate time t: TDB seconds since epoch_utc (used in place of TCB); "
+_TIME = ("tqdyn coordinate time t: TT seconds since epoch_utc (used in place of TCB); "
          "tps/* are sampled at each receiver's proper time tau = t0 + k dt")
 
 _DATASETS = {

@@ -6,7 +6,7 @@ by satellite b) this module solves the light-travel-time equation
 
     c tau(t) = |r_e(t - tau) - r_r(t)|  [+ c * Shapiro delay, optional]
 
-on the trajectory's own time grid t (TDB seconds since the epoch, GCRS,
+on the trajectory's own time grid t (TT seconds since the epoch, GCRS,
 geocentric), where
 
 * r_r(t) is the *receiving* body at the grid time t -- the test mass (TM) of
@@ -295,7 +295,7 @@ class LightTravelTimes:
     """Light travel times of the six links on a trajectory's time grid.
 
     Link axis: LISA order 12, 23, 31, 13, 32, 21 (``Link.index``; link ab is
-    received on satellite a, emitted by satellite b).  Times are TDB seconds
+    received on satellite a, emitted by satellite b).  Times are TT seconds
     since the epoch; vectors GCRS [m, m/s]; dd quantities are ``(hi, lo)``
     tuples of float64 arrays.  Rows whose emission time precedes the first
     grid time are NaN.
@@ -303,7 +303,7 @@ class LightTravelTimes:
     Attributes
     ----------
     t : (hi, lo) of (N,)
-        Reception times (the grid) [s, TDB].
+        Reception times (the grid) [s, TT].
     tau : (hi, lo) of (N, 6)
         Light travel time [s] (coordinate time, GCRS), dd.
     range : (hi, lo) of (N, 6)
@@ -398,7 +398,7 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
     Parameters
     ----------
     t : dd (N,)
-        Grid times [s, TDB since the epoch], strictly increasing (any spacing):
+        Grid times [s, TT since the epoch], strictly increasing (any spacing):
         a (hi, lo) tuple, an (N, 2) array or plain float64 (N,).
     r, v : dd (N, 3, 2, 3) or (N, 3, 3)
         Positions [m] and velocities [m/s], GCRS, of the test masses [time,

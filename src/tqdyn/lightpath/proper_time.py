@@ -4,17 +4,24 @@
 orbit; :func:`lisa_orbit_quantities` combines it with the light travel times
 of :mod:`tqdyn.lightpath.light_time` into every dataset of a LISA orbit file
 (layout and writer: :mod:`tqdyn.formats.lisa`).  Definitions (geocentric,
-GCRS, t = tqdyn's TDB seconds since the epoch):
+GCRS, t = tqdyn's TT seconds since the epoch; the clocks' proper times
+against TT):
 
-* Proper time: each satellite's clock (centre of mass) with
-  d tau_i / dt = 1 - (GM_E / r_i + v_i^2 / 2) / c^2, GM_E the trajectory's
-  Earth GM, integrated along the orbit with the end-corrected trapezoidal
+* Proper time: each satellite's clock (centre of mass).  In the GCRS,
+  d tau / dTCG = 1 - (U + v^2/2) / c^2 with U = GM_E / r (the Earth's
+  monopole; GM_E the trajectory's TT-compatible value, for which U and v
+  have the same numbers in TCG and TT-compatible units), and TT = (1 - L_G)
+  TCG + const, so against tqdyn's coordinate time TT
+
+      d tau / dTT = (1 - (U + v^2/2) / c^2) / (1 - L_G),
+
+  L_G = 6.969290134e-10 (a clock on the geoid, where U + v^2/2 = L_G c^2,
+  keeps TT).  Integrated along the orbit with the end-corrected trapezoidal
   rule (derivative of the integrand from r, v, a; error ~1e-24 s per step)
-  from delta_tau = 0 at the trajectory's first sample (``t_init``).  t is
-  treated as the geocentric coordinate time TCG: the secular rate
-  L_G = 6.969290134e-10 between TCG and TT/TDB, the periodic TDB - TT terms
-  (~1.7 ms, annual) and the tidal potentials of Moon and Sun (~1e-17
-  relative) are NOT applied; they are (nearly) common to the three clocks.
+  from delta_tau = 0 at the trajectory's first sample (``t_init``).  Not
+  applied: the tidal potentials of the Moon and the Sun at the satellites
+  (~1e-17 relative, nearly common to the three clocks) and the Earth's
+  non-spherical field (J2: ~1e-3 of U, 7e-14 relative).
 * ppr = ltt + delta_tau_recv(t) - delta_tau_emit(t - ltt) (delta_tau_emit
   at the emission time from its Taylor series, error < 1e-21 s);
   d_ppr = (dtau_r - dtau_e + d_ltt (1 + dtau_e)) / (1 + dtau_r) with
@@ -36,7 +43,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008
+from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, L_G
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from .light_time import LightTravelTimes
 
@@ -68,9 +75,9 @@ def _dd_cumsum(x, out):
 def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Proper-time deviation delta_tau_i(t) = tau_i(t) - t of clocks on the orbits r_i(t).
 
-    d tau/dt = 1 - f with f = (GM/|r| + |v|^2/2) / c^2 (geocentric, the
-    Earth's monopole; t is taken as the geocentric coordinate time),
-    integrated with the end-corrected trapezoidal rule
+    t is the coordinate time TT of the GCRS: d tau/dt = 1 - f with
+    f = ((GM/|r| + |v|^2/2) / c^2 - L_G) / (1 - L_G) (the module docstring;
+    the Earth's monopole), integrated with the end-corrected trapezoidal rule
     int_k^{k+1} f = h (f_k + f_{k+1}) / 2 + h^2 (f'_k - f'_{k+1}) / 12,
     f' = (-GM r.v/|r|^3 + v.a) / c^2 (error h^5 f''''/720 per step, ~1e-24 s
     at 50 s on TianQin's orbit), summed with compensation; delta_tau = 0 at
@@ -90,8 +97,9 @@ def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarr
         h = np.diff(np.asarray(t, np.float64))
     r, v, a = (np.asarray(x, np.float64) for x in (r, v, a))
     rn = np.linalg.norm(r, axis=-1)
-    f = (gm / rn + 0.5 * np.einsum("...k,...k->...", v, v)) / C_LIGHT ** 2
-    fd = (-gm * np.einsum("...k,...k->...", r, v) / rn ** 3 + np.einsum("...k,...k->...", v, a)) / C_LIGHT ** 2
+    f = ((gm / rn + 0.5 * np.einsum("...k,...k->...", v, v)) / C_LIGHT ** 2 - L_G) / (1.0 - L_G)
+    fd = (-gm * np.einsum("...k,...k->...", r, v) / rn ** 3 + np.einsum("...k,...k->...", v, a)) / C_LIGHT ** 2 \
+        / (1.0 - L_G)
     hh = h[:, None]
     inc = hh * 0.5 * (f[:-1] + f[1:]) + hh * hh / 12.0 * (fd[:-1] - fd[1:])
     out = np.empty_like(f)
@@ -104,7 +112,7 @@ def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarr
 def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: float | None = None) -> dict[str, Any]:
     """All datasets of a LISA orbit file from a tqdyn trajectory's arrays.
 
-    t: dd (hi, lo) grid times (N,) [s, TDB]; sat_r, sat_v, sat_a: (N, 3, 3)
+    t: dd (hi, lo) grid times (N,) [s, TT]; sat_r, sat_v, sat_a: (N, 3, 3)
     satellite positions [m] (float64 or dd (hi, lo)), velocities [m/s],
     total accelerations [m/s^2], GCRS; lp: the light travel times on the
     same grid (:func:`tqdyn.lightpath.light_travel_times`); gm: Earth GM for

@@ -1,6 +1,6 @@
 """Instantaneous ranges of the six links (no light travel time), in double-double.
 
-Both ends at the same coordinate time t (TDB), for comparison with the
+Both ends at the same coordinate time t (TT), for comparison with the
 light-path ranges c tau of :func:`tqdyn.lightpath.light_time.light_travel_times`;
 bodies per link as in :func:`tqdyn.lightpath.light_time.link_bodies`.
 """
@@ -23,7 +23,7 @@ def instantaneous_ranges(r) -> tuple[np.ndarray, np.ndarray]:
     float64).  Bodies per link as in
     :func:`~tqdyn.lightpath.light_time.link_bodies` (TM facing TM, or centre
     to centre); links ab and ba give the same value.  No light travel time:
-    both ends at the same coordinate time t (TDB), for comparison with the
+    both ends at the same coordinate time t (TT), for comparison with the
     light-path ranges c tau.  Returns (hi, lo), each (N, 6) [m], LISA
     link order.
     """

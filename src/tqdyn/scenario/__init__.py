@@ -15,7 +15,7 @@ Conventions
 * Frame: satellite elements are osculating two-body elements in the GCRS
   (geocentric, ICRF axes), referred to the scenario epoch.
 * Time: ``scenario.epoch_utc`` is a UTC calendar date-time; run durations and
-  steps are TDB seconds after that epoch (see :mod:`tqdyn.astro.timescales`).
+  steps are TT seconds after that epoch (see :mod:`tqdyn.astro.timescales`).
 
 TOML layout (every section and key optional except at least one
 ``[[satellites]]`` entry with ``a_km``)::

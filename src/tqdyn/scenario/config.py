@@ -20,25 +20,14 @@ from typing import Any, Sequence
 
 from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008
+from ..astro.eop_sources import DEFAULT_EOP_SOURCE, EOP_SOURCES, EOP_SOURCES_ALLOWED, normalize_eop_source
 from ..astro.timescales import Epoch
+from .toml_text import toml_str, toml_value
 
 __all__ = [
-    "SatelliteConfig",
-    "IntegratorConfig",
-    "RunConfig",
-    "ForcesConfig",
-    "SpacecraftConfig",
-    "ConstellationConfig",
-    "POINTING_LAWS",
-    "Scenario",
-    "ScenarioError",
-    "CONTROL_MODES",
-    "LIBRATION_MODELS",
-    "MAX_EARTH_DEGREE",
-    "MAX_MOON_DEGREE",
-    "MAX_OCEAN_TIDE_DEGREE",
-    "SELF_GRAVITY_MODELS",
-    "THIRD_BODIES",
+    "SatelliteConfig", "IntegratorConfig", "RunConfig", "ForcesConfig", "SpacecraftConfig",
+    "ConstellationConfig", "POINTING_LAWS", "Scenario", "ScenarioError", "CONTROL_MODES", "LIBRATION_MODELS",
+    "MAX_EARTH_DEGREE", "MAX_MOON_DEGREE", "MAX_OCEAN_TIDE_DEGREE", "SELF_GRAVITY_MODELS", "THIRD_BODIES",
     "TM_AXES",
 ]
 
@@ -218,7 +207,7 @@ class IntegratorConfig:
 class RunConfig:
     """Run length and output.
 
-    ``duration_s`` [s of TDB] (> 0); ``precision``: ``"dd"`` (double-double)
+    ``duration_s`` [s] (> 0); ``precision``: ``"dd"`` (double-double)
     or ``"float64"``; ``output``: HDF5 file name (non-empty); ``output_every``:
     write every N-th step (integer >= 1).
     """
@@ -260,10 +249,13 @@ class ForcesConfig:
     ``third_bodies``: point-mass bodies, a subset of THIRD_BODIES;
     ``third_bodies_extended``: those of them evaluated in the propagation's
     extended precision (default Moon and Sun: their float64 round-off,
-    ~1e-21 m/s^2, would move the orbits by ~1e-12 m per day).
+    ~1e-21 m/s^2, would move the orbits by ~1e-12 m per day);
+    ``third_bodies_gcrs``: their positions and GMs transformed from the
+    ephemeris's TDB-compatible BCRS to the TT-compatible GCRS (1PN,
+    :mod:`tqdyn.astro.geocentric`; false: the BCRS differences, as tqdyn 0.1).
     ``solid_tides``: IERS 2010 solid Earth tides (steps 1 and 2).
     ``ocean_tides_degree``: FES2004 ocean tides to this degree (0 = off).
-    ``pole_tides``: solid Earth and ocean pole tides.
+    ``pole_tides``: solid Earth and ocean pole tides; ``atmospheric_tides``: S1, S2 (Biancale & Bode 2006).
     ``moon_degree``: GL0660B lunar field degree (0 = off, 2..20);
     ``moon_libration``: lunar orientation "de421" (PA kernel) | "iau".
     ``sun_j2``: the Sun's J2 with its IAU pole.
@@ -271,8 +263,10 @@ class ForcesConfig:
     ``earth_field_indirect``: the geocentre's acceleration by the Moon and
     Sun (those listed in third_bodies) acting on the Earth's non-central
     field (needs earth_degree >= 2).
-    ``eop``: polar motion, UT1-UTC and celestial-pole offsets from EOP 14 C04
-    (false: zero -- for tests and comparisons only).
+    ``eop``: the source of polar motion, UT1-UTC and celestial-pole offsets,
+    one of :data:`tqdyn.astro.eop_sources.EOP_SOURCES` (default "auto":
+    measured, predicted, then the long-term model; true = "auto", false =
+    "off": none, for tests and comparisons); stored as the name.
     """
 
     earth_monopole: bool = True
@@ -282,19 +276,24 @@ class ForcesConfig:
     ephemeris: str = "de421"
     third_bodies: tuple[str, ...] = ()
     third_bodies_extended: tuple[str, ...] = ("moon", "sun")
+    third_bodies_gcrs: bool = True
     solid_tides: bool = False
     ocean_tides_degree: int = 0
     pole_tides: bool = False
+    atmospheric_tides: bool = False
     moon_degree: int = 0
     moon_libration: str = "de421"
     sun_j2: bool = False
     relativity: bool = False
     earth_field_indirect: bool = False
-    eop: bool = True
+    eop: str = DEFAULT_EOP_SOURCE
 
     def __post_init__(self) -> None:
-        for key in ("earth_monopole", "earth_degree2_extended", "solid_tides", "pole_tides", "sun_j2", "relativity",
-                    "earth_field_indirect", "eop"):
+        ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
+        _require(ok, "forces.eop", self.eop, "is not an EOP source", EOP_SOURCES_ALLOWED)
+        _set(self, "eop", normalize_eop_source(self.eop))
+        for key in ("earth_monopole", "earth_degree2_extended", "third_bodies_gcrs", "solid_tides", "pole_tides",
+                    "atmospheric_tides", "sun_j2", "relativity", "earth_field_indirect"):
             _require(isinstance(getattr(self, key), bool), f"forces.{key}", getattr(self, key), "is not a boolean", "true or false")
         _set(self, "gm_earth", _to_decimal(self.gm_earth, "forces.gm_earth"))
         _require(self.gm_earth > 0, "forces.gm_earth", self.gm_earth, "is not positive", "gm_earth > 0 m^3/s^2")
@@ -529,71 +528,42 @@ class Scenario:
         read it back to an equal :class:`Scenario`.  Numbers are written in
         their exact decimal form (durations and steps in s)."""
         out: list[str] = ["# tqdyn scenario (resolved). Units: SI unless the key name says otherwise.", ""]
-        out += ["[scenario]", f"name = {_toml_str(self.name)}", f"description = {_toml_str(self.description)}",
-                f"epoch_utc = {_toml_str(self.epoch_utc)}  # UTC",
-                f"central_body = {_toml_str(self.central_body)}", ""]
+        out += ["[scenario]", f"name = {toml_str(self.name)}", f"description = {toml_str(self.description)}",
+                f"epoch_utc = {toml_str(self.epoch_utc)}  # UTC",
+                f"central_body = {toml_str(self.central_body)}", ""]
         r = self.run
-        out += ["[run]", f"duration = {_toml_dec(r.duration_s)}  # s (TDB)", f"precision = {_toml_str(r.precision)}",
-                f"output = {_toml_str(r.output)}", f"output_every = {r.output_every}", ""]
+        out += ["[run]", f"duration = {toml_value(r.duration_s)}  # s", f"precision = {toml_str(r.precision)}",
+                f"output = {toml_str(r.output)}", f"output_every = {r.output_every}", ""]
         g = self.integrator
-        out += ["[integrator]", f"method = {_toml_str(g.method)}", f"mode = {_toml_str(g.mode)}",
-                f"step = {_toml_dec(g.step_s)}  # s", f"tableau = {_toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]
+        out += ["[integrator]", f"method = {toml_str(g.method)}", f"mode = {toml_str(g.mode)}",
+                f"step = {toml_value(g.step_s)}  # s", f"tableau = {toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]
         f = self.forces
         b = lambda x: "true" if x else "false"  # noqa: E731
         out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}",
-                f"gm_earth = {_toml_dec(f.gm_earth)}  # m^3/s^2", f"earth_degree = {f.earth_degree}",
+                f"gm_earth = {toml_value(f.gm_earth)}  # m^3/s^2", f"earth_degree = {f.earth_degree}",
                 f"earth_degree2_extended = {b(f.earth_degree2_extended)}",
-                f"ephemeris = {_toml_str(f.ephemeris)}",
-                "third_bodies = [" + ", ".join(_toml_str(x) for x in f.third_bodies) + "]",
-                "third_bodies_extended = [" + ", ".join(_toml_str(x) for x in f.third_bodies_extended) + "]",
+                f"ephemeris = {toml_str(f.ephemeris)}",
+                "third_bodies = [" + ", ".join(toml_str(x) for x in f.third_bodies) + "]",
+                "third_bodies_extended = [" + ", ".join(toml_str(x) for x in f.third_bodies_extended) + "]",
+                f"third_bodies_gcrs = {b(f.third_bodies_gcrs)}",
                 f"solid_tides = {b(f.solid_tides)}", f"ocean_tides_degree = {f.ocean_tides_degree}",
-                f"pole_tides = {b(f.pole_tides)}", f"moon_degree = {f.moon_degree}",
-                f"moon_libration = {_toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
+                f"pole_tides = {b(f.pole_tides)}", f"atmospheric_tides = {b(f.atmospheric_tides)}",
+                f"moon_degree = {f.moon_degree}", f"moon_libration = {toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
-                f"eop = {b(f.eop)}", ""]
+                f"eop = {toml_str(f.eop)}", ""]
         s = self.spacecraft
-        out += ["[spacecraft]", f"d_tm = {_toml_dec(s.d_tm_m)}  # m", f"d_p = {_toml_dec(s.d_p_m)}  # m",
-                f"tm_axis = {_toml_str(s.tm_axis)}",
-                f"self_gravity = {_toml_value(s.self_gravity)}  # m/s^2 in OA_l",
-                f"self_gravity_common = {_toml_value(s.self_gravity_common)}  # m/s^2 in S", ""]
+        out += ["[spacecraft]", f"d_tm = {toml_value(s.d_tm_m)}  # m", f"d_p = {toml_value(s.d_p_m)}  # m",
+                f"tm_axis = {toml_str(s.tm_axis)}",
+                f"self_gravity = {toml_value(s.self_gravity)}  # m/s^2 in OA_l",
+                f"self_gravity_common = {toml_value(s.self_gravity_common)}  # m/s^2 in S", ""]
         c = self.constellation
-        out += ["[constellation]", f"pointing = {_toml_str(c.pointing)}", f"control = {_toml_str(c.control)}",
+        out += ["[constellation]", f"pointing = {toml_str(c.pointing)}", f"control = {toml_str(c.control)}",
                 f"free_tms = {b(c.free_tms)}", ""]
         for sat in self.satellites:
             with localcontext() as ctx:
                 ctx.prec = _EXACT
                 a_km = sat.a_m / 1000
-            out += ["[[satellites]]", f"name = {_toml_str(sat.name)}", f"a_km = {_toml_dec(a_km)}", f"e = {_toml_dec(sat.e)}",
-                    f"i_deg = {_toml_dec(sat.i_deg)}", f"raan_deg = {_toml_dec(sat.raan_deg)}",
-                    f"argp_deg = {_toml_dec(sat.argp_deg)}", f"nu_deg = {_toml_dec(sat.nu_deg)}", ""]
+            out += ["[[satellites]]", f"name = {toml_str(sat.name)}", f"a_km = {toml_value(a_km)}", f"e = {toml_value(sat.e)}",
+                    f"i_deg = {toml_value(sat.i_deg)}", f"raan_deg = {toml_value(sat.raan_deg)}",
+                    f"argp_deg = {toml_value(sat.argp_deg)}", f"nu_deg = {toml_value(sat.nu_deg)}", ""]
         return "\n".join(out)
-
-
-def _toml_value(x: Any) -> str:
-    """A string or a nested tuple of Decimals as TOML."""
-    if isinstance(x, str):
-        return _toml_str(x)
-    if isinstance(x, tuple):
-        return "[" + ", ".join(_toml_value(e) for e in x) + "]"
-    return _toml_dec(x)
-
-
-def _toml_dec(d: Decimal) -> str:
-    # str(Decimal) of a finite value is always a valid TOML integer or float
-    # ("100009.5", "1E+5", "3.986004415E+14", "0E-7").
-    return str(d)
-
-
-_TOML_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
-
-
-def _toml_str(s: str) -> str:
-    out = []
-    for ch in s:
-        if ch in _TOML_ESCAPES:
-            out.append(_TOML_ESCAPES[ch])
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append(f"\\u{ord(ch):04X}")
-        else:
-            out.append(ch)
-    return '"' + "".join(out) + '"'

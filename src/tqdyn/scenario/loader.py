@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from .config import (
+    EOP_SOURCES_ALLOWED,
     _EXACT,
     _NOVALUE,
     ConstellationConfig,
@@ -87,6 +88,7 @@ def parse_duration(value: Any) -> Decimal:
 
 _STR, _NUM, _INT, _BOOL, _DUR, _EPOCH = "string", "number", "integer", "boolean", "duration", "epoch"
 _STRLIST = "list of strings"
+_BOOL_OR_STR = "boolean or string"  # forces.eop: true / false or a source name
 _ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
@@ -94,9 +96,9 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
     "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
-               "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
-               "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
-               "earth_field_indirect": _BOOL, "eop": _BOOL},
+               "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "third_bodies_gcrs": _BOOL, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
+               "atmospheric_tides": _BOOL, "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
+               "earth_field_indirect": _BOOL, "eop": _BOOL_OR_STR},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY},
     "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
 }
@@ -128,6 +130,9 @@ def _typed(value: Any, kind: str, name: str) -> Any:
         ok = isinstance(value, list) and all(isinstance(x, str) for x in value)
         _require(ok, name, value, f"is {_a(_toml_type(value))}", "a list of strings")
         return tuple(value)
+    if kind == _BOOL_OR_STR:
+        _require(isinstance(value, (bool, str)), name, value, f"is {_a(_toml_type(value))}", EOP_SOURCES_ALLOWED)
+        return value
     if kind == _ANY:
         return value
     if kind == _DUR:

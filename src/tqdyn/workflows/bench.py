@@ -39,7 +39,8 @@ PURE_GRAVITY = ["constellation.pointing=none", "constellation.control=off"]
 #: The reduced model of the heyoka comparison: Earth 12x12 + Sun + Moon
 #: (point masses), no EOP (heyoka's Earth rotation has none).
 REDUCED = ["forces.earth_degree=12", "forces.third_bodies=sun,moon", "forces.solid_tides=false",
-           "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.moon_degree=0", "forces.sun_j2=false",
+           "forces.ocean_tides_degree=0", "forces.pole_tides=false", "forces.atmospheric_tides=false",
+           "forces.moon_degree=0", "forces.sun_j2=false",
            "forces.relativity=false", "forces.earth_field_indirect=false", "forces.eop=false",
            "constellation.pointing=none", "constellation.control=off"]
 

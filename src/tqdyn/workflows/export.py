@@ -32,7 +32,7 @@ __all__ = ["LisaExport", "export_lisa"]
 @dataclass(frozen=True)
 class LisaExport:
     """Summary of one export: ``path`` written; ``size`` samples from ``t0``
-    every ``dt`` [s, TDB since ``epoch_utc``]; ``dropped_rows`` leading rows
+    every ``dt`` [s, TT since ``epoch_utc``]; ``dropped_rows`` leading rows
     without an emission time inside the trajectory; ``source`` "tm" | "sat"
     and ``note`` (light-path endpoints); ``ltt_range`` (min, max) [s];
     ``shapiro`` whether the Earth Shapiro delay is included."""
@@ -112,7 +112,9 @@ def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None
         "generator": "tqdyn export --format lisa",
         "tqdyn_version": _TQDYN_VERSION,
         "frame": _FRAME,
-        "time_scale": _TIME,
+        "time_scale": _TIME + ("" if getattr(traj, "format_version", 2) >= 2 else
+                               "; the source trajectory is of format version 1: its t is TT-elapsed seconds labelled "
+                               "TDB"),
         "epoch_utc": str(attrs.get("epoch_utc", "")),
         "t_init": q["t_init"],
         "tt_method": "iterative (Newton, double-double, quintic Hermite dense output of the emitter)",

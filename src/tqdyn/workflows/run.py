@@ -29,7 +29,7 @@ from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
-           "checkpoint_path"]
+           "checkpoint_path", "eop_attrs", "eop_warning"]
 
 
 @dataclass(frozen=True)
@@ -59,8 +59,52 @@ def output_fields(scen) -> tuple[str, ...]:
     return tuple(fields + (["tm/self_gravity"] if c.coupled else []))
 
 
-def output_attrs(scen) -> dict:
-    """Root attributes of the trajectory file of ``scen``."""
+def _eop_of(scen, model):
+    """(table, source name) of the Earth orientation a run of ``scen`` uses
+    (None, "off" without EOP or without an Earth field)."""
+    if model is not None:
+        return getattr(model, "eop", None), getattr(model, "eop_source", "off")
+    if not scen.forces.earth_degree:
+        return None, "off"
+    from ..astro.eop_sources import eop_table
+
+    eop = eop_table(scen.forces.eop)
+    return eop, scen.forces.eop if eop is not None else "off"
+
+
+def _run_span(scen):
+    from ..astro.eop_sources import run_span_mjd
+    from ..astro.timescales import Epoch
+
+    return run_span_mjd(Epoch.from_utc(scen.epoch_utc), float(scen.run.duration_s))
+
+
+def eop_attrs(scen, model=None) -> dict:
+    """The Earth-orientation root attributes of a run of ``scen`` (with
+    ``model``'s table if given): ``eop`` (the source name), ``eop_sources``
+    (which source covered which days of the run, the long-term model with
+    its parameters) and ``eop_data`` (the files and the leap-second table)."""
+    from ..astro.eop_sources import data_note, describe_coverage
+
+    eop, source = _eop_of(scen, model)
+    if eop is None and not scen.forces.earth_degree:
+        return {"eop": "off", "eop_sources": "not used (forces.earth_degree = 0: no Earth field)",
+                "eop_data": data_note(None)}
+    return {"eop": source, "eop_sources": describe_coverage(eop, *_run_span(scen)), "eop_data": data_note(eop)}
+
+
+def eop_warning(scen, model=None) -> str | None:
+    """One line if a run of ``scen`` uses the long-term EOP model (beyond the
+    IERS measurements and predictions), else None: for the CLI to print."""
+    from ..astro.eop_sources import long_term_warning
+
+    eop, _ = _eop_of(scen, model)
+    return None if eop is None else long_term_warning(eop, *_run_span(scen))
+
+
+def output_attrs(scen, model=None) -> dict:
+    """Root attributes of the trajectory file of ``scen`` (the EOP attributes
+    from ``model``'s table if given, see :func:`eop_attrs`)."""
     integ = scen.integrator
     c = scen.constellation
     ref = scen.reference
@@ -76,6 +120,7 @@ def output_attrs(scen) -> dict:
         "pointing": c.pointing,
         "control": c.control,
         "free_tms": int(c.free_tms),
+        **eop_attrs(scen, model),
     }
 
 
@@ -94,7 +139,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
     scen : :class:`tqdyn.scenario.Scenario`.
     model : the force model (built from ``scen.forces`` if None).
     progress : called with the number of steps done since the last call
-        (fixed mode) or the TDB seconds advanced (adaptive mode).
+        (fixed mode) or the seconds advanced (adaptive mode).
     checkpoint_every : write a checkpoint ``<output>.checkpoint`` every that
         many steps (fixed mode; 0 = never).  An interrupted run keeps it and
         its partial trajectory; ``resume=True`` continues it to the same file
@@ -123,7 +168,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
     if writer_factory is not None:
         writer = writer_factory()
     else:
-        writer = io.TrajectoryWriter(out_path, output_attrs(scen), output_fields(scen),
+        writer = io.TrajectoryWriter(out_path, output_attrs(scen, model), output_fields(scen),
                                      n_sat=len(scen.satellites),
                                      expected_rows=scen.n_steps // scen.run.output_every + 1)
         if scen.constellation.coupled:

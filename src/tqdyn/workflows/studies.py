@@ -37,7 +37,7 @@ is (re)run.  Pending runs execute as tasks on a Dask ``LocalCluster``
 is not used because it gathers all members, on one time grid, into one
 netCDF file) or in this process when only one worker is asked for.
 
-Units: durations in TDB days / seconds since the epoch 2004-06-06 00:00:00
+Units: durations in days / seconds (TT) since the epoch 2004-06-06 00:00:00
 UTC; accelerations m/s^2 in the satellite frame S; everything else SI.
 """
 
@@ -88,7 +88,7 @@ _DIGEST_CHARS = 12
 @dataclass(frozen=True)
 class RunSpec:
     """One study run: ``scenario`` (built-in name) + ``overrides`` (as for
-    ``tqdyn run --set``), ``days`` nominal duration [TDB days],
+    ``tqdyn run --set``), ``days`` nominal duration [days],
     ``output_every`` (output row every N integrator steps), ``description``."""
 
     name: str

@@ -8,8 +8,11 @@ physics module imports it.  The format is documented field by field in
 Conventions (for every field, see :data:`FIELDS` for each one's unit/frame)
 --------------------------------------------------------------------------
 * Units: SI (m, m/s, m/s^2, rad, rad/s, rad/s^2, s).
-* Time scale: TDB.  Times ``t`` are seconds since the root attribute
-  ``epoch_utc`` (the epoch is *labelled* in UTC, ISO 8601; elapsed time is TDB).
+* Time scale: the root attribute ``time_scale`` (TT for the geocentric
+  system).  Times ``t`` are seconds since the root attribute ``epoch_utc``
+  (the epoch is *labelled* in UTC, ISO 8601).  Format version 1 files say
+  ``"TDB"``: their t is TT-elapsed seconds labelled TDB (the ephemerides of
+  tqdyn 0.1 were read at TDB(epoch) + t).
 * Frame: GCRS for inertial vectors; body frame S for the angular velocity;
   the optical-assembly frame OA_l for test-mass quantities.
 * Shapes: ``[time, satellite, tm, component]``; the satellite axis has length

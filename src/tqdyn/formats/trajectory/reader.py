@@ -11,7 +11,7 @@ import numpy as np
 
 from ... import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
-from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS, ReferenceSystem
+from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, ReferenceSystem
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, row_fields)
 
@@ -43,7 +43,7 @@ class Trajectory:
     Create with :func:`read_trajectory` (or in memory with :meth:`from_rows`).  Arrays are float64 and read-only,
     shaped ``(N, *trailing)`` for time-dependent fields (``N`` time rows) and
     ``trailing`` for static ones; units, frames and trailing shapes are those of
-    :data:`FIELDS` (SI; GCRS / S / OA_l; times in TDB seconds since
+    :data:`FIELDS` (SI; GCRS / S / OA_l; times in TT seconds since
     ``attrs["epoch_utc"]``).
 
     Attributes
@@ -89,10 +89,14 @@ class Trajectory:
     @property
     def reference(self) -> ReferenceSystem:
         """Origin, frame and time scale of the file's vectors and times
-        (root attributes ``origin``, ``frame``, ``time_scale``; files written
-        before version 0.2 have no ``origin``: the geocentre)."""
+        (root attributes ``origin``, ``frame``, ``time_scale``).  Files of
+        format version 1 (tqdyn 0.1) are geocentric with t TT-elapsed seconds
+        labelled TDB: :data:`tqdyn.astro.reference.GEOCENTRIC_V1`, whose
+        description says so."""
         key = (self.attrs.get("origin", GEOCENTRIC.origin), self.attrs.get("frame", GEOCENTRIC.frame),
                self.attrs.get("time_scale", GEOCENTRIC.time_scale))
+        if self.format_version == 1:
+            return GEOCENTRIC_V1
         for r in REFERENCE_SYSTEMS:
             if (r.origin, r.frame, r.time_scale) == key:
                 return r
@@ -152,7 +156,7 @@ class Trajectory:
     def to_xarray(self):
         """The trajectory as an ``xarray.Dataset``.
 
-        Dimensions ``time`` (coordinate: float64 TDB seconds since epoch,
+        Dimensions ``time`` (coordinate: float64 TT seconds since epoch,
         hi + lo), ``sat`` (1..n_sat), ``tm`` (1, 2), ``comp`` ("x", "y", "z"),
         ``row`` ("X_S", "Y_S", "Z_S") and ``col`` ("x", "y", "z") for
         ``sat_T_S_I``.  Variables are named by path with "/" -> "_" (e.g.
@@ -169,9 +173,9 @@ class Trajectory:
         if "t" in self._data:
             t, t_lo = np_two_sum(*self._data["t"])
             spec = FIELDS["t"]
-            coords["time"] = ("time", t, {"units": "s", "frame": spec.frame,
+            coords["time"] = ("time", t, {"units": "s", "frame": self.reference.time_scale,
                                           "description": spec.description + " (float64 hi + lo)"})
-            variables["t_lo"] = ("time", t_lo, {"units": "s", "frame": spec.frame,
+            variables["t_lo"] = ("time", t_lo, {"units": "s", "frame": self.reference.time_scale,
                                                 "description": "residual of time: exact t = time + t_lo"})
         if self._n_sat:
             coords["sat"] = ("sat", np.arange(1, self._n_sat + 1))
@@ -218,7 +222,7 @@ def read_trajectory(path) -> Trajectory:
     naming the file, the value found and what is supported.  Shapes are checked
     against :data:`FIELDS` (all time-dependent fields share N rows with ``t``;
     one n_sat throughout).  HDF5 objects that are not fields of the format are
-    ignored.  Returns a :class:`Trajectory` (float64 arrays, SI units, TDB).
+    ignored.  Returns a :class:`Trajectory` (float64 arrays, SI units, the file's time scale).
     """
     p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
     fname = str(p)

@@ -35,7 +35,7 @@ __all__ = [
 FORMAT = "tqdyn-trajectory"
 """Value of the root attribute ``format``."""
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 """Format version written by :class:`~tqdyn.formats.trajectory.TrajectoryWriter`; readers accept
 any version <= this."""
 
@@ -89,8 +89,8 @@ def _f(kind, shape, dims, unit, frame, description, time_dependent=True):
 
 
 FIELDS: dict[str, FieldSpec] = {
-    "t": _f("dd", (), (), "s", "TDB",
-            "time since epoch_utc, TDB seconds"),
+    "t": _f("dd", (), (), "s", "time_scale",
+            "time since epoch_utc in the root attribute time_scale (TT: seconds of TT since the epoch's TT)"),
     "sat/r": _f("dd", ("sat", 3), ("sat", "comp"), "m", "GCRS",
                 "satellite centre-of-mass position"),
     "sat/v": _f("dd", ("sat", 3), ("sat", "comp"), "m/s", "GCRS",
@@ -139,12 +139,16 @@ ROOT_ATTRS: dict[str, str] = {
     "origin": 'str, the central body at the origin of the coordinates: "earth" (absent in files '
               'written before version 0.2: "earth")',
     "frame": 'str, the axes and reference system of the vectors: "GCRS"',
-    "time_scale": 'str, the time scale of t: "TDB"',
+    "time_scale": 'str, the time scale of t: "TT" (format version 1: "TDB", i.e. TT-elapsed seconds labelled '
+                  'TDB)',
     "precision": 'str, "dd" | "float64"',
     "step_s": "float, integrator / output step in s",
     "integrator": "str, integrator name",
     "pointing": 'str, "global" | "taylor1" | "taylor2" | "iterative" | "none"',
     "control": 'str, "on" | "off"',
+    "eop": 'str, the Earth-orientation source: "auto" | "finals" | "c04-20" | "c04-14" | "off" | "custom" (extension)',
+    "eop_sources": "str, which EOP source covered which days of the run (extension)",
+    "eop_data": "str, the EOP files and the leap-second table used (extension)",
 }
 """Root attributes of format version 1 and their type / allowed values."""
 

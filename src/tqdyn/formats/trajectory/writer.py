@@ -146,7 +146,7 @@ class TrajectoryWriter:
         (ISO 8601), ``precision`` ("dd" | "float64"), ``step_s`` (float, s),
         ``integrator``, ``pointing`` (global | taylor1 | taylor2 | iterative |
         none), ``control`` (on | off).  ``format``, ``format_version``,
-        ``tqdyn_version``, ``time_scale`` ("TDB") and ``frame`` ("GCRS") are
+        ``tqdyn_version``, ``origin`` ("earth"), ``frame`` ("GCRS") and ``time_scale`` ("TT") are
         filled in (a given ``tqdyn_version`` is kept; the others must match).
         Extra str/int/float attributes are stored as given.
     fields : sequence of str
@@ -163,7 +163,7 @@ class TrajectoryWriter:
         h5py compression filter for time-dependent datasets (default None:
         off, for speed).
 
-    Data are float64 (SI units, TDB seconds, frames as in :data:`FIELDS`); each
+    Data are float64 (SI units, TT seconds since the epoch, frames as in :data:`FIELDS`); each
     :meth:`append` adds ``rows`` time rows to every time-dependent field.
     """
 
@@ -193,6 +193,7 @@ class TrajectoryWriter:
         self._expected = int(expected_rows) if expected_rows is not None else 0
         self._chunk_rows = max(1, min(_DEFAULT_CHUNK_ROWS, self._expected or _DEFAULT_CHUNK_ROWS))
         full_attrs = _check_attrs(attrs)
+        self._time_scale = full_attrs["time_scale"]
 
         self._rows = 0  # rows appended (on disk + buffered)
         self._rows_on_disk = 0
@@ -245,10 +246,10 @@ class TrajectoryWriter:
             return tmp
         raise OutputError(f"cannot create a unique temporary file for {str(self._path)!r}")  # pragma: no cover
 
-    @staticmethod
-    def _field_attrs(obj, spec: FieldSpec) -> None:
+    def _field_attrs(self, obj, spec: FieldSpec) -> None:
         obj.attrs["units"] = spec.unit
-        obj.attrs["frame"] = spec.frame
+        # the time field's "frame" is the file's time scale (FIELDS says "time_scale")
+        obj.attrs["frame"] = self._time_scale if spec.frame == "time_scale" else spec.frame
         obj.attrs["description"] = spec.description
 
     def _require_open(self, what: str) -> h5py.File:
@@ -303,7 +304,7 @@ class TrajectoryWriter:
         ``(rows, *trailing, 2)`` with ``[..., 0] = hi`` and ``[..., 1] = lo``.
         Trailing shapes are those of :data:`FIELDS` with ``sat`` = n_sat and
         ``tm`` = 2 (e.g. ``sat/r``: ``(rows, n_sat, 3)`` in m, GCRS; ``t``:
-        ``(rows,)`` in TDB seconds since the epoch).  All fields must have the
+        ``(rows,)`` in TT seconds since the epoch).  All fields must have the
         same number of rows.  Everything is validated before anything is
         stored, so a rejected call (ValueError naming the field) changes
         nothing.  The data are copied; small appends are buffered in memory
@@ -475,6 +476,8 @@ class TrajectoryWriter:
             self._finalizer.detach()
             raise OutputError(f"cannot reopen partial trajectory {str(partial)!r}: {exc}") from None
         self._state["h5"] = h5
+        ts = h5.attrs.get("time_scale", "TT")
+        self._time_scale = ts.decode() if isinstance(ts, bytes) else str(ts)
         self._fields = tuple(f for f in FIELDS if f in h5)
         self._tfields = tuple(f for f in self._fields if FIELDS[f].time_dependent)
         self._static_pending = set()

@@ -16,7 +16,7 @@ output directory and returning a :class:`Report`:
 Conventions: SI units (m, s, m/s^2, rad; angles in the figures and table in
 deg where marked), GCRS for inertial vectors, S / OA_l frames for control
 quantities as stored in the trajectory (:data:`tqdyn.formats.trajectory.FIELDS`), time in
-TDB seconds (days in the figures) since the scenario epoch.  Ranges are
+TT seconds (days in the figures) since the scenario epoch.  Ranges are
 formed and differenced in double-double before any float64 rounding
 (:mod:`tqdyn.lightpath`, :mod:`tqdyn.analysis.spectra`); the ASDs use the
 default Kaiser-window Welch estimate of the second dd difference

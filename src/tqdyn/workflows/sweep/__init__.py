@@ -39,7 +39,7 @@ It is written to ``<output_dir>/<name>.nc`` (netCDF-4/HDF5 through xarray's
 ``h5netcdf`` engine, or ``netcdf4`` if only that is installed).
 
 Units and conventions are those of the trajectory files: SI, GCRS, time
-``time`` in TDB seconds since each member's ``epoch_utc``; all members must
+``time`` in TT seconds since each member's ``epoch_utc``; all members must
 share one time grid (checked before anything runs).
 
 Errors in the sweep file raise :class:`SweepError` (a ``ValueError``, one

@@ -17,7 +17,8 @@ from ...formats import trajectory as io
 from ..run import one_line
 from .outcome import MemberOutcome
 from .plan import SweepPlan
-from .spec import SweepSpec, _coord_values, _toml_text
+from ...scenario.toml_text import toml_value
+from .spec import SweepSpec, _coord_values
 
 __all__ = ["gather"]
 
@@ -43,7 +44,7 @@ def _param_coords(spec: SweepSpec, dims: tuple[str, ...]) -> dict:
             extra = tuple(f"{p.dim}_dim{k}" for k in range(numeric.ndim - 1))
             coords[p.dim + "_value"] = ((dim,) + extra, numeric, dict(attrs, description=f"value of {p.key}"))
         else:
-            coords[p.dim + "_value"] = (dim, np.array([_toml_text(v) for v in p.values], dtype=str),
+            coords[p.dim + "_value"] = (dim, np.array([toml_value(v) for v in p.values], dtype=str),
                                         dict(attrs, description=f"value of {p.key} (TOML text)"))
     if spec.mode == "zip":
         coords["member"] = ("member", np.arange(spec.shape[0], dtype=np.int64), {"description": "member number - 1"})
@@ -65,7 +66,7 @@ def gather(plan: SweepPlan, outcomes: Sequence[MemberOutcome]) -> tuple[Any, lis
     by :attr:`Parameter.dim`, coordinate = values or labels, plus
     ``<name>_value`` for labelled parameters; ``zip``: ``member`` with each
     parameter as a coordinate on it), then the trajectory dimensions of
-    :meth:`tqdyn.formats.trajectory.Trajectory.to_xarray` (``time`` [s TDB since epoch],
+    :meth:`tqdyn.formats.trajectory.Trajectory.to_xarray` (``time`` [s TT since epoch],
     ``sat``, ``tm``, ``comp``, ...).  Every trajectory variable gets the member
     dimensions in front (``t_lo`` excepted: one time grid); failed members
     and variables a member lacks are NaN.  Per-member variables: ``ok``

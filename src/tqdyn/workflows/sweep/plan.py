@@ -18,7 +18,8 @@ from pathlib import Path
 
 from ...formats import trajectory as io
 from ...scenario import ScenarioError, load_scenario, loads_scenario
-from .spec import SweepSpec, _err, _toml_text, load_sweep
+from ...scenario.toml_text import toml_value
+from .spec import SweepSpec, _err, load_sweep
 
 __all__ = ["Member", "SweepPlan", "member_done", "plan_sweep"]
 
@@ -80,7 +81,7 @@ def _resolve_members(spec: SweepSpec) -> tuple[Member, ...]:
         raise _err("sweep.set", problem=str(exc)) from None
     for i, p in enumerate(spec.parameters, start=1):
         try:
-            load_scenario(spec.scenario, spec.common + (f"{p.key}={_toml_text(p.values[0])}",))
+            load_scenario(spec.scenario, spec.common + (f"{p.key}={toml_value(p.values[0])}",))
         except ScenarioError as exc:
             if exc.field.startswith("override"):
                 raise _err(f"sweep.parameter.{i}.key", problem=str(exc)) from None
@@ -90,7 +91,7 @@ def _resolve_members(spec: SweepSpec) -> tuple[Member, ...]:
     for index, (position, which) in enumerate(_positions(spec)):
         params = tuple((p.dim, p.display(j)) for p, j in zip(spec.parameters, which))
         label = f"sweep member {index + 1} (" + ", ".join(f"{k}={v}" for k, v in params) + ")"
-        overrides = spec.common + tuple(f"{p.key}={_toml_text(p.values[j])}" for p, j in zip(spec.parameters, which))
+        overrides = spec.common + tuple(f"{p.key}={toml_value(p.values[j])}" for p, j in zip(spec.parameters, which))
         try:
             scen = load_scenario(spec.scenario, overrides + (f"run.output={_OUTPUT_PLACEHOLDER}",))
         except ScenarioError as exc:

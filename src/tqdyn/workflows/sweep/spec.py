@@ -21,6 +21,7 @@ import numpy as np
 
 from ...formats import trajectory as io
 from ...scenario import DEFAULT_SCENARIO, ScenarioError, builtin_scenarios
+from ...scenario.toml_text import toml_str, toml_value
 
 __all__ = ["MODES", "Parameter", "SweepError", "SweepSpec", "load_sweep", "loads_sweep"]
 
@@ -52,40 +53,6 @@ def _err(field_: str, *args, **kwargs) -> SweepError:
 # --------------------------------------------------------------------------- values -> override text
 
 
-def _toml_str(s: str) -> str:
-    out = []
-    for ch in s:
-        if ch in '"\\':
-            out.append("\\" + ch)
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append(f"\\u{ord(ch):04X}")
-        else:
-            out.append(ch)
-    return '"' + "".join(out) + '"'
-
-
-def _toml_text(value: Any) -> str:
-    """A sweep value as TOML text (the right-hand side of an override)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, (Decimal, float)):
-        d = Decimal(repr(value)) if isinstance(value, float) else value
-        if d.is_nan():
-            return "nan"
-        if d.is_infinite():
-            return "-inf" if d < 0 else "inf"
-        return str(d)
-    if isinstance(value, str):
-        return _toml_str(value)
-    if isinstance(value, (_dt.datetime, _dt.date, _dt.time)):
-        return value.isoformat()
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
-    raise TypeError(f"cannot write {type(value).__name__} as a TOML value")  # pragma: no cover - validated
-
-
 def _check_value(value: Any, where: str, whole: Any) -> Any:
     """Validate one sweep value (a TOML scalar or a nested array of them); lists become tuples."""
     if isinstance(value, (list, tuple)):
@@ -114,7 +81,7 @@ def _scalar_kind(value: Any) -> str | None:
 
 def _display(value: Any) -> str:
     """A value as it appears in reports: a string as is, anything else as its TOML text."""
-    return value if isinstance(value, str) else _toml_text(value)
+    return value if isinstance(value, str) else toml_value(value)
 
 
 # --------------------------------------------------------------------------- the sweep spec
@@ -255,15 +222,15 @@ class SweepSpec:
 
     def to_toml(self) -> str:
         """The sweep as TOML text (paths resolved; :func:`loads_sweep` reads it back)."""
-        out = ["[sweep]", f"name = {_toml_str(self.name)}", f"scenario = {_toml_str(self.scenario)}",
-               f"output_dir = {_toml_str(str(self.output_dir))}",
-               "set = [" + ", ".join(_toml_str(s) for s in self.common) + "]", f"mode = {_toml_str(self.mode)}"]
+        out = ["[sweep]", f"name = {toml_str(self.name)}", f"scenario = {toml_str(self.scenario)}",
+               f"output_dir = {toml_str(str(self.output_dir))}",
+               "set = [" + ", ".join(toml_str(s) for s in self.common) + "]", f"mode = {toml_str(self.mode)}"]
         for p in self.parameters:
-            out += ["", "[[sweep.parameter]]", f"key = {_toml_str(p.key)}", f"values = {_toml_text(p.values)}"]
+            out += ["", "[[sweep.parameter]]", f"key = {toml_str(p.key)}", f"values = {toml_value(p.values)}"]
             if p.labels is not None:
-                out.append("labels = [" + ", ".join(_toml_str(s) for s in p.labels) + "]")
+                out.append("labels = [" + ", ".join(toml_str(s) for s in p.labels) + "]")
             if p.name is not None:
-                out.append(f"name = {_toml_str(p.name)}")
+                out.append(f"name = {toml_str(p.name)}")
         return "\n".join(out) + "\n"
 
 
