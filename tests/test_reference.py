@@ -17,7 +17,7 @@ def test_scenario_resolves_the_reference_system():
     assert (GEOCENTRIC.origin, GEOCENTRIC.frame) == ("earth", "GCRS")
     assert 'central_body = "earth"' in scen.to_toml()
     assert loads_scenario(scen.to_toml()).reference is GEOCENTRIC
-    assert CENTRAL_BODIES == ("earth",)
+    assert CENTRAL_BODIES == ("earth", "sun")
 
 
 def test_unknown_central_body_is_one_clear_line():

@@ -59,6 +59,7 @@ from .constants import DAY_S, J2000_JD
 
 __all__ = [
     "BODIES",
+    "HELIOCENTRIC_BODIES",
     "NAIF_ID",
     "Ephemeris",
     "default_ephemeris",
@@ -68,6 +69,9 @@ __all__ = [
 
 #: Bodies whose geocentric states :meth:`Ephemeris.geocentric` provides.
 BODIES = ("sun", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+
+#: Bodies whose heliocentric states :meth:`Ephemeris.heliocentric_states` provides.
+HELIOCENTRIC_BODIES = ("earth", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
 
 #: NAIF ids used for each name (planets: system barycenters); "earth" is the
 #: Earth itself (399), used for its GM only.
@@ -417,6 +421,55 @@ class Ephemeris:
         for b, name in enumerate(names):
             key, base = _CHAIN[name]
             self._pairs[key].evaluate(j1, j2, velocity, pos, vel, b, base_p, base_v, _BASE_INDEX[base], -1.0)
+        pos = pos.reshape(shape + (len(names), 3))
+        vel = vel.reshape(shape + (len(names), 3)) if velocity else None
+        return pos, vel
+
+    def heliocentric_states(self, bodies, jd1, jd2, *, velocity: bool = True):
+        """Heliocentric states of several bodies at once: barycentric state
+        of the body minus that of the Sun (0 -> 10).
+
+        bodies: names from :data:`HELIOCENTRIC_BODIES` (``"earth"`` = the
+        chain (0->3) + (3->399), ``"moon"`` = (0->3) + (3->301), the planets
+        at their system barycentres (0->k)); jd1, jd2: two-part TDB Julian
+        dates [d], broadcast to shape S.  Returns pos S + (n_bodies, 3)
+        float64 [m] and vel (same, [m/s]) or None: Sun-centred, ICRF axes,
+        TDB-compatible BCRS coordinates (a Newtonian translation of the
+        barycentric ones).  ValueError for an unknown body or a date outside
+        ``span_jd``.
+        """
+        if isinstance(bodies, str):
+            bodies = (bodies,)
+        names = tuple(str(b).lower() for b in bodies)
+        for b in names:
+            if b not in HELIOCENTRIC_BODIES:
+                raise ValueError(f"ephemeris: unknown heliocentric body {b!r}; known: {', '.join(HELIOCENTRIC_BODIES)}")
+        self.validate_bodies(tuple(b for b in names if b != "earth") + ("sun",))
+        shape, j1, j2 = self._flat_dates(jd1, jd2)
+        n = j1.shape[0]
+        # scratch rows: 0 = SSB -> Sun, 1 = SSB -> EMB
+        base_p = np.empty((n, 2, 3))
+        base_v = np.empty((n, 2, 3)) if velocity else base_p
+        self._pairs[(_SSB, 10)].evaluate(j1, j2, velocity, base_p, base_v, 0, base_p, base_v, 0, 0.0)
+        if any(b in ("earth", "moon") for b in names):
+            self._pairs[_EARTH_CHAIN[0]].evaluate(j1, j2, velocity, base_p, base_v, 1, base_p, base_v, 0, 0.0)
+        pos = np.empty((n, len(names), 3))
+        vel = np.empty((n, len(names), 3)) if velocity else pos
+        for b, name in enumerate(names):
+            if name in ("earth", "moon"):
+                key = (_EMB, _EARTH if name == "earth" else _MOON)
+                self._pairs[key].evaluate(j1, j2, velocity, pos, vel, b, base_p, base_v, 1, 1.0)
+            else:
+                self._pairs[_CHAIN[name][0]].evaluate(j1, j2, velocity, pos, vel, b, base_p, base_v, 0, 0.0)
+                continue
+            pos[:, b] -= base_p[:, 0]
+            if velocity:
+                vel[:, b] -= base_v[:, 0]
+        for b, name in enumerate(names):
+            if name not in ("earth", "moon"):
+                pos[:, b] -= base_p[:, 0]
+                if velocity:
+                    vel[:, b] -= base_v[:, 0]
         pos = pos.reshape(shape + (len(names), 3))
         vel = vel.reshape(shape + (len(names), 3)) if velocity else None
         return pos, vel

@@ -10,10 +10,19 @@ scenario names the central body (``scenario.central_body``); the reference
 system follows from it, the force model carries it and the trajectory file
 records it (root attributes ``origin``, ``frame``, ``time_scale``).
 
-Version 0.2 has one: :data:`GEOCENTRIC`, whose coordinate time is TT (the
-geocentric equations of motion and EGM2008's GM are TT-compatible): t is
-seconds of TT since the epoch's TT, the JPL ephemerides are read at TDB(TT)
-(:func:`tqdyn.astro.timescales.tdb_jd`).  Trajectory files of format version
+Version 0.2 has two:
+
+* :data:`GEOCENTRIC` (TianQin), whose coordinate time is TT (the geocentric
+  equations of motion and EGM2008's GM are TT-compatible): t is seconds of
+  TT since the epoch's TT, the JPL ephemerides are read at TDB(TT)
+  (:func:`tqdyn.astro.timescales.tdb_jd`);
+* :data:`HELIOCENTRIC` (LISA, Taiji): Sun-centred coordinates of the
+  TDB-compatible BCRS with ICRF axes, t in TDB seconds since the epoch's
+  TDB; the JPL ephemerides (and their GMs) are TDB-compatible already and
+  are read at TDB(epoch) + t.
+
+:meth:`ReferenceSystem.ephemeris_jd` is the one place where t becomes the
+ephemerides' TDB argument.  Trajectory files of format version
 1 (tqdyn 0.1) are geocentric with ``time_scale = "TDB"``: their t is
 TT-elapsed seconds labelled TDB, and the ephemerides of that version were
 read at TDB(epoch) + t (:data:`GEOCENTRIC_V1`, docs/design.md).
@@ -23,7 +32,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CENTRAL_BODIES", "GEOCENTRIC", "GEOCENTRIC_V1", "REFERENCE_SYSTEMS", "ReferenceSystem", "reference_system"]
+__all__ = ["CENTRAL_BODIES", "GEOCENTRIC", "GEOCENTRIC_V1", "HELIOCENTRIC", "REFERENCE_SYSTEMS", "ReferenceSystem", "reference_system"]
 
 
 @dataclass(frozen=True)
@@ -33,8 +42,11 @@ class ReferenceSystem:
     central_body : the origin of the coordinates (and of the elements of
         the initial states), a name of :data:`CENTRAL_BODIES`;
     frame : the axes and reference system, ``"GCRS"`` (geocentric celestial
-        reference system: ICRF axes, origin at the geocentre);
-    time_scale : the time scale of t (seconds since the scenario epoch);
+        reference system: ICRF axes, origin at the geocentre) or ``"BCRS"``
+        (barycentric celestial reference system: ICRF axes; here with the
+        origin moved to the Sun's centre, a Newtonian translation);
+    time_scale : the time scale of t (seconds since the scenario epoch),
+        ``"TT"`` or ``"TDB"``;
     description : one line for ``tqdyn info`` and the docs.
     """
 
@@ -48,12 +60,30 @@ class ReferenceSystem:
         """The origin of the coordinates (the central body's name), as the trajectory file records it."""
         return self.central_body
 
+    def ephemeris_jd(self, epoch, t_hi, t_lo=0.0):
+        """Two-part TDB Julian date [d] (jd1, jd2) at which the JPL
+        ephemerides are read for t = t_hi + t_lo [s of :attr:`time_scale`
+        since ``epoch``, a :class:`tqdyn.astro.timescales.Epoch`]: TDB(TT)
+        for a TT axis (:func:`tqdyn.astro.timescales.tdb_jd`), the epoch's
+        TDB plus t for a TDB axis (:func:`tqdyn.astro.timescales.tdb_after`).
+        Arrays of the broadcast shape of t_hi and t_lo, ps resolution."""
+        from .timescales import tdb_after, tdb_jd
+
+        if self.time_scale == "TDB":
+            return tdb_after(epoch, t_hi, t_lo)
+        return tdb_jd(epoch, t_hi, t_lo)
+
 
 #: The geocentric system of TianQin: GCRS, Earth-centred, ICRF axes, TT.
 GEOCENTRIC = ReferenceSystem(
     central_body="earth", frame="GCRS", time_scale="TT",
     description="geocentric GCRS (origin the geocentre, ICRF axes, TT-compatible); t in TT seconds since the "
                 "epoch, the JPL ephemerides at TDB(TT)")
+#: The heliocentric system of LISA and Taiji: Sun-centred BCRS, ICRF axes, TDB.
+HELIOCENTRIC = ReferenceSystem(
+    central_body="sun", frame="BCRS", time_scale="TDB",
+    description="heliocentric BCRS (origin the Sun's centre, ICRF axes, TDB-compatible); t in TDB seconds since "
+                "the epoch, the JPL ephemerides at TDB(epoch) + t")
 #: What a trajectory file of format version 1 (tqdyn 0.1) is relative to.
 GEOCENTRIC_V1 = ReferenceSystem(
     central_body="earth", frame="GCRS", time_scale="TDB",
@@ -61,7 +91,7 @@ GEOCENTRIC_V1 = ReferenceSystem(
                 "TDB, the ephemerides were read at TDB(epoch) + t (25 us/day off near 2004)")
 
 #: Every reference system tqdyn propagates in.
-REFERENCE_SYSTEMS = (GEOCENTRIC,)
+REFERENCE_SYSTEMS = (GEOCENTRIC, HELIOCENTRIC)
 _SYSTEMS = {r.central_body: r for r in REFERENCE_SYSTEMS}
 #: Central bodies a scenario may name.
 CENTRAL_BODIES = tuple(_SYSTEMS)

@@ -29,7 +29,6 @@ def forces(scenario, duration, every, plot_path, sets):
     from .. import dynamics
     from ..analysis.budget import force_budget
     from ..scenario import ScenarioError, load_scenario
-    from ..astro.timescales import Epoch
 
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, None, None, None))
@@ -54,7 +53,7 @@ def forces(scenario, duration, every, plot_path, sets):
     t_hi, t_lo = rows.t
     r = rows.sat_r[0] + rows.sat_r[1]
     v = rows.sat_v[0] + rows.sat_v[1]
-    budget = force_budget(model, Epoch.from_utc(scen.epoch_utc), t_hi, t_lo, r, v)
+    budget = force_budget(model, scen.epoch, t_hi, t_lo, r, v)
     lines = [f"force budget along {scen.name!r} ({len(scen.satellites)} satellites, {t_hi.size} samples over "
              f"{float(scen.run.duration_s) / 86400:g} days), |a| in m/s^2:",
              f"  {'term':<22} {'max':>10} {'rms':>10}  source"]

@@ -16,7 +16,6 @@ from typing import Callable
 import mpmath
 import numpy as np
 
-from ..astro.timescales import Epoch
 from ..forces.model import ForceModel, build_force_model
 from ..numerics import dp87
 from ..numerics.dd import mp_from_dd
@@ -70,7 +69,7 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     model = build_force_model(scenario.forces, scenario.reference) if model is None else model
     system = build_system(scenario, model)
     model = system.with_inputs(model)
-    epoch = Epoch.from_utc(scenario.epoch_utc)
+    epoch = scenario.epoch
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)
     if scenario.integrator.mode == "adaptive":
@@ -96,7 +95,7 @@ def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:
     a file holds) raise ValueError / FileNotFoundError before any
     propagation or output starts.  Returns the model."""
     model = build_force_model(scenario.forces, scenario.reference) if model is None else model
-    epoch = Epoch.from_utc(scenario.epoch_utc)
+    epoch = scenario.epoch
     t_end = float(scenario.run.duration_s)
     if getattr(model, "eop", None) is not None:  # one line naming forces.eop if its table is too short
         from ..astro.eop_sources import check_coverage, run_span_mjd

@@ -33,6 +33,7 @@ from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import EarthField, degree2_accel_ext, earth_field_accel
 from .earth_indirect import EarthFieldIndirect, earth_field_indirect_accel
+from .heliocentric import CentralJ2, SunMonopole, central_j2_accel
 from .moon import MoonField, moon_field_accel
 from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
@@ -48,12 +49,16 @@ SLOT_MOON_FIELD = 3
 SLOT_SUN_J2 = 4
 SLOT_EARTH_FIELD = 5
 SLOT_EARTH_FIELD_INDIRECT = 6
-SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY,
+SLOT_CENTRAL_J2 = 7
+#: The central body's monopole (the Earth's or, heliocentric, the Sun's) uses the first slot.
+SLOT_CENTRAL_MONOPOLE = SLOT_EARTH_MONOPOLE
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "central_j2": SLOT_CENTRAL_J2, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY,
          "moon_field": SLOT_MOON_FIELD, "sun_j2": SLOT_SUN_J2, "earth_field": SLOT_EARTH_FIELD,
          "earth_field_indirect": SLOT_EARTH_FIELD_INDIRECT}
 _TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY, Relativity: SLOT_RELATIVITY,
               MoonField: SLOT_MOON_FIELD, SunJ2: SLOT_SUN_J2, EarthField: SLOT_EARTH_FIELD,
-              EarthFieldIndirect: SLOT_EARTH_FIELD_INDIRECT}
+              EarthFieldIndirect: SLOT_EARTH_FIELD_INDIRECT, SunMonopole: SLOT_CENTRAL_MONOPOLE,
+              CentralJ2: SLOT_CENTRAL_J2}
 
 
 class ForceModel:
@@ -117,7 +122,7 @@ def describe_terms() -> list[tuple[str, str, str]]:
     from .pole_tides import OceanPoleTide, SolidPoleTide
     from .solid_tides import SolidTides
 
-    classes = list(_TERM_SLOT) + [SolidTides, OceanTides, SolidPoleTide, OceanPoleTide, AtmosphericTides]
+    classes = list(dict.fromkeys(_TERM_SLOT)) + [SolidTides, OceanTides, SolidPoleTide, OceanPoleTide, AtmosphericTides]
     return [(cls.name, cls.description, cls.source) for cls in classes]
 
 
@@ -179,8 +184,11 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
     ``forces.eop`` (:func:`tqdyn.astro.eop_sources.eop_table`) unless an
     :class:`~tqdyn.astro.eop.EOP` table (or None: no EOP) is given, e.g. to
     compare sources."""
+    if reference.central_body == "sun":
+        return _heliocentric_model(forces, reference)
     if reference.central_body != "earth":
-        raise ValueError(f"scenario.central_body: {reference.central_body!r} has no force model; allowed: 'earth'")
+        raise ValueError(f"scenario.central_body: {reference.central_body!r} has no force model; "
+                         "allowed: 'earth', 'sun'")
     terms = []
     if forces.earth_monopole:
         terms.append(EarthMonopole(gm=forces.gm_earth))
@@ -221,10 +229,28 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
     return ForceModel(terms, reference, eop=eop, eop_source=source if eop is not None else "off")
 
 
+def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
+    """The heliocentric terms of :mod:`tqdyn.forces.heliocentric` switched on in ``forces``."""
+    from .heliocentric import heliocentric_third_bodies, sun_schwarzschild
+
+    terms = []
+    if forces.sun_monopole:
+        terms.append(SunMonopole())
+    eph = _ephemeris(forces.ephemeris) if forces.third_bodies else None
+    if forces.third_bodies:
+        terms.append(heliocentric_third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended))
+    if forces.sun_j2:
+        terms.append(CentralJ2())
+    if forces.relativity:
+        terms.append(sun_schwarzschild())
+    return ForceModel(terms, reference)
+
+
 @njit(cache=True)
 def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
-    """Total gravitational acceleration [m/s^2] at the geocentric GCRS position
-    (x, y, z) [m] and velocity (vx, vy, vz) [m/s] (generic dd / float64; the
+    """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
+    and velocity (vx, vy, vz) [m/s] relative to the central body, in the
+    force model's reference system (geocentric GCRS or heliocentric BCRS) (generic dd / float64; the
     velocity enters the relativistic terms only), from the enabled terms.
 
     tdat: (n_tdat,) float64 time-only inputs at this instant; params, layout:
@@ -279,5 +305,9 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     if layout[SLOT_RELATIVITY, 0]:
         o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
         gx, gy, gz = relativity_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_CENTRAL_J2, 0]:
+        o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
+        gx, gy, gz = central_j2_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     return add(ax, px), add(ay, py), add(az, pz)

@@ -14,8 +14,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 from dataclasses import dataclass, field
-from decimal import Decimal, InvalidOperation, localcontext
-from pathlib import Path
+from decimal import Decimal, localcontext
 from typing import Any, Sequence
 
 from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
@@ -36,140 +35,12 @@ _METHODS = ("dp87",)
 _MODES = ("fixed", "adaptive")
 _TABLEAUS = ("corrected", "published")
 _RTOL_MAX = 1e-3
-_EXACT = 200  # Decimal working precision for exact unit conversions
-
-_NOVALUE = object()
-
-
-# --------------------------------------------------------------------------- errors
-
-
-def _fmt(value: Any) -> str:
-    if isinstance(value, Decimal):
-        return str(value)
-    if isinstance(value, Path):
-        return repr(str(value))
-    return repr(value)
-
-
-class ScenarioError(ValueError):
-    """Invalid scenario: one line ``"<field>: <value> <problem>; allowed: <allowed>"``.
-
-    Attributes ``field`` (dotted TOML path such as ``"satellites.2.e"``),
-    ``value`` (the offending value, or ``None``), ``problem`` and ``allowed``.
-    """
-
-    def __init__(self, field: str, value: Any = _NOVALUE, problem: str = "", allowed: str | None = None):
-        self.field = field
-        self.value = None if value is _NOVALUE else value
-        self.problem = problem
-        self.allowed = allowed
-        parts = [f"{field}:"]
-        if value is not _NOVALUE:
-            parts.append(_fmt(value))
-        if problem:
-            parts.append(problem)
-        msg = " ".join(parts)
-        if allowed:
-            msg += f"; allowed: {allowed}"
-        super().__init__(msg.replace("\n", " "))
-
-
-def _one_of(options: Sequence[str]) -> str:
-    return ", ".join(repr(o) for o in options)
-
-
-# --------------------------------------------------------------------------- value helpers
-
-
-def _to_decimal(value: Any, name: str) -> Decimal:
-    """Coerce int/Decimal/str/float to a finite Decimal (for direct Python construction)."""
-    if isinstance(value, bool):
-        raise ScenarioError(name, value, "is a boolean", "a finite number")
-    if isinstance(value, Decimal):
-        d = value
-    elif isinstance(value, int):
-        d = Decimal(value)
-    elif isinstance(value, float):
-        d = Decimal(repr(value))
-    elif isinstance(value, str):
-        try:
-            d = Decimal(value.strip())
-        except InvalidOperation:
-            raise ScenarioError(name, value, "is not a number", "a finite number") from None
-    else:
-        raise ScenarioError(name, value, f"has type {type(value).__name__}", "a finite number")
-    if not d.is_finite():
-        raise ScenarioError(name, value, "is not finite", "a finite number")
-    return d
-
-
-def _require(cond: bool, name: str, value: Any, problem: str, allowed: str) -> None:
-    if not cond:
-        raise ScenarioError(name, value, problem, allowed)
-
-
-def _require_choice(value: Any, name: str, options: Sequence[str]) -> None:
-    _require(isinstance(value, str) and value in options, name, value, "is not a valid choice", _one_of(options))
-
-
-def _set(obj: Any, name: str, value: Any) -> None:
-    object.__setattr__(obj, name, value)
-
-
-# --------------------------------------------------------------------------- TOML type names (messages)
-
-
-def _a(noun: str) -> str:
-    return ("an " if noun[:1] in "aeiou" else "a ") + noun
-
-
-def _toml_type(value: Any) -> str:
-    if isinstance(value, bool):
-        return "boolean"
-    if isinstance(value, int):
-        return "integer"
-    if isinstance(value, (Decimal, float)):
-        return "float"
-    if isinstance(value, str):
-        return "string"
-    if isinstance(value, list):
-        return "array"
-    if isinstance(value, dict):
-        return "table"
-    if isinstance(value, (_dt.date, _dt.time)):
-        return "date-time"
-    return type(value).__name__
-
-
+from .initial import AU_M, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
+from .values import (  # noqa: F401  (re-exported for the loader)
+    _EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require, _require_choice, _set, _to_decimal,
+    _toml_type)
 
 # --------------------------------------------------------------------------- dataclasses
-
-
-@dataclass(frozen=True)
-class SatelliteConfig:
-    """Initial osculating Keplerian elements of one satellite (GCRS, at the scenario epoch).
-
-    ``a_m`` semi-major axis [m] (> 0), ``e`` eccentricity [-] (0 <= e < 1),
-    ``i_deg``, ``raan_deg``, ``argp_deg``, ``nu_deg``: inclination, right
-    ascension of the ascending node, argument of pericenter, true anomaly
-    [deg], finite.  All numbers are exact ``Decimal``.
-    """
-
-    name: str
-    a_m: Decimal
-    e: Decimal
-    i_deg: Decimal
-    raan_deg: Decimal
-    argp_deg: Decimal
-    nu_deg: Decimal
-
-    def __post_init__(self) -> None:
-        _require(isinstance(self.name, str) and self.name.strip() != "", "satellite.name", self.name, "is not a non-empty string", "a non-empty string")
-        for f in ("a_m", "e", "i_deg", "raan_deg", "argp_deg", "nu_deg"):
-            _set(self, f, _to_decimal(getattr(self, f), f"satellite.{f}"))
-        _require(self.a_m > 0, "satellite.a_m", self.a_m, "is not positive", "a > 0 m")
-        _require(0 <= self.e < 1, "satellite.e", self.e, "is not an elliptic eccentricity", "0 <= e < 1")
 
 
 @dataclass(frozen=True)
@@ -226,8 +97,12 @@ class RunConfig:
         _require(isinstance(oe, int) and not isinstance(oe, bool) and oe >= 1, "run.output_every", oe, "is not an integer >= 1", "an integer >= 1")
 
 
-#: Bodies available as point-mass third bodies (JPL DE ephemerides).
-THIRD_BODIES = ("sun", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+#: Bodies available as point-mass third bodies (JPL DE ephemerides): all but
+#: the central body itself ("sun" for geocentric runs, "earth" for heliocentric ones).
+THIRD_BODIES = ("sun", "earth", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+#: Keys of [forces] that belong to the geocentric model only.
+GEOCENTRIC_ONLY_FORCES = ("earth_degree", "solid_tides", "ocean_tides_degree", "pole_tides", "atmospheric_tides",
+                          "moon_degree", "earth_field_indirect")
 #: Largest degrees the shipped coefficient files hold.
 MAX_EARTH_DEGREE = 90  # EGM2008_90.gfc
 MAX_MOON_DEGREE = 20  # jggrx_0660b_sha_deg20.tab
@@ -240,8 +115,9 @@ class ForcesConfig:
     """Force-model switches.  Every perturbation is off unless switched on
     (the built-in ``tianqin`` scenario switches on the paper's full model).
 
-    ``earth_monopole``: Earth point mass; ``gm_earth`` [m^3/s^2] (> 0),
-    default EGM2008 3.986004415e14.
+    ``earth_monopole``: Earth point mass (geocentric runs); ``gm_earth``
+    [m^3/s^2] (> 0), default EGM2008 3.986004415e14.
+    ``sun_monopole``: Sun point mass (heliocentric runs; GM of DE430).
     ``earth_degree``: degree and order of the Earth's static field EGM2008
     (0 = off, 2..90); ``earth_degree2_extended``: its degree-2 part (J2,
     ~5e-7 m/s^2, with the degree-2 tides) in extended precision.
@@ -259,7 +135,8 @@ class ForcesConfig:
     ``moon_degree``: GL0660B lunar field degree (0 = off, 2..20);
     ``moon_libration``: lunar orientation "de421" (PA kernel) | "iau".
     ``sun_j2``: the Sun's J2 with its IAU pole.
-    ``relativity``: IERS 2010 eq. 10.12 (Schwarzschild, Lense-Thirring, de Sitter).
+    ``relativity``: IERS 2010 eq. 10.12 (geocentric: Schwarzschild,
+    Lense-Thirring, de Sitter; heliocentric: the Sun's Schwarzschild term).
     ``earth_field_indirect``: the geocentre's acceleration by the Moon and
     Sun (those listed in third_bodies) acting on the Earth's non-central
     field (needs earth_degree >= 2).
@@ -270,6 +147,7 @@ class ForcesConfig:
     """
 
     earth_monopole: bool = True
+    sun_monopole: bool = True
     gm_earth: Decimal = Decimal(GM_EARTH_EGM2008)
     earth_degree: int = 0
     earth_degree2_extended: bool = True
@@ -292,7 +170,7 @@ class ForcesConfig:
         ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
         _require(ok, "forces.eop", self.eop, "is not an EOP source", EOP_SOURCES_ALLOWED)
         _set(self, "eop", normalize_eop_source(self.eop))
-        for key in ("earth_monopole", "earth_degree2_extended", "third_bodies_gcrs", "solid_tides", "pole_tides",
+        for key in ("earth_monopole", "sun_monopole", "earth_degree2_extended", "third_bodies_gcrs", "solid_tides", "pole_tides",
                     "atmospheric_tides", "sun_j2", "relativity", "earth_field_indirect"):
             _require(isinstance(getattr(self, key), bool), f"forces.{key}", getattr(self, key), "is not a boolean", "true or false")
         _set(self, "gm_earth", _to_decimal(self.gm_earth, "forces.gm_earth"))
@@ -322,33 +200,6 @@ SELF_GRAVITY_MODELS = ("table-iv", "off")
 TM_AXES = ("x", "y", "z")
 
 
-def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: str) -> tuple:
-    """Nested tuples of Decimal with one of ``shapes`` (ScenarioError otherwise)."""
-    allowed = " or ".join(str(tuple(s)) for s in shapes)
-    allowed = f"an array of shape {allowed} of finite numbers [{unit}]"
-
-    def conv(x, depth):
-        if isinstance(x, (list, tuple)):
-            return tuple(conv(e, depth + 1) for e in x)
-        if isinstance(x, bool) or not isinstance(x, (int, float, Decimal)):
-            raise ScenarioError(name, value, f"contains {_a(_toml_type(x))}", allowed)
-        d = Decimal(str(x)) if isinstance(x, float) else Decimal(x)
-        _require(d.is_finite(), name, value, "is not finite", allowed)
-        return d
-
-    arr = conv(value, 0)
-
-    def shape(x):
-        if not isinstance(x, tuple):
-            return ()
-        inner = {shape(e) for e in x}
-        return (len(x),) + inner.pop() if len(inner) == 1 else (len(x), -1)
-
-    _require(isinstance(arr, tuple) and shape(arr) in [tuple(s) for s in shapes], name,
-             value, "has the wrong shape", allowed)
-    return arr
-
-
 @dataclass(frozen=True)
 class SpacecraftConfig:
     """Spacecraft architecture (the same for the three satellites).
@@ -362,6 +213,13 @@ class SpacecraftConfig:
     ``self_gravity_common``: an extra DC acceleration on both TMs of a
     satellite, fixed in the satellite frame S, shape (3,) (all satellites)
     or (3, 3) [m/s^2] (the paper's common self-gravity studies).
+    ``self_gravity_center``: [start, end] [m/s^2] (or None: off), an
+    acceleration of every satellite's orbit toward the constellation's
+    centre (the centroid of the three satellites), positive toward it,
+    varying linearly in time from ``start`` to ``end`` over
+    ``self_gravity_center_span`` = [t_start, t_end] (ISO dates, UTC unless
+    suffixed " TDB"; held at the end values outside; default: the span of
+    ``initial.oem``'s files) -- the model of ESA's LISA orbit files.
     """
 
     d_tm_m: Decimal = Decimal("0.40")
@@ -369,6 +227,8 @@ class SpacecraftConfig:
     tm_axis: str = "y"
     self_gravity: Any = "table-iv"
     self_gravity_common: Any = (Decimal(0), Decimal(0), Decimal(0))
+    self_gravity_center: Any = None
+    self_gravity_center_span: Any = None
 
     def __post_init__(self) -> None:
         _set(self, "d_tm_m", _to_decimal(self.d_tm_m, "spacecraft.d_tm_m"))
@@ -383,6 +243,19 @@ class SpacecraftConfig:
                                                   ((2, 3), (3, 2, 3)), "m/s^2 in OA_l"))
         _set(self, "self_gravity_common", _num_array(self.self_gravity_common, "spacecraft.self_gravity_common",
                                                      ((3,), (3, 3)), "m/s^2 in S"))
+        if self.self_gravity_center is not None:
+            _set(self, "self_gravity_center", _num_array(self.self_gravity_center, "spacecraft.self_gravity_center",
+                                                         ((2,),), "m/s^2, positive toward the centre"))
+        span = self.self_gravity_center_span
+        if span is not None:
+            ok = isinstance(span, (list, tuple)) and len(span) == 2 and all(isinstance(x, str) for x in span)
+            _require(ok, "spacecraft.self_gravity_center_span", span, "is not two dates",
+                     '["START", "END"], ISO dates with an optional " UTC" (default) or " TDB" suffix')
+            epochs = tuple(epoch_from_label(x, "spacecraft.self_gravity_center_span") for x in span)
+            _require((epochs[1].tdb[0] - epochs[0].tdb[0]) + (epochs[1].tdb[1] - epochs[0].tdb[1]) > 0,
+                     "spacecraft.self_gravity_center_span", list(span), "does not end after it starts",
+                     "an end date after the start date")
+            _set(self, "self_gravity_center_span", tuple(e.iso for e in epochs))
 
     def self_gravity_values(self):
         """(oa, common): float64 arrays (3, 2, 3) [m/s^2, OA_l] and (3, 3) [m/s^2, S]."""
@@ -460,22 +333,40 @@ class Scenario:
     constellation: ConstellationConfig = field(default_factory=ConstellationConfig)
     satellites: tuple[SatelliteConfig, ...] = ()
     central_body: str = "earth"
+    epoch_tdb: str = ""
+    initial: InitialConfig = field(default_factory=InitialConfig)
 
     def __post_init__(self) -> None:
         _require_choice(self.central_body, "scenario.central_body", CENTRAL_BODIES)
+        _require(isinstance(self.initial, InitialConfig), "initial", self.initial, "is not an InitialConfig",
+                 "InitialConfig")
         _require(isinstance(self.name, str) and self.name.strip() != "", "scenario.name", self.name, "is not a non-empty string", "a non-empty string")
         _require(isinstance(self.description, str), "scenario.description", self.description, "is not a string", "a string")
-        try:
-            epoch = Epoch.from_utc(self.epoch_utc)
-        except ValueError as exc:
-            reason = getattr(exc, "reason", str(exc))
-            raise ScenarioError("scenario.epoch_utc", self.epoch_utc, f"is not a valid UTC epoch ({reason})",
-                                "a UTC date-time YYYY-MM-DDTHH:MM:SS[.fff] from 1960 on") from None
+        if self.epoch_tdb:
+            try:
+                epoch = Epoch.from_tdb(self.epoch_tdb)
+            except ValueError as exc:
+                reason = getattr(exc, "reason", str(exc))
+                raise ScenarioError("scenario.epoch_tdb", self.epoch_tdb, f"is not a valid TDB epoch ({reason})",
+                                    "a TDB date-time YYYY-MM-DDTHH:MM:SS[.fff] from 1960 on") from None
+            _set(self, "epoch_tdb", epoch.tdb_iso)
+        else:
+            try:
+                epoch = Epoch.from_utc(self.epoch_utc)
+            except ValueError as exc:
+                reason = getattr(exc, "reason", str(exc))
+                raise ScenarioError("scenario.epoch_utc", self.epoch_utc, f"is not a valid UTC epoch ({reason})",
+                                    "a UTC date-time YYYY-MM-DDTHH:MM:SS[.fff] from 1960 on") from None
         _set(self, "epoch_utc", epoch.utc_iso)
         for name, cls in (("run", RunConfig), ("integrator", IntegratorConfig), ("forces", ForcesConfig),
                           ("spacecraft", SpacecraftConfig), ("constellation", ConstellationConfig)):
             _require(isinstance(getattr(self, name), cls), name, getattr(self, name), f"is not a {cls.__name__}", cls.__name__)
+        self._check_central_body()
         sats = tuple(self.satellites)
+        if self.initial.derived and not sats:
+            from .initial import derived_satellites
+
+            sats = derived_satellites(self.initial, epoch, self.central_body)
         _require(len(sats) >= 1, "satellites", list(sats), "is empty", "at least one satellite")
         seen: dict[str, int] = {}
         for k, sat in enumerate(sats, start=1):
@@ -500,6 +391,31 @@ class Scenario:
                     "a duration that is a whole number of steps",
                 )
 
+    def _check_central_body(self) -> None:
+        """The force model, the initial states and the coupled dynamics against the central body."""
+        f, body = self.forces, self.central_body
+        for b in f.third_bodies:
+            _require(b != body, "forces.third_bodies", b, f"is the central body (scenario.central_body = {body!r})",
+                     _one_of([x for x in THIRD_BODIES if x != body]))
+        if body == "sun":
+            for key in GEOCENTRIC_ONLY_FORCES:
+                v = getattr(f, key)
+                _require(not v, f"forces.{key}", v, 'belongs to the geocentric model (scenario.central_body = "sun")',
+                         "0 / false for a heliocentric run")
+            _require(not self.constellation.coupled, "constellation.pointing", self.constellation.pointing,
+                     'has no heliocentric spacecraft architecture yet (scenario.central_body = "sun")',
+                     '"none" (point-mass satellites) for a heliocentric run')
+        else:
+            _require(self.initial.design == "none", "initial.design", self.initial.design,
+                     "is a heliocentric constellation design", '"none" for a geocentric run')
+            _require(not self.initial.oem, "initial.oem", list(self.initial.oem),
+                     "gives heliocentric (Sun-centred) states", 'central_body = "sun"')
+            _require(self.spacecraft.self_gravity_center is None, "spacecraft.self_gravity_center",
+                     self.spacecraft.self_gravity_center, "is the heliocentric constellations' model",
+                     'central_body = "sun"')
+        if self.initial.design != "none":
+            _require(body == "sun", "initial.design", self.initial.design, "is heliocentric", 'central_body = "sun"')
+
     @property
     def reference(self) -> ReferenceSystem:
         """Origin, frame and time scale of the states (:mod:`tqdyn.astro.reference`), from ``central_body``."""
@@ -507,8 +423,10 @@ class Scenario:
 
     @property
     def epoch(self) -> Epoch:
-        """The scenario epoch as a :class:`tqdyn.astro.timescales.Epoch` (UTC/TAI/TT/TDB two-part JDs)."""
-        return Epoch.from_utc(self.epoch_utc)
+        """The scenario epoch as a :class:`tqdyn.astro.timescales.Epoch`
+        (UTC/TAI/TT/TDB two-part JDs): from ``epoch_tdb`` when given, else
+        from ``epoch_utc``."""
+        return Epoch.from_tdb(self.epoch_tdb) if self.epoch_tdb else Epoch.from_utc(self.epoch_utc)
 
     @property
     def n_steps(self) -> int:
@@ -529,7 +447,8 @@ class Scenario:
         their exact decimal form (durations and steps in s)."""
         out: list[str] = ["# tqdyn scenario (resolved). Units: SI unless the key name says otherwise.", ""]
         out += ["[scenario]", f"name = {toml_str(self.name)}", f"description = {toml_str(self.description)}",
-                f"epoch_utc = {toml_str(self.epoch_utc)}  # UTC",
+                (f"epoch_tdb = {toml_str(self.epoch_tdb)}  # TDB (UTC {self.epoch_utc})" if self.epoch_tdb
+                 else f"epoch_utc = {toml_str(self.epoch_utc)}  # UTC"),
                 f"central_body = {toml_str(self.central_body)}", ""]
         r = self.run
         out += ["[run]", f"duration = {toml_value(r.duration_s)}  # s", f"precision = {toml_str(r.precision)}",
@@ -539,7 +458,7 @@ class Scenario:
                 f"step = {toml_value(g.step_s)}  # s", f"tableau = {toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]
         f = self.forces
         b = lambda x: "true" if x else "false"  # noqa: E731
-        out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}",
+        out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}", f"sun_monopole = {b(f.sun_monopole)}",
                 f"gm_earth = {toml_value(f.gm_earth)}  # m^3/s^2", f"earth_degree = {f.earth_degree}",
                 f"earth_degree2_extended = {b(f.earth_degree2_extended)}",
                 f"ephemeris = {toml_str(f.ephemeris)}",
@@ -555,15 +474,34 @@ class Scenario:
         out += ["[spacecraft]", f"d_tm = {toml_value(s.d_tm_m)}  # m", f"d_p = {toml_value(s.d_p_m)}  # m",
                 f"tm_axis = {toml_str(s.tm_axis)}",
                 f"self_gravity = {toml_value(s.self_gravity)}  # m/s^2 in OA_l",
-                f"self_gravity_common = {toml_value(s.self_gravity_common)}  # m/s^2 in S", ""]
+                f"self_gravity_common = {toml_value(s.self_gravity_common)}  # m/s^2 in S"]
+        if s.self_gravity_center is not None:
+            out += [f"self_gravity_center = {toml_value(s.self_gravity_center)}  # m/s^2 toward the centre"]
+        if s.self_gravity_center_span is not None:
+            out += ["self_gravity_center_span = [" + ", ".join(toml_str(x) for x in s.self_gravity_center_span) + "]"]
+        out += [""]
+        i = self.initial
+        out += ["[initial]", f"axes = {toml_str(i.axes)}", f"design = {toml_str(i.design)}",
+                f"arm_length = {toml_value(i.arm_length_m)}  # m", f"displacement_deg = {toml_value(i.displacement_deg)}",
+                f"rotation = {toml_str(i.rotation)}", f"semi_major_axis = {toml_value(i.semi_major_axis_m)}  # m",
+                "oem = [" + ", ".join(toml_str(x) for x in i.oem) + "]", ""]
         c = self.constellation
         out += ["[constellation]", f"pointing = {toml_str(c.pointing)}", f"control = {toml_str(c.control)}",
                 f"free_tms = {b(c.free_tms)}", ""]
         for sat in self.satellites:
+            out += ["[[satellites]]", f"name = {toml_str(sat.name)}"]
+            if i.derived:  # the states follow from [initial]
+                out += [""]
+                continue
             with localcontext() as ctx:
                 ctx.prec = _EXACT
+                if sat.cartesian:
+                    r_km = tuple(x / 1000 for x in sat.r_m)
+                    v_kmps = tuple(x / 1000 for x in sat.v_mps)
+                    out += [f"r_km = {toml_value(r_km)}", f"v_kmps = {toml_value(v_kmps)}", ""]
+                    continue
                 a_km = sat.a_m / 1000
-            out += ["[[satellites]]", f"name = {toml_str(sat.name)}", f"a_km = {toml_value(a_km)}", f"e = {toml_value(sat.e)}",
+            out += [f"a_km = {toml_value(a_km)}", f"e = {toml_value(sat.e)}",
                     f"i_deg = {toml_value(sat.i_deg)}", f"raan_deg = {toml_value(sat.raan_deg)}",
                     f"argp_deg = {toml_value(sat.argp_deg)}", f"nu_deg = {toml_value(sat.nu_deg)}", ""]
         return "\n".join(out)

@@ -10,6 +10,7 @@ kept as ``Decimal``.  Errors are :class:`~tqdyn.scenario.config.ScenarioError`.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import os
 import re
@@ -25,6 +26,7 @@ from .config import (
     _NOVALUE,
     ConstellationConfig,
     ForcesConfig,
+    InitialConfig,
     IntegratorConfig,
     RunConfig,
     SatelliteConfig,
@@ -92,22 +94,31 @@ _BOOL_OR_STR = "boolean or string"  # forces.eop: true / false or a source name
 _ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
-    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "central_body": _STR, "extends": _STR},
+    "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "epoch_tdb": _EPOCH, "central_body": _STR,
+                 "extends": _STR},
     "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
-    "forces": {"earth_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
+    "forces": {"earth_monopole": _BOOL, "sun_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
                "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "third_bodies_gcrs": _BOOL, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
                "atmospheric_tides": _BOOL, "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
                "earth_field_indirect": _BOOL, "eop": _BOOL_OR_STR},
-    "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY},
+    "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY,
+                   "self_gravity_center": _ANY, "self_gravity_center_span": _ANY},
+    "initial": {"axes": _STR, "design": _STR, "arm_length": _NUM, "displacement_deg": _NUM, "rotation": _STR,
+                "semi_major_axis": _NUM, "oem": _STRLIST},
     "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
 }
 _SAT_SCHEMA: dict[str, str] = {
     "name": _STR, "a_km": _NUM, "e": _NUM, "i_deg": _NUM, "raan_deg": _NUM, "argp_deg": _NUM, "nu_deg": _NUM,
+    "r_km": _ANY, "v_kmps": _ANY,
 }
+_ELEMENT_KEYS = ("a_km", "e", "i_deg", "raan_deg", "argp_deg", "nu_deg")
 _TOP_KEYS = tuple(_SCHEMA) + ("satellites",)
+#: Epoch keys: one of them sets the epoch (a file or override that sets one drops the other).
+_EPOCH_KEYS = ("epoch_utc", "epoch_tdb")
 # TOML key -> dataclass field, where they differ
-_FIELD_OF = {"step": "step_s", "duration": "duration_s", "d_tm": "d_tm_m", "d_p": "d_p_m"}
+_FIELD_OF = {"step": "step_s", "duration": "duration_s", "d_tm": "d_tm_m", "d_p": "d_p_m",
+             "arm_length": "arm_length_m", "semi_major_axis": "semi_major_axis_m"}
 
 
 def _typed(value: Any, kind: str, name: str) -> Any:
@@ -174,10 +185,39 @@ def _build(cls, prefix: str, raw: Mapping[str, Any], schema: Mapping[str, str]):
         raise ScenarioError(f"{prefix}.{toml_key}", value, err.problem, err.allowed) from None
 
 
-def _build_satellite(raw: Any, k: int) -> SatelliteConfig:
+def _km_vector(value: Any, name: str) -> tuple:
+    """3 finite numbers in km (or km/s) -> exact Decimals in m (m/s)."""
+    ok = isinstance(value, list) and len(value) == 3 and all(
+        isinstance(x, (int, Decimal)) and not isinstance(x, bool) and Decimal(x).is_finite() for x in value)
+    _require(ok, name, value, "is not 3 finite numbers", "an array of 3 finite numbers")
+    with localcontext() as ctx:
+        ctx.prec = _EXACT
+        return tuple(Decimal(x) * 1000 for x in value)
+
+
+def _build_satellite(raw: Any, k: int, derived: bool) -> SatelliteConfig | str:
+    """A [[satellites]] table: a SatelliteConfig (elements or r, v), or only
+    its name when ``derived`` (the states come from [initial])."""
     prefix = f"satellites.{k}"
     _check_table(raw, prefix, tuple(_SAT_SCHEMA))
-    _require("a_km" in raw, f"{prefix}.a_km", _NOVALUE, "is missing", "a semi-major axis in km (> 0)")
+    if derived:
+        extra = [key for key in raw if key != "name"]
+        _require(not extra, f"{prefix}.{extra[0] if extra else ''}", raw.get(extra[0]) if extra else None,
+                 "is given, but the states come from [initial] (design or oem)",
+                 "only name in [[satellites]], or initial.design = \"none\" and no initial.oem")
+        return _typed(raw.get("name", f"Sat{k}"), _STR, f"{prefix}.name")
+    cart = "r_km" in raw or "v_kmps" in raw
+    if cart:
+        given = [key for key in _ELEMENT_KEYS if key in raw]
+        _require(not given, f"{prefix}.{given[0] if given else 'a_km'}", raw.get(given[0]) if given else None,
+                 "is given together with r_km / v_kmps", "either Keplerian elements or a Cartesian state")
+        for key in ("r_km", "v_kmps"):
+            _require(key in raw, f"{prefix}.{key}", _NOVALUE, "is missing", "r_km and v_kmps, 3 numbers each")
+        name = _typed(raw.get("name", f"Sat{k}"), _STR, f"{prefix}.name")
+        return SatelliteConfig(name=name, r_m=_km_vector(raw["r_km"], f"{prefix}.r_km"),
+                               v_mps=_km_vector(raw["v_kmps"], f"{prefix}.v_kmps"))
+    _require("a_km" in raw, f"{prefix}.a_km", _NOVALUE, "is missing",
+             "a semi-major axis in km (> 0), or a Cartesian state r_km, v_kmps")
     vals = {key: _typed(raw[key], kind, f"{prefix}.{key}") for key, kind in _SAT_SCHEMA.items() if key in raw}
     a_km = vals.pop("a_km")
     with localcontext() as ctx:
@@ -205,17 +245,34 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     forces = _build(ForcesConfig, "forces", raw.get("forces", {}), _SCHEMA["forces"])
     craft = _build(SpacecraftConfig, "spacecraft", raw.get("spacecraft", {}), _SCHEMA["spacecraft"])
     const = _build(ConstellationConfig, "constellation", raw.get("constellation", {}), _SCHEMA["constellation"])
+    initial_raw = dict(raw.get("initial", {}))
     sats_raw = raw.get("satellites")
-    _require(sats_raw is not None, "satellites", _NOVALUE, "is missing", "at least one [[satellites]] table")
-    _require(isinstance(sats_raw, list) and len(sats_raw) >= 1, "satellites", sats_raw, "is not a non-empty array of tables",
-             "at least one [[satellites]] table")
-    sats = tuple(_build_satellite(s, k) for k, s in enumerate(sats_raw, start=1))
+    derived = initial_raw.get("design", "none") != "none" or bool(initial_raw.get("oem"))
+    if derived and sats_raw is None:
+        sats_raw = []
+    else:
+        _require(sats_raw is not None, "satellites", _NOVALUE, "is missing", "at least one [[satellites]] table")
+        _require(isinstance(sats_raw, list) and len(sats_raw) >= 1, "satellites", sats_raw,
+                 "is not a non-empty array of tables", "at least one [[satellites]] table")
+    sats = tuple(_build_satellite(s, k, derived) for k, s in enumerate(sats_raw, start=1))
+    initial = _build(InitialConfig, "initial", initial_raw, _SCHEMA["initial"])
+    if derived:
+        initial = dataclasses.replace(initial, names=sats)
+        sats = ()
     name = _typed(meta.get("name", default_name), _STR, "scenario.name")
     desc = _typed(meta.get("description", ""), _STR, "scenario.description")
+    _require(not ("epoch_utc" in meta and "epoch_tdb" in meta), "scenario.epoch_tdb", meta.get("epoch_tdb"),
+             "is given together with scenario.epoch_utc", "one epoch: epoch_utc or epoch_tdb")
+    epoch_tdb = _typed(meta["epoch_tdb"], _EPOCH, "scenario.epoch_tdb") if "epoch_tdb" in meta else ""
     epoch = _typed(meta.get("epoch_utc", DEFAULT_EPOCH_UTC), _EPOCH, "scenario.epoch_utc")
+    if not epoch_tdb and "epoch_utc" not in meta and initial.oem:
+        from .initial import oem_first_common_epoch
+
+        epoch_tdb = oem_first_common_epoch(initial.oem)
     body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
-                    spacecraft=craft, constellation=const, satellites=sats, central_body=body)
+                    spacecraft=craft, constellation=const, satellites=sats, central_body=body,
+                    epoch_tdb=epoch_tdb, initial=initial)
 
 
 # --------------------------------------------------------------------------- overrides
@@ -266,6 +323,12 @@ def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
         table = raw.setdefault(sec, {})
         _require(isinstance(table, dict), sec, table, "is not a table", "a table")
         table[sub] = _parse_override_value(text, _SCHEMA[sec][sub])
+        if sec == "scenario" and sub in _EPOCH_KEYS:
+            for other in _EPOCH_KEYS:
+                if other != sub:
+                    table.pop(other, None)
+        if (sec, sub) == ("initial", "oem") and isinstance(table[sub], list):
+            table[sub] = [_abspath(x, Path.cwd()) for x in table[sub]]
 
 
 # --------------------------------------------------------------------------- public loaders
@@ -280,21 +343,41 @@ def builtin_scenarios() -> tuple[str, ...]:
     return tuple(sorted(p.name[: -len(".toml")] for p in _builtin_dir().iterdir() if p.name.endswith(".toml")))
 
 
-def loads_scenario(text: str, overrides: Sequence[str] = (), *, source: str = "<string>", default_name: str = "scenario") -> Scenario:
+def loads_scenario(text: str, overrides: Sequence[str] = (), *, source: str = "<string>", default_name: str = "scenario",
+                   base_dir: str | os.PathLike | None = None) -> Scenario:
     """Build a :class:`Scenario` from TOML ``text`` (see :func:`load_scenario` for overrides).
 
     ``source`` names the text in error messages; ``default_name`` is used when
-    the text has no ``scenario.name``.
+    the text has no ``scenario.name``; relative ``initial.oem`` paths are
+    relative to ``base_dir`` (default: the working directory; in a built-in
+    scenario, the package's data directory; in ``--set``, the working directory).
     """
     try:
         raw = tomllib.loads(text, parse_float=Decimal)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(source, problem=f"invalid TOML: {exc}", allowed="a TOML document (https://toml.io)") from None
+    _resolve_paths(raw, Path.cwd() if base_dir is None else Path(base_dir))
     raw = _resolve_extends(raw, source, ())
     if isinstance(overrides, str):
         overrides = (overrides,)
     _apply_overrides(raw, overrides)
     return _scenario_from_raw(raw, default_name)
+
+
+def _abspath(path: Any, base: Path) -> Any:
+    """``path`` made absolute against ``base`` (other values unchanged, for the validation to name)."""
+    return str(base / path) if isinstance(path, str) and path.strip() and not os.path.isabs(path) else path
+
+
+def _resolve_paths(raw: dict, base: Path) -> None:
+    """Relative ``initial.oem`` paths of a raw table, made absolute against ``base``."""
+    initial = raw.get("initial")
+    if isinstance(initial, dict) and isinstance(initial.get("oem"), list):
+        initial["oem"] = [_abspath(x, base) for x in initial["oem"]]
+
+
+def _data_dir() -> Path:
+    return Path(str(resources.files("tqdyn") / "data"))
 
 
 def _resolve_extends(raw: dict, source: str, chain: tuple[str, ...]) -> dict:
@@ -311,13 +394,20 @@ def _resolve_extends(raw: dict, source: str, chain: tuple[str, ...]) -> dict:
     _require(base_name not in chain, "scenario.extends", base_name, f"extends itself ({' -> '.join(chain)})",
              "a chain of built-in scenarios without cycles")
     text = (_builtin_dir() / f"{base_name}.toml").read_text(encoding="utf-8")
-    base = _resolve_extends(tomllib.loads(text, parse_float=Decimal), base_name, chain + (base_name,))
+    base_raw = tomllib.loads(text, parse_float=Decimal)
+    _resolve_paths(base_raw, _data_dir())
+    base = _resolve_extends(base_raw, base_name, chain + (base_name,))
     merged = {k: (dict(v) if isinstance(v, dict) else v) for k, v in base.items()}
     for key, value in raw.items():
         if isinstance(value, dict) and isinstance(merged.get(key), dict):
             merged[key].update(value)
         else:
             merged[key] = value
+    for k in _EPOCH_KEYS:
+        if k in meta:
+            for other in _EPOCH_KEYS:
+                if other != k and other not in meta:
+                    merged["scenario"].pop(other, None)
     merged["scenario"] = {k: v for k, v in merged["scenario"].items() if k != "extends"}
     merged["scenario"].setdefault("description", "")
     for k in ("name", "description"):
@@ -355,7 +445,8 @@ def load_scenario(name_or_path: str | os.PathLike | None = None, overrides: Sequ
     )
     if not looks_like_path and text_name in builtins:
         text = (_builtin_dir() / f"{text_name}.toml").read_text(encoding="utf-8")
-        return loads_scenario(text, overrides, source=f"built-in scenario {text_name!r}", default_name=text_name)
+        return loads_scenario(text, overrides, source=f"built-in scenario {text_name!r}", default_name=text_name,
+                              base_dir=_data_dir())
     path = Path(text_name)
     if not path.is_file():
         what = "is not a file" if path.exists() else ("does not exist" if looks_like_path else "is neither a built-in scenario nor a file")
@@ -364,4 +455,4 @@ def load_scenario(name_or_path: str | os.PathLike | None = None, overrides: Sequ
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError("scenario", text_name, f"cannot be read ({exc})", "a readable UTF-8 .toml file") from None
-    return loads_scenario(text, overrides, source=str(path), default_name=path.stem)
+    return loads_scenario(text, overrides, source=str(path), default_name=path.stem, base_dir=path.resolve().parent)

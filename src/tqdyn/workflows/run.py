@@ -74,9 +74,8 @@ def _eop_of(scen, model):
 
 def _run_span(scen):
     from ..astro.eop_sources import run_span_mjd
-    from ..astro.timescales import Epoch
 
-    return run_span_mjd(Epoch.from_utc(scen.epoch_utc), float(scen.run.duration_s))
+    return run_span_mjd(scen.epoch, float(scen.run.duration_s))
 
 
 def eop_attrs(scen, model=None) -> dict:
@@ -111,6 +110,7 @@ def output_attrs(scen, model=None) -> dict:
     return {
         "scenario": scen.to_toml(),
         "epoch_utc": scen.epoch_utc,
+        **({"epoch_tdb": scen.epoch_tdb} if scen.epoch_tdb else {}),
         "origin": ref.origin,
         "frame": ref.frame,
         "time_scale": ref.time_scale,

@@ -12,7 +12,7 @@ import numpy as np
 from ... import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
 from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, ReferenceSystem
-from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
+from .schema import (field_frame, _COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, row_fields)
 
 __all__ = ["Trajectory", "read_trajectory"]
@@ -103,6 +103,16 @@ class Trajectory:
         return ReferenceSystem(*key, description="as recorded in the file")
 
     @property
+    def epoch(self):
+        """The epoch of t = 0 as a :class:`tqdyn.astro.timescales.Epoch`:
+        from the root attribute ``epoch_tdb`` when present (exact), else
+        from ``epoch_utc``."""
+        from ...astro.timescales import Epoch
+
+        tdb = self.attrs.get("epoch_tdb")
+        return Epoch.from_tdb(str(tdb)) if tdb else Epoch.from_utc(str(self.attrs["epoch_utc"]))
+
+    @property
     def fields(self) -> tuple[str, ...]:
         """Fields present in the file, in canonical :data:`FIELDS` order."""
         return tuple(f for f in FIELDS if f in self._data)
@@ -185,7 +195,8 @@ class Trajectory:
             spec = FIELDS[f]
             dims = (("time",) if spec.time_dependent else ()) + spec.dims
             name = f.replace("/", "_")
-            attrs = {"units": spec.unit, "frame": spec.frame, "description": spec.description}
+            attrs = {"units": spec.unit, "frame": field_frame(spec, self.reference.time_scale, self.reference.frame),
+                     "description": spec.description}
             arrays = self._data[f]
             if len(arrays) == 2:
                 val, res = np_two_sum(*arrays)

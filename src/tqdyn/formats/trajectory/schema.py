@@ -88,6 +88,16 @@ def _f(kind, shape, dims, unit, frame, description, time_dependent=True):
     return FieldSpec(kind, tuple(shape), unit, frame, description, time_dependent, tuple(dims))
 
 
+def field_frame(spec: FieldSpec, time_scale: str, frame: str) -> str:
+    """The ``frame`` attribute of a field in a file whose root attributes say
+    ``time_scale`` and ``frame``: FIELDS's "time_scale" is the file's time
+    scale, its "GCRS" (the vectors of the central body's system) the file's
+    frame ("GCRS" or "BCRS"); other frames (S, OA_l ...) as FIELDS says."""
+    if spec.frame == "time_scale":
+        return time_scale
+    return frame if spec.frame == "GCRS" else spec.frame
+
+
 FIELDS: dict[str, FieldSpec] = {
     "t": _f("dd", (), (), "s", "time_scale",
             "time since epoch_utc in the root attribute time_scale (TT: seconds of TT since the epoch's TT)"),
@@ -136,11 +146,14 @@ ROOT_ATTRS: dict[str, str] = {
     "tqdyn_version": "str, version of tqdyn that wrote the file",
     "scenario": "str, the resolved scenario as TOML text",
     "epoch_utc": "str, ISO 8601 UTC label of t = 0",
-    "origin": 'str, the central body at the origin of the coordinates: "earth" (absent in files '
+    "origin": 'str, the central body at the origin of the coordinates: "earth" or "sun" (absent in files '
               'written before version 0.2: "earth")',
-    "frame": 'str, the axes and reference system of the vectors: "GCRS"',
-    "time_scale": 'str, the time scale of t: "TT" (format version 1: "TDB", i.e. TT-elapsed seconds labelled '
-                  'TDB)',
+    "frame": 'str, the axes and reference system of the vectors: "GCRS" (origin "earth") or "BCRS" (origin '
+             '"sun": Sun-centred BCRS, ICRF axes)',
+    "time_scale": 'str, the time scale of t: "TT" (geocentric), "TDB" (heliocentric; format version 1: "TDB" '
+                  'means TT-elapsed seconds labelled TDB)',
+    "epoch_tdb": "str, ISO 8601 TDB epoch of t = 0 when the scenario gave it in TDB (exact; epoch_utc is then its "
+                 "label rounded to 1 us) (extension)",
     "precision": 'str, "dd" | "float64"',
     "step_s": "float, integrator / output step in s",
     "integrator": "str, integrator name",

@@ -20,7 +20,7 @@ from typing import Any, Mapping, Sequence
 import h5py
 import numpy as np
 
-from .schema import FIELDS, FieldSpec, OutputError, _check_attrs, _fmt_shape, _spec, _symbolic
+from .schema import FIELDS, FieldSpec, OutputError, _check_attrs, _fmt_shape, _spec, _symbolic, field_frame
 
 __all__ = ["check_writable", "TrajectoryWriter"]
 
@@ -194,6 +194,7 @@ class TrajectoryWriter:
         self._chunk_rows = max(1, min(_DEFAULT_CHUNK_ROWS, self._expected or _DEFAULT_CHUNK_ROWS))
         full_attrs = _check_attrs(attrs)
         self._time_scale = full_attrs["time_scale"]
+        self._frame = full_attrs["frame"]
 
         self._rows = 0  # rows appended (on disk + buffered)
         self._rows_on_disk = 0
@@ -248,8 +249,9 @@ class TrajectoryWriter:
 
     def _field_attrs(self, obj, spec: FieldSpec) -> None:
         obj.attrs["units"] = spec.unit
-        # the time field's "frame" is the file's time scale (FIELDS says "time_scale")
-        obj.attrs["frame"] = self._time_scale if spec.frame == "time_scale" else spec.frame
+        # the time field's "frame" is the file's time scale (FIELDS says "time_scale"), the
+        # vectors' is the file's frame (FIELDS says "GCRS", the geocentric one)
+        obj.attrs["frame"] = field_frame(spec, self._time_scale, self._frame)
         obj.attrs["description"] = spec.description
 
     def _require_open(self, what: str) -> h5py.File:
@@ -478,6 +480,8 @@ class TrajectoryWriter:
         self._state["h5"] = h5
         ts = h5.attrs.get("time_scale", "TT")
         self._time_scale = ts.decode() if isinstance(ts, bytes) else str(ts)
+        fr = h5.attrs.get("frame", "GCRS")
+        self._frame = fr.decode() if isinstance(fr, bytes) else str(fr)
         self._fields = tuple(f for f in FIELDS if f in h5)
         self._tfields = tuple(f for f in self._fields if FIELDS[f].time_dependent)
         self._static_pending = set()

@@ -1,0 +1,198 @@
+"""The initial states of a scenario: :class:`SatelliteConfig` (one
+satellite's Keplerian elements or Cartesian state) and :class:`InitialConfig`
+(section ``[initial]``: their axes, or an equal-arm constellation design, or
+CCSDS OEM files), and :func:`derived_satellites`, which turns a design or OEM
+files into Cartesian satellites at the scenario epoch."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from decimal import Decimal
+
+from ..astro.timescales import Epoch
+from .values import ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
+
+__all__ = ["AU_M", "INITIAL_AXES", "INITIAL_DESIGNS", "ROTATIONS", "InitialConfig", "SatelliteConfig",
+           "derived_satellites", "epoch_from_label", "oem_first_common_epoch"]
+
+
+@dataclass(frozen=True)
+class SatelliteConfig:
+    """Initial state of one satellite at the scenario epoch, relative to the
+    central body, in the axes of ``initial.axes`` (:class:`InitialConfig`).
+
+    Either osculating Keplerian elements: ``a_m`` semi-major axis [m] (> 0),
+    ``e`` eccentricity [-] (0 <= e < 1), ``i_deg``, ``raan_deg``,
+    ``argp_deg``, ``nu_deg``: inclination, longitude (right ascension) of
+    the ascending node, argument of pericentre, true anomaly [deg], finite;
+    or a Cartesian state: ``r_m`` position [m] and ``v_mps`` velocity [m/s],
+    3 numbers each (then the elements are None).  All numbers are exact
+    ``Decimal``.
+    """
+
+    name: str
+    a_m: Decimal | None = None
+    e: Decimal | None = None
+    i_deg: Decimal | None = None
+    raan_deg: Decimal | None = None
+    argp_deg: Decimal | None = None
+    nu_deg: Decimal | None = None
+    r_m: tuple | None = None
+    v_mps: tuple | None = None
+
+    def __post_init__(self) -> None:
+        _require(isinstance(self.name, str) and self.name.strip() != "", "satellite.name", self.name, "is not a non-empty string", "a non-empty string")
+        elements = ("a_m", "e", "i_deg", "raan_deg", "argp_deg", "nu_deg")
+        if self.r_m is not None or self.v_mps is not None:
+            given = [f for f in elements if getattr(self, f) is not None]
+            _require(not given, f"satellite.{given[0] if given else 'a_m'}", getattr(self, given[0]) if given else None,
+                     "is given together with a Cartesian state", "either elements or r and v")
+            for f, unit in (("r_m", "m"), ("v_mps", "m/s")):
+                _require(getattr(self, f) is not None, f"satellite.{f}", None, "is missing",
+                         f"3 finite numbers [{unit}] (a Cartesian state needs both r and v)")
+                _set(self, f, _num_array(getattr(self, f), f"satellite.{f}", ((3,),), unit))
+            return
+        _require(self.a_m is not None, "satellite.a_m", None, "is missing", "a > 0 m (or a Cartesian state r, v)")
+        for f in elements:
+            _set(self, f, _to_decimal(Decimal(0) if getattr(self, f) is None else getattr(self, f), f"satellite.{f}"))
+        _require(self.a_m > 0, "satellite.a_m", self.a_m, "is not positive", "a > 0 m")
+        _require(0 <= self.e < 1, "satellite.e", self.e, "is not an elliptic eccentricity", "0 <= e < 1")
+
+    @property
+    def cartesian(self) -> bool:
+        """True when the state is given as r, v (else Keplerian elements)."""
+        return self.r_m is not None
+
+
+INITIAL_AXES = ("equatorial", "ecliptic")
+INITIAL_DESIGNS = ("none", "keplerian")
+ROTATIONS = ("clockwise", "counterclockwise")
+AU_M = Decimal(149597870700)
+
+
+def epoch_from_label(text: str, name: str) -> Epoch:
+    """An :class:`Epoch` from an ISO date with an optional " UTC" (default)
+    or " TDB" suffix; ScenarioError naming ``name`` otherwise."""
+    parts = text.strip().rsplit(" ", 1)
+    scale = parts[1].upper() if len(parts) == 2 and parts[1].upper() in ("UTC", "TDB") else "UTC"
+    iso = parts[0] if len(parts) == 2 and parts[1].upper() in ("UTC", "TDB") else text
+    try:
+        return Epoch.from_tdb(iso) if scale == "TDB" else Epoch.from_utc(iso)
+    except ValueError as exc:
+        raise ScenarioError(name, text, f"is not a valid {scale} date ({getattr(exc, 'reason', exc)})",
+                            'an ISO date YYYY-MM-DDTHH:MM:SS[.fff] with an optional " UTC" or " TDB" suffix') from None
+
+
+@dataclass(frozen=True)
+class InitialConfig:
+    """Where the satellites' initial states come from (TOML section ``[initial]``).
+
+    ``axes``: the axes of the satellites' elements or Cartesian states,
+    "equatorial" (ICRF axes: the GCRS or BCRS of the run) or "ecliptic"
+    (the IAU 2006 mean ecliptic and equinox of J2000.0, which includes the
+    frame bias; rotated to ICRF exactly).
+    ``design``: "none" (the [[satellites]] tables give the states) or
+    "keplerian": the equal-arm Keplerian constellation of
+    :mod:`tqdyn.astro.constellation_design` (heliocentric, 3 satellites)
+    with ``arm_length_m`` [m], ``displacement_deg`` (mean angle from the
+    Earth, negative trailing), ``rotation`` ("clockwise" or
+    "counterclockwise") and ``semi_major_axis_m`` [m] (default 1 au).
+    ``oem``: CCSDS OEM files, one per satellite in satellite order (the
+    states interpolated at the epoch as each file says; default epoch the
+    files' first common record).  ``names``: satellite names for a design
+    or OEM files (default Sat1, Sat2, ...).
+    """
+
+    axes: str = "equatorial"
+    design: str = "none"
+    arm_length_m: Decimal = Decimal("2.5e9")
+    displacement_deg: Decimal = Decimal(-20)
+    rotation: str = "clockwise"
+    semi_major_axis_m: Decimal = AU_M
+    oem: tuple[str, ...] = ()
+    names: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        _require_choice(self.axes, "initial.axes", INITIAL_AXES)
+        _require_choice(self.design, "initial.design", INITIAL_DESIGNS)
+        _require_choice(self.rotation, "initial.rotation", ROTATIONS)
+        for f in ("arm_length_m", "displacement_deg", "semi_major_axis_m"):
+            _set(self, f, _to_decimal(getattr(self, f), f"initial.{f}"))
+        _require(self.semi_major_axis_m > 0, "initial.semi_major_axis", self.semi_major_axis_m, "is not positive",
+                 "a > 0 m")
+        _require(0 < self.arm_length_m < self.semi_major_axis_m / 10, "initial.arm_length", self.arm_length_m,
+                 "is out of range", "0 < L < a/10 (the design expands in L/2a)")
+        oem = tuple(self.oem)
+        _require(all(isinstance(x, str) and x.strip() for x in oem), "initial.oem", list(oem),
+                 "is not a list of file names", "a list of OEM file paths, one per satellite")
+        _set(self, "oem", oem)
+        _require(not (oem and self.design != "none"), "initial.oem", list(oem),
+                 f"is given together with initial.design = {self.design!r}", 'design = "none" with OEM files')
+        _set(self, "names", tuple(self.names))
+
+    @property
+    def derived(self) -> bool:
+        """True when the satellites' states follow from a design or OEM files."""
+        return self.design != "none" or bool(self.oem)
+
+
+
+
+def _decimal_vector(values) -> tuple:
+    """3 exact Decimals from mpmath numbers or floats (mpmath: 40 significant digits)."""
+    return tuple(Decimal(str(x)) for x in values)
+
+
+def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) -> tuple[SatelliteConfig, ...]:
+    """Cartesian satellites [m, m/s; relative to the central body, ICRF
+    axes] at ``epoch`` from ``initial.design`` or ``initial.oem``; named
+    ``initial.names`` (default Sat1, Sat2, ...).  ScenarioError naming the
+    key for a file that cannot be read or does not cover the epoch."""
+    if initial.design == "keplerian":
+        import mpmath
+
+        from ..astro.constellation_design import keplerian_constellation
+        from ..forces.heliocentric import SunMonopole
+
+        with mpmath.workdps(40):
+            try:
+                states = keplerian_constellation(
+                    arm_length=initial.arm_length_m, displacement_deg=initial.displacement_deg,
+                    rotation=initial.rotation, semi_major_axis=initial.semi_major_axis_m,
+                    gm=SunMonopole().gm, epoch_tdb_jd=epoch.tdb)
+            except ValueError as exc:
+                raise ScenarioError("initial.design", initial.design, f"cannot be built ({exc})",
+                                    "arm_length, displacement_deg, rotation, semi_major_axis in range") from None
+            rv = [(_decimal_vector(r), _decimal_vector(v)) for r, v in states]
+    else:
+        from ..readers.oem import oem_states_icrf
+
+        rv = []
+        for k, path in enumerate(initial.oem, start=1):
+            try:
+                r, v = oem_states_icrf(path, epoch.tdb)
+            except (OSError, ValueError) as exc:
+                raise ScenarioError(f"initial.oem.{k}", path, f"cannot give a state at {epoch.iso} ({exc})",
+                                    "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB) covering "
+                                    "the epoch") from None
+            rv.append((_decimal_vector(r), _decimal_vector(v)))
+    names = list(initial.names) + [f"Sat{k}" for k in range(len(initial.names) + 1, len(rv) + 1)]
+    if len(names) > len(rv):
+        raise ScenarioError("satellites", names, f"names {len(names)} satellites, the initial states give {len(rv)}",
+                            f"at most {len(rv)} [[satellites]] names")
+    return tuple(SatelliteConfig(name=n, r_m=r, v_mps=v) for n, (r, v) in zip(names, rv))
+
+
+def oem_first_common_epoch(paths) -> str:
+    """The TDB ISO date of the OEM files' first common record (the latest
+    of their first epochs), the default epoch of ``initial.oem``."""
+    from ..readers.oem import oem_first_epoch_tdb
+
+    firsts = []
+    for k, path in enumerate(paths, start=1):
+        try:
+            firsts.append(oem_first_epoch_tdb(path))
+        except (OSError, ValueError) as exc:
+            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
+                                "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
+    return max(firsts, key=lambda x: x[0])[1]

@@ -1,0 +1,147 @@
+"""Validation helpers of the scenario dataclasses: :class:`ScenarioError`
+(one line ``"<field>: <value> <problem>; allowed: <what is allowed>"``) and
+the exact value conversions (Decimal) shared by :mod:`.config`,
+:mod:`.initial` and :mod:`.loader`."""
+
+from __future__ import annotations
+
+import datetime as _dt
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+from typing import Any, Sequence
+
+__all__ = ["ScenarioError"]
+
+_EXACT = 200  # Decimal working precision for exact unit conversions
+
+_NOVALUE = object()
+
+
+# --------------------------------------------------------------------------- errors
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, Decimal):
+        return str(value)
+    if isinstance(value, Path):
+        return repr(str(value))
+    return repr(value)
+
+
+class ScenarioError(ValueError):
+    """Invalid scenario: one line ``"<field>: <value> <problem>; allowed: <allowed>"``.
+
+    Attributes ``field`` (dotted TOML path such as ``"satellites.2.e"``),
+    ``value`` (the offending value, or ``None``), ``problem`` and ``allowed``.
+    """
+
+    def __init__(self, field: str, value: Any = _NOVALUE, problem: str = "", allowed: str | None = None):
+        self.field = field
+        self.value = None if value is _NOVALUE else value
+        self.problem = problem
+        self.allowed = allowed
+        parts = [f"{field}:"]
+        if value is not _NOVALUE:
+            parts.append(_fmt(value))
+        if problem:
+            parts.append(problem)
+        msg = " ".join(parts)
+        if allowed:
+            msg += f"; allowed: {allowed}"
+        super().__init__(msg.replace("\n", " "))
+
+
+def _one_of(options: Sequence[str]) -> str:
+    return ", ".join(repr(o) for o in options)
+
+
+# --------------------------------------------------------------------------- value helpers
+
+
+def _to_decimal(value: Any, name: str) -> Decimal:
+    """Coerce int/Decimal/str/float to a finite Decimal (for direct Python construction)."""
+    if isinstance(value, bool):
+        raise ScenarioError(name, value, "is a boolean", "a finite number")
+    if isinstance(value, Decimal):
+        d = value
+    elif isinstance(value, int):
+        d = Decimal(value)
+    elif isinstance(value, float):
+        d = Decimal(repr(value))
+    elif isinstance(value, str):
+        try:
+            d = Decimal(value.strip())
+        except InvalidOperation:
+            raise ScenarioError(name, value, "is not a number", "a finite number") from None
+    else:
+        raise ScenarioError(name, value, f"has type {type(value).__name__}", "a finite number")
+    if not d.is_finite():
+        raise ScenarioError(name, value, "is not finite", "a finite number")
+    return d
+
+
+def _require(cond: bool, name: str, value: Any, problem: str, allowed: str) -> None:
+    if not cond:
+        raise ScenarioError(name, value, problem, allowed)
+
+
+def _require_choice(value: Any, name: str, options: Sequence[str]) -> None:
+    _require(isinstance(value, str) and value in options, name, value, "is not a valid choice", _one_of(options))
+
+
+def _set(obj: Any, name: str, value: Any) -> None:
+    object.__setattr__(obj, name, value)
+
+
+# --------------------------------------------------------------------------- TOML type names (messages)
+
+
+def _a(noun: str) -> str:
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
+def _toml_type(value: Any) -> str:
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, int):
+        return "integer"
+    if isinstance(value, (Decimal, float)):
+        return "float"
+    if isinstance(value, str):
+        return "string"
+    if isinstance(value, list):
+        return "array"
+    if isinstance(value, dict):
+        return "table"
+    if isinstance(value, (_dt.date, _dt.time)):
+        return "date-time"
+    return type(value).__name__
+
+
+
+
+def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: str) -> tuple:
+    """Nested tuples of Decimal with one of ``shapes`` (ScenarioError otherwise)."""
+    allowed = " or ".join(str(tuple(s)) for s in shapes)
+    allowed = f"an array of shape {allowed} of finite numbers [{unit}]"
+
+    def conv(x, depth):
+        if isinstance(x, (list, tuple)):
+            return tuple(conv(e, depth + 1) for e in x)
+        if isinstance(x, bool) or not isinstance(x, (int, float, Decimal)):
+            raise ScenarioError(name, value, f"contains {_a(_toml_type(x))}", allowed)
+        d = Decimal(str(x)) if isinstance(x, float) else Decimal(x)
+        _require(d.is_finite(), name, value, "is not finite", allowed)
+        return d
+
+    arr = conv(value, 0)
+
+    def shape(x):
+        if not isinstance(x, tuple):
+            return ()
+        inner = {shape(e) for e in x}
+        return (len(x),) + inner.pop() if len(inner) == 1 else (len(x), -1)
+
+    _require(isinstance(arr, tuple) and shape(arr) in [tuple(s) for s in shapes], name,
+             value, "has the wrong shape", allowed)
+    return arr
