@@ -35,22 +35,17 @@ MODE_COUPLED = 1
 MODE_FREE_TM = 2
 
 # cpar layout (float64)
-
-# cpar layout (float64)
 CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
 CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
 CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
 CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
 CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_TD = 40, 41, 42, 43   # jerk model (see _jerk_perturbation)
-CP_LEN = 44
-#: time-only inputs of the coupled system, appended to the force model's:
-#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
+CP_SGC = 44        # tdat column of the self-gravity toward the constellation centre [m/s^2], -1 if off
+CP_LEN = 45
 #: time-only inputs of the coupled system, appended to the force model's:
 #: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
 SYSTEM_TDAT_BODIES = ("moon", "sun")
 N_SYSTEM_TDAT = 12
-
-# aux layout per satellite (float64), AX_SAT values each
 
 # aux layout per satellite (float64), AX_SAT values each
 AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
@@ -61,8 +56,6 @@ AX_SAT = AX_TM + 2 * AX_TMLEN
 AUX_LEN = 3 * AX_SAT
 
 # float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
-
-# float64 work: a tuple of small arrays (indexed, never sliced, in the hot path)
 _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
               ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
               ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
@@ -70,7 +63,8 @@ _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), 
 
 
 def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
-              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1) -> np.ndarray:
+              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1,
+              centre_column=-1) -> np.ndarray:
     """Pack the constellation parameters for :func:`system_rhs`.
 
     mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
@@ -82,7 +76,9 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_
     gm_moon, gm_sun : [m^3/s^2], j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth:
     the jerk model of the local pointing laws (0 = term absent);
     tdat_offset : column of the system's time-only inputs (Moon, Sun states,
-    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none.
+    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none;
+    centre_column : column in tdat of the magnitude [m/s^2] of the
+    self-gravity toward the constellation centre (positive toward it), -1 if off.
     """
     p = np.zeros(CP_LEN)
     p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
@@ -94,6 +90,7 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_
     if sg_s is not None:
         p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
     p[CP_GM_MOON], p[CP_GM_SUN], p[CP_J2K], p[CP_TD] = gm_moon, gm_sun, j2k, tdat_offset
+    p[CP_SGC] = centre_column
     return p
 
 

@@ -79,7 +79,8 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     else:
         result = propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
                                   start, checkpoint, checkpoint_every, system)
-    if [t.name for t in model.terms] == ["earth_monopole"] and not system.coupled:
+    if [t.name for t in model.terms] in (["earth_monopole"], ["sun_monopole"]) and not system.coupled \
+            and system.centre_ramp is None:
         e0 = two_body_energy(result.y0, model.terms[0].gm)
         e1 = two_body_energy(result.y_final, model.terms[0].gm)
         with mpmath.workdps(60):

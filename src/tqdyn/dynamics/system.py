@@ -24,7 +24,7 @@ from ..forces.earth import EarthField
 from ..forces.model import ForceModel, _ephemeris, build_force_model
 from . import layout as _lay
 
-__all__ = ["System", "build_system", "self_gravity_oa"]
+__all__ = ["System", "build_system", "centre_ramp", "self_gravity_oa"]
 
 
 @dataclass(frozen=True)
@@ -41,12 +41,14 @@ class System:
     coupled: bool
     free_tms: bool
     ephemeris: object = None
+    centre_ramp: tuple | None = None
 
     def with_inputs(self, model: ForceModel):
         """The force model, extended by the system's own time-only inputs
         (the Moon's and Sun's states for the jerk of the local pointing
-        laws) when it needs any; see :class:`_SystemInputs`."""
-        if self.ephemeris is None or isinstance(model, _SystemInputs):
+        laws; the magnitude of the self-gravity toward the constellation
+        centre) when it needs any; see :class:`_SystemInputs`."""
+        if (self.ephemeris is None and self.centre_ramp is None) or isinstance(model, _SystemInputs):
             return model
         return _SystemInputs(model, self)
 
@@ -61,7 +63,8 @@ class _SystemInputs:
     def __init__(self, model: ForceModel, system: System):
         self._model = model
         self._system = system
-        self.n_tdat = model.n_tdat + _lay.N_SYSTEM_TDAT
+        self.n_tdat = (model.n_tdat + (_lay.N_SYSTEM_TDAT if system.ephemeris is not None else 0)
+                       + (1 if system.centre_ramp is not None else 0))
 
     def __getattr__(self, name):
         return getattr(self._model, name)
@@ -71,11 +74,23 @@ class _SystemInputs:
         return True
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
-        base = self._model.precompute(epoch, t_hi, t_lo)
-        jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
-        pos, vel = self._system.ephemeris.geocentric_states(_lay.SYSTEM_TDAT_BODIES, jd1, jd2, velocity=True)
-        extra = np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (_lay.N_SYSTEM_TDAT,))
-        return np.concatenate([base, extra], axis=-1)
+        cols = [self._model.precompute(epoch, t_hi, t_lo)]
+        if self._system.ephemeris is not None:
+            jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
+            pos, vel = self._system.ephemeris.geocentric_states(_lay.SYSTEM_TDAT_BODIES, jd1, jd2, velocity=True)
+            cols.append(np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (_lay.N_SYSTEM_TDAT,)))
+        if self._system.centre_ramp is not None:
+            cols.append(centre_ramp(self._system.centre_ramp, np.asarray(t_hi) + np.asarray(t_lo))[..., None])
+        return np.concatenate(cols, axis=-1)
+
+
+def centre_ramp(ramp, t) -> np.ndarray:
+    """Magnitude [m/s^2] (positive toward the constellation centre) of the
+    self-gravity ramp ``(g_start, g_end, t_start, t_end)`` at t [s since the
+    epoch, the run's time scale]: linear from g_start at t_start to g_end at
+    t_end, held at the end values outside; float64 of the shape of t."""
+    g0, g1, t0, t1 = ramp
+    return g0 + (g1 - g0) * np.clip((np.asarray(t, dtype=np.float64) - t0) / (t1 - t0), 0.0, 1.0)
 
 
 def self_gravity_oa(scenario) -> np.ndarray:
@@ -90,7 +105,12 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     model (built if None), whose time-only inputs the system's follow."""
     c = scenario.constellation
     if not c.coupled:
-        return System(_lay.make_cpar(_lay.MODE_POINT_MASS), False, False)
+        ramp = scenario.self_gravity_centre_ramp()
+        if ramp is None:
+            return System(_lay.make_cpar(_lay.MODE_POINT_MASS), False, False)
+        model = build_force_model(scenario.forces, scenario.reference) if model is None else model
+        return System(_lay.make_cpar(_lay.MODE_POINT_MASS, centre_column=model.n_tdat), False, False,
+                      centre_ramp=ramp)
     sc = scenario.spacecraft
     craft = Spacecraft(d_tm=float(sc.d_tm_m), d_p=float(sc.d_p_m), tm_axis=sc.tm_axis)
     _, common = sc.self_gravity_values()

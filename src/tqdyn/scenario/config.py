@@ -415,6 +415,27 @@ class Scenario:
                      'central_body = "sun"')
         if self.initial.design != "none":
             _require(body == "sun", "initial.design", self.initial.design, "is heliocentric", 'central_body = "sun"')
+        sc = self.spacecraft
+        if sc.self_gravity_center is not None and sc.self_gravity_center_span is None:
+            _require(bool(self.initial.oem), "spacecraft.self_gravity_center_span", None, "is missing",
+                     '["START", "END"] dates (the default, the span of initial.oem, needs OEM files)')
+            from .initial import oem_common_span
+
+            _set(sc, "self_gravity_center_span", oem_common_span(self.initial.oem))
+
+    def self_gravity_centre_ramp(self) -> tuple[float, float, float, float] | None:
+        """(g_start, g_end, t_start, t_end) of ``spacecraft.self_gravity_center``:
+        magnitudes [m/s^2, positive toward the constellation centre] and
+        the span in s since the epoch on the run's time axis (TDB); None if off."""
+        sc = self.spacecraft
+        if sc.self_gravity_center is None:
+            return None
+        ep = self.epoch
+        ts = []
+        for text in sc.self_gravity_center_span:
+            e = epoch_from_label(text, "spacecraft.self_gravity_center_span")
+            ts.append(((e.tdb[0] - ep.tdb[0]) + (e.tdb[1] - ep.tdb[1])) * 86400.0)
+        return float(sc.self_gravity_center[0]), float(sc.self_gravity_center[1]), ts[0], ts[1]
 
     @property
     def reference(self) -> ReferenceSystem:

@@ -196,3 +196,21 @@ def oem_first_common_epoch(paths) -> str:
             raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
                                 "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
     return max(firsts, key=lambda x: x[0])[1]
+
+
+def oem_common_span(paths) -> tuple[str, str]:
+    """The OEM files' common span (latest first epoch, earliest last epoch)
+    as two TDB ISO dates with the suffix " TDB" (the default span of
+    ``spacecraft.self_gravity_center``)."""
+    from ..readers.oem import oem_span_tdb
+
+    spans = []
+    for k, path in enumerate(paths, start=1):
+        try:
+            spans.append(oem_span_tdb(path))
+        except (OSError, ValueError) as exc:
+            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
+                                "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
+    first = max((s[0] for s in spans), key=lambda x: x[0])
+    last = min((s[1] for s in spans), key=lambda x: x[0])
+    return f"{first[1]} TDB", f"{last[1]} TDB"
