@@ -1,3 +1,4 @@
 """File formats (I/O only): the trajectory file (:mod:`.trajectory`), run
-checkpoints (:mod:`.checkpoint`), LISA orbit files (:mod:`.lisa`) and the
-netCDF dataset of a sweep (:mod:`.netcdf`)."""
+checkpoints (:mod:`.checkpoint`), LISA orbit files (:mod:`.lisa`), CCSDS
+orbit ephemeris messages (:mod:`.oem`) and the netCDF dataset of a sweep
+(:mod:`.netcdf`)."""
