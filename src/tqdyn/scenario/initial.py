@@ -165,12 +165,12 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
                                     "arm_length, displacement_deg, rotation, semi_major_axis in range") from None
             rv = [(_decimal_vector(r), _decimal_vector(v)) for r, v in states]
     else:
-        from ..readers.oem import oem_states_icrf
+        from ..readers.oem import states_at
 
         rv = []
         for k, path in enumerate(initial.oem, start=1):
             try:
-                r, v = oem_states_icrf(path, epoch.tdb)
+                r, v = states_at(_heliocentric_oem(path), *epoch.tdb)
             except (OSError, ValueError) as exc:
                 raise ScenarioError(f"initial.oem.{k}", path, f"cannot give a state at {epoch.iso} ({exc})",
                                     "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB) covering "
@@ -186,31 +186,46 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
 def oem_first_common_epoch(paths) -> str:
     """The TDB ISO date of the OEM files' first common record (the latest
     of their first epochs), the default epoch of ``initial.oem``."""
-    from ..readers.oem import oem_first_epoch_tdb
-
     firsts = []
     for k, path in enumerate(paths, start=1):
         try:
-            firsts.append(oem_first_epoch_tdb(path))
+            traj = _heliocentric_oem(path)
+            firsts.append((traj.start, _tdb_text(traj.start)))
         except (OSError, ValueError) as exc:
             raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
                                 "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
-    return max(firsts, key=lambda x: x[0])[1]
+    return max(firsts, key=lambda x: x[0][0] + x[0][1])[1]
 
 
 def oem_common_span(paths) -> tuple[str, str]:
     """The OEM files' common span (latest first epoch, earliest last epoch)
     as two TDB ISO dates with the suffix " TDB" (the default span of
     ``spacecraft.self_gravity_center``)."""
-    from ..readers.oem import oem_span_tdb
-
     spans = []
     for k, path in enumerate(paths, start=1):
         try:
-            spans.append(oem_span_tdb(path))
+            traj = _heliocentric_oem(path)
+            spans.append(((traj.start, _tdb_text(traj.start)), (traj.stop, _tdb_text(traj.stop))))
         except (OSError, ValueError) as exc:
             raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
                                 "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
-    first = max((s[0] for s in spans), key=lambda x: x[0])
-    last = min((s[1] for s in spans), key=lambda x: x[0])
+    first = max((s[0] for s in spans), key=lambda x: x[0][0] + x[0][1])
+    last = min((s[1] for s in spans), key=lambda x: x[0][0] + x[0][1])
     return f"{first[1]} TDB", f"{last[1]} TDB"
+
+
+def _heliocentric_oem(path: str):
+    """An OEM file's single segment as Sun-centred ICRF/TDB states
+    (:func:`tqdyn.readers.oem.to_heliocentric`); ValueError naming the file."""
+    from ..readers.oem import read_oem, to_heliocentric
+
+    return to_heliocentric(read_oem(path))
+
+
+def _tdb_text(jd) -> str:
+    """ISO TDB date (1 ns digits) of a two-part TDB Julian date."""
+    import erfa
+
+    y, mo, d, hmsf = erfa.d2dtf("TDB", 9, jd[0], jd[1])
+    return (f"{int(y):04d}-{int(mo):02d}-{int(d):02d}T{int(hmsf['h']):02d}:{int(hmsf['m']):02d}:"
+            f"{int(hmsf['s']):02d}.{int(hmsf['f']):09d}")
