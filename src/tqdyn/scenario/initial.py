@@ -156,13 +156,12 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
 
         with mpmath.workdps(40):
             try:
-                states = keplerian_constellation(
-                    arm_length=initial.arm_length_m, displacement_deg=initial.displacement_deg,
-                    rotation=initial.rotation, semi_major_axis=initial.semi_major_axis_m,
-                    gm=SunMonopole().gm, epoch_tdb_jd=epoch.tdb)
+                design = keplerian_constellation(initial.arm_length_m, initial.displacement_deg, initial.rotation,
+                                                 epoch.tdb, a=initial.semi_major_axis_m, gm=SunMonopole().gm)
             except ValueError as exc:
                 raise ScenarioError("initial.design", initial.design, f"cannot be built ({exc})",
                                     "arm_length, displacement_deg, rotation, semi_major_axis in range") from None
+            states = list(zip(design.r, design.v))
             rv = [(_decimal_vector(r), _decimal_vector(v)) for r, v in states]
     else:
         from ..readers.oem import states_at
