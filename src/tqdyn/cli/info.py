@@ -21,6 +21,7 @@ def info():
     from importlib import resources
 
     from ..astro.eop_sources import describe_sources
+    from ..astro.reference import REFERENCE_SYSTEMS
     from ..forces.model import describe_terms
     from ..numerics import _dp87_tableau
     from ..scenario import builtin_scenarios
@@ -36,6 +37,8 @@ def info():
                                        ("numpy", "numba", "mpmath", "erfa", "h5py", "xarray", "heyoka",
                                         "astropy_iers_data")),
              "built-in scenarios: " + ", ".join(builtin_scenarios()),
+             "reference systems (scenario.central_body):",
+             *(f"  {r.central_body:<6} {r.frame}, t in {r.time_scale}: {r.description}" for r in REFERENCE_SYSTEMS),
              "precision: dd (compiled double-double, ~32 digits, FMA two-product) | float64",
              "integrator: Prince-Dormand RK8(7)13M, fixed step or adaptive (embedded 7th order), "
              "Hermite dense output",
