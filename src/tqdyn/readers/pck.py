@@ -201,12 +201,13 @@ def read_iau_sun_elements(path=None) -> IauSunElements:
 _GM_RE = re.compile(r"BODY(\d+)_GM\s*=\s*\(\s*([-+0-9.EeDd]+)\s*\)")
 
 
-def parse_gm_tpc(text: str) -> dict[int, float]:
+def parse_gm_tpc(text: str, *, exact: bool = False) -> dict[int, float]:
     """Read the GM assignments of a NAIF text PCK (``BODYnnn_GM = ( value )``
     inside ``\\begindata`` blocks).
 
     text: the file's content.  Returns {NAIF id: GM [m^3/s^2]} (the file's
-    km^3/s^2 times 1e9, converted from the exact decimal, one rounding).
+    km^3/s^2 times 1e9, converted from the exact decimal, one rounding; with
+    ``exact`` the exact ``Decimal`` itself, for extended-precision terms).
     Raises ValueError if no GM is found.
     """
     out: dict[int, float] = {}
@@ -221,15 +222,17 @@ def parse_gm_tpc(text: str) -> dict[int, float]:
             continue
         if data:
             for m in _GM_RE.finditer(s):
-                out[int(m[1])] = float(Decimal(m[2].replace("D", "E").replace("d", "e")) * 10**9)
+                gm = Decimal(m[2].replace("D", "E").replace("d", "e")) * 10**9
+                out[int(m[1])] = gm if exact else float(gm)
     if not out:
         raise ValueError("GM kernel: no BODYnnn_GM assignment found inside \\begindata blocks")
     return out
 
 
 @functools.lru_cache(maxsize=1)
-def _shipped_gm() -> dict[int, float]:
+def _shipped_gm(exact: bool = False) -> dict[int, float]:
+    """{NAIF id: GM [m^3/s^2]} of the shipped ``data/gm_de431.tpc`` (float64, or exact Decimals)."""
     path = importlib.resources.files("tqdyn") / "data" / "gm_de431.tpc"
     if not path.is_file():
         raise FileNotFoundError(f"tqdyn data file not found: {path}")
-    return parse_gm_tpc(path.read_text(encoding="ascii", errors="replace"))
+    return parse_gm_tpc(path.read_text(encoding="ascii", errors="replace"), exact=exact)
