@@ -150,7 +150,7 @@ def _attr_value(key: str, val):
 
 def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau, tps_ppr, tps_d_ppr,
                       tps_delta_t, attrs: Mapping[str, Any] | None = None,
-                      extra: Mapping[str, np.ndarray] | None = None) -> pathlib.Path:
+                      extra: Mapping[str, np.ndarray] | None = None, frame_label: str = "GCRS") -> pathlib.Path:
     """Write a LISA orbit file (layout 2.x, see the module docstring), atomically.
 
     Parameters (N samples; float64; link axis in the order 12, 23, 31, 13,
@@ -182,6 +182,9 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
     extra : mapping, optional
         Extra float64 datasets (any path not used by the format, e.g.
         ``"tqdyn/ltt_lo"``), each with N rows.
+    frame_label : str
+        The frame named in the vector datasets' ``description`` attributes
+        (default "GCRS"; "BCRS" for barycentric files).
 
     Every array must be finite (lisainstrument rejects NaN).  Returns the
     absolute path written.  Raises ValueError (bad input, naming the field)
@@ -232,7 +235,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
                 ds = h5.create_dataset(name, data=arr)
                 if name in _DATASETS:
                     ds.attrs["units"] = _DATASETS[name][1]
-                    ds.attrs["description"] = _DATASETS[name][2]
+                    ds.attrs["description"] = _DATASETS[name][2].replace("GCRS", frame_label)
         fd = os.open(tmp, os.O_RDONLY)
         try:
             os.fsync(fd)
