@@ -671,7 +671,7 @@ def _export_bcrs(traj, out, src, attrs, *, shapiro, gm, axes, time_origin) -> Li
                           "/ (1 - L_B); x / (1 - L_B); v unchanged; a (1 - L_B); ltt / (1 - L_B); d_ltt, d_ppr "
                           "unchanged" + ("" if helio else "; TT -> TDB at the geocentre by erfa.dtdb (Fairhead & "
                                          "Bretagnon)"),
-        "t_init": float(t_out[0][0] + t_out[1][0]),
+        "t_init": float(th_out[0] + tl_out[0]),  # delta_tau = 0 here: the trajectory's first sample
         "tt_method": "iterative (Newton, double-double, quintic Hermite dense output of the emitter), solved in "
                      "the BCRS (TDB-compatible units, then scaled to TCB)",
         "ignore_shapiro": not shapiro,
