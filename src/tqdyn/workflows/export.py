@@ -57,7 +57,8 @@ from .. import __version__ as _TQDYN_VERSION
 from ..astro.constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J2000_JD, L_B, L_G
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from ..formats import trajectory as _io
-from ..formats.lisa import _FRAME, _TIME, _TPS_DEFINITION, _uniform_grid, write_lisa_orbits
+from ..formats.lisa import (AXES, FRAMES, TIME_ORIGINS, _FRAME, _TIME, _TPS_DEFINITION, _time_offset,
+                            _uniform_grid, tcb_jd_of_epoch, write_lisa_orbits)
 from ..lightpath import light_travel_times, light_travel_times_of, shapiro_delay
 from ..lightpath.proper_time import lisa_orbit_quantities, proper_time_deviation
 from ..numerics.dd import np_dd_add, np_fast_two_sum, np_two_prod, np_two_sum
@@ -221,19 +222,9 @@ def _first_valid_row(ltt, src) -> int:
 
 # ------------------------------------------------------------------ BCRS / TCB
 
-#: Frames of ``export_lisa(frame=...)``: "gcrs" (the trajectory's own geocentric GCRS and TT; geocentric runs
-#: only) or "bcrs" (barycentric, TCB).
-FRAMES = ("gcrs", "bcrs")
-#: Axes of a BCRS file: "icrf" (the BCRS's own) or "ecliptic" (IAU 2006 mean ecliptic and equinox of J2000,
-#: erfa.ecm06 at J2000 TT: the axes of lisaorbits' files and of lisagwresponse's ecliptic source coordinates).
-AXES = ("icrf", "ecliptic")
-#: Origins of the TCB time axis of a BCRS file (``t = t0 + k dt``).
-TIME_ORIGINS = ("epoch", "j2000", "unix")
-
 #: S = 1 / (1 - L_B): TDB-compatible -> TCB-compatible lengths and time intervals (IAU 2006 Resolution B3).
 TCB_SCALE = 1.0 + L_B / (1.0 - L_B)
 _S_MINUS_1 = L_B / (1.0 - L_B)  # S - 1, exact to the last rounding
-_UNIX_EPOCH_JD = 2440587.5  # 1970-01-01T00:00:00 UTC (ERFA quasi-JD)
 _U_EXT_BODIES = ("sun", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
 _DIFF_S = 300.0  # s: half-step of the central differences of the TDB - TT series
 
@@ -255,43 +246,6 @@ def _dd_plus(hi, lo, x):
     """(hi + lo) + x as a dd pair (x float64)."""
     s, e = np_two_sum(np.asarray(hi, np.float64), np.asarray(x, np.float64))
     return np_fast_two_sum(s, e + lo)
-
-
-def tcb_jd_of_epoch(epoch) -> tuple[float, float]:
-    """Two-part TCB Julian date of an epoch (erfa.tdbtcb of its TDB: IAU 2006 B3)."""
-    c1, c2 = erfa.tdbtcb(*epoch.tdb)
-    return float(c1), float(c2)
-
-
-def _unix_of_tcb(c1: float, c2: float) -> float:
-    """Unix time [s] of a TCB instant, as astropy's ``Time(..., scale="tcb").unix``: TCB -> TDB (IAU 2006 B3) ->
-    TT (erfa.dtdb at the geocentre) -> TAI -> UTC, then (JD_UTC - 2440587.5) * 86400 (ERFA's quasi-JD: 86400 s a
-    day; leap seconds are not counted)."""
-    b1, b2 = erfa.tcbtdb(c1, c2)
-    dtr = erfa.dtdb(b1, b2, 0.0, 0.0, 0.0, 0.0)
-    t1, t2 = erfa.tdbtt(b1, b2, dtr)
-    a1, a2 = erfa.tttai(t1, t2)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", erfa.ErfaWarning)
-        u1, u2 = erfa.taiutc(a1, a2)
-    return float(((u1 - _UNIX_EPOCH_JD) + u2) * DAY_S)
-
-
-def _time_offset(origin: str, epoch, t_first: float) -> tuple[float, str]:
-    """t_off [s] added to the TCB seconds since the epoch's TCB, and the sentence stating the convention."""
-    c1, c2 = tcb_jd_of_epoch(epoch)
-    if origin == "epoch":
-        return 0.0, ("t = TCB seconds since the trajectory epoch's TCB instant (attributes epoch_tcb_jd1 + "
-                     "epoch_tcb_jd2), as lisaorbits' analytic orbits count TCB seconds from their t_init (default 0)")
-    if origin == "j2000":
-        return float((c1 - J2000_JD) * DAY_S + c2 * DAY_S), (
-            "t = TCB seconds since J2000.0 TCB (JD 2451545.0 TCB); a float64 t near 1e9 s resolves 2.4e-7 s")
-    first = _unix_of_tcb(c1, c2 + t_first / DAY_S)
-    return first - t_first, (
-        "t0 = the Unix time of the first sample's TCB instant (astropy Time(..., scale='tcb').unix: seconds since "
-        "1970-01-01T00:00:00 UTC, leap seconds not counted), as lisaorbits' OEMOrbits dates its samples; the "
-        "samples t0 + k dt are TCB seconds after it (a Unix stamp at t0 only); a float64 t near 2e9 s resolves "
-        "4.8e-7 s")
 
 
 def _light_bodies(traj):
