@@ -486,6 +486,17 @@ class Ephemeris:
         self._pairs[_EARTH_CHAIN[0]].evaluate(j1, j2, True, base_p, base_v, 1, base_p, base_v, 0, 1.0)
         return base_p[:, 1].reshape(shape + (3,)), base_v[:, 1].reshape(shape + (3,))
 
+    def sun_barycentric(self, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
+        """Barycentric position [m] and velocity [m/s] of the Sun (segment
+        0 -> 10), ICRF axes, BCRS (TDB-compatible), at the two-part TDB Julian
+        dates jd1, jd2 (broadcast to shape S): two arrays S + (3,)."""
+        shape, j1, j2 = self._flat_dates(jd1, jd2)
+        n = j1.shape[0]
+        pos = np.empty((n, 1, 3))
+        vel = np.empty((n, 1, 3))
+        self._pairs[(_SSB, 10)].evaluate(j1, j2, True, pos, vel, 0, pos, vel, 0, 0.0)
+        return pos[:, 0].reshape(shape + (3,)), vel[:, 0].reshape(shape + (3,))
+
     def geocentric(self, body, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
         """Geocentric position [m] and velocity [m/s] of ``body``.
 

@@ -4,6 +4,11 @@ A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
 It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`).  As
 everywhere in the CLI, bad input exits with status 2 and one line
 ``tqdyn: error: ...`` on stderr, and no output file is left behind.
+
+Formats are registered in :data:`_EXPORTERS` (name -> function(run_file,
+out_file, options) returning the lines to print); a new format adds one
+function and one entry there, and its own options to the command (options
+that do not apply to the chosen format are rejected by its function).
 """
 
 from __future__ import annotations
@@ -15,7 +20,30 @@ from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["FORMATS", "export"]
 
-FORMATS = ("lisa",)
+def _export_lisa(run_file, out_file, opts) -> list[str]:
+    """``--format lisa``: :func:`tqdyn.workflows.export.export_lisa`; returns the report lines."""
+    from ..workflows.export import export_lisa
+
+    summary = export_lisa(run_file, out_file, shapiro=opts["shapiro"], frame=opts["frame"],
+                          axes=opts["axes"] or "icrf", time_origin=opts["time_origin"] or "epoch")
+    if summary.frame == "bcrs":
+        where = f"TCB, {opts['time_origin'] or 'epoch'} origin, BCRS" + (
+            ", ecliptic axes" if opts["axes"] == "ecliptic" else "")
+    else:
+        where = "TT since the epoch, GCRS"
+    shap = f"; Shapiro delay of {summary.shapiro_bodies} included"
+    head = (f"LISA orbit file {summary.path}: {summary.size} samples from t0 = {summary.t0:g} s every "
+            f"{summary.dt:g} s ({where})")
+    return [
+        head,
+        f"light travel times: {summary.note}; {summary.ltt_range[0]:.9f} .. {summary.ltt_range[1]:.9f} s"
+        + (shap if summary.shapiro else ""),
+        f"dropped {summary.dropped_rows} leading row(s) whose emission time precedes the trajectory",
+    ]
+
+
+_EXPORTERS = {"lisa": _export_lisa}
+FORMATS = tuple(_EXPORTERS)
 """Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x)."""
 
 
@@ -23,8 +51,18 @@ FORMATS = ("lisa",)
 @click.argument("run_file", metavar="RUN.h5")
 @click.argument("out_file", metavar="OUT.h5")
 @click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa.")
-@click.option("--shapiro", is_flag=True, help="Include the Earth's Shapiro delay in the light travel times.")
-def export(run_file, out_file, fmt, shapiro):
+@click.option("--shapiro", is_flag=True, help="Include the Shapiro delay in the light travel times (GCRS: the "
+              "Earth's; BCRS: the Sun's, and the Earth's for a geocentric run).")
+@click.option("--frame", type=click.Choice(["gcrs", "bcrs"]), default=None,
+              help="lisa: gcrs = the run's geocentric GCRS and TT (default for geocentric runs); bcrs = barycentric "
+                   "BCRS with TCB as coordinate time (default, and the only choice, for heliocentric runs).")
+@click.option("--axes", type=click.Choice(["icrf", "ecliptic"]), default=None,
+              help="lisa, bcrs only: the axes of the vectors, icrf (default) or the J2000 mean ecliptic of "
+                   "lisaorbits' files.")
+@click.option("--time-origin", "time_origin", type=click.Choice(["epoch", "j2000", "unix"]), default=None,
+              help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
+                   "Unix time of the first sample (as lisaorbits' OEM orbits).")
+def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
     """Export the trajectory RUN.h5 to OUT.h5 in another tool's format.
 
     --format lisa writes a LISA orbit file (lisaorbits layout 2.x, read by
@@ -39,19 +77,12 @@ def export(run_file, out_file, fmt, shapiro):
     if fmt not in FORMATS:
         _fail(f"--format: {fmt!r} is not allowed; allowed: {', '.join(FORMATS)}")
     from ..formats import trajectory as io
-    from ..workflows.export import export_lisa
 
+    opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin}
     try:
-        summary = export_lisa(run_file, out_file, shapiro=shapiro)
+        lines = _EXPORTERS[fmt](run_file, out_file, opts)
     except (FileNotFoundError, ValueError, io.OutputError) as exc:
         _fail(str(exc))
     except KeyboardInterrupt:
         _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
-    head = (f"LISA orbit file {summary.path}: {summary.size} samples from t0 = {summary.t0:g} s every "
-            f"{summary.dt:g} s (TT since the epoch, GCRS)")
-    click.echo("\n".join([
-        head,
-        f"light travel times: {summary.note}; {summary.ltt_range[0]:.9f} .. {summary.ltt_range[1]:.9f} s"
-        + ("; Earth Shapiro delay included" if summary.shapiro else ""),
-        f"dropped {summary.dropped_rows} leading row(s) whose emission time precedes the trajectory",
-    ]))
+    click.echo("\n".join(lines))

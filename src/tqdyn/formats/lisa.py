@@ -67,16 +67,22 @@ from __future__ import annotations
 import os
 import pathlib
 import secrets
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
+import erfa
 import h5py
 import numpy as np
 
 from . import trajectory as _io
 
 __all__ = [
+    "AXES",
+    "FRAMES",
+    "TIME_ORIGINS",
     "LISA_LINK_ORDER",
+    "tcb_jd_of_epoch",
     "LISA_ORBIT_FORMAT_VERSION",
     "write_lisa_orbits",
 ]
@@ -117,6 +123,59 @@ _DATASETS = {
 _RESERVED_ATTRS = ("version", "t0", "dt", "size")
 
 
+# ------------------------------------------------------------------ BCRS files: frames and time origins
+
+#: Frames of ``export_lisa(frame=...)``: "gcrs" (the trajectory's own geocentric GCRS and TT; geocentric runs
+#: only) or "bcrs" (barycentric, TCB).
+FRAMES = ("gcrs", "bcrs")
+#: Axes of a BCRS file: "icrf" (the BCRS's own) or "ecliptic" (IAU 2006 mean ecliptic and equinox of J2000,
+#: erfa.ecm06 at J2000 TT: the axes of lisaorbits' files and of lisagwresponse's ecliptic source coordinates).
+AXES = ("icrf", "ecliptic")
+#: Origins of the TCB time axis of a BCRS file (``t = t0 + k dt``).
+TIME_ORIGINS = ("epoch", "j2000", "unix")
+
+_UNIX_EPOCH_JD = 2440587.5  # 1970-01-01T00:00:00 UTC (ERFA quasi-JD)
+_J2000_JD = 2451545.0
+_DAY_S = 86400.0
+
+
+def tcb_jd_of_epoch(epoch) -> tuple[float, float]:
+    """Two-part TCB Julian date of an epoch (erfa.tdbtcb of its TDB: IAU 2006 B3)."""
+    c1, c2 = erfa.tdbtcb(*epoch.tdb)
+    return float(c1), float(c2)
+
+
+def _unix_of_tcb(c1: float, c2: float) -> float:
+    """Unix time [s] of a TCB instant, as astropy's ``Time(..., scale="tcb").unix``: TCB -> TDB (IAU 2006 B3) ->
+    TT (erfa.dtdb at the geocentre) -> TAI -> UTC, then (JD_UTC - 2440587.5) * 86400 (ERFA's quasi-JD: 86400 s a
+    day; leap seconds are not counted)."""
+    b1, b2 = erfa.tcbtdb(c1, c2)
+    dtr = erfa.dtdb(b1, b2, 0.0, 0.0, 0.0, 0.0)
+    t1, t2 = erfa.tdbtt(b1, b2, dtr)
+    a1, a2 = erfa.tttai(t1, t2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)
+        u1, u2 = erfa.taiutc(a1, a2)
+    return float(((u1 - _UNIX_EPOCH_JD) + u2) * _DAY_S)
+
+
+def _time_offset(origin: str, epoch, t_first: float) -> tuple[float, str]:
+    """t_off [s] added to the TCB seconds since the epoch's TCB, and the sentence stating the convention."""
+    c1, c2 = tcb_jd_of_epoch(epoch)
+    if origin == "epoch":
+        return 0.0, ("t = TCB seconds since the trajectory epoch's TCB instant (attributes epoch_tcb_jd1 + "
+                     "epoch_tcb_jd2), as lisaorbits' analytic orbits count TCB seconds from their t_init (default 0)")
+    if origin == "j2000":
+        return float((c1 - _J2000_JD) * _DAY_S + c2 * _DAY_S), (
+            "t = TCB seconds since J2000.0 TCB (JD 2451545.0 TCB); a float64 t near 1e9 s resolves 2.4e-7 s")
+    first = _unix_of_tcb(c1, c2 + t_first / _DAY_S)
+    return first - t_first, (
+        "t0 = the Unix time of the first sample's TCB instant (astropy Time(..., scale='tcb').unix: seconds since "
+        "1970-01-01T00:00:00 UTC, leap seconds not counted), as lisaorbits' OEMOrbits dates its samples; the "
+        "samples t0 + k dt are TCB seconds after it (a Unix stamp at t0 only); a float64 t near 2e9 s resolves "
+        "4.8e-7 s")
+
+
 # ------------------------------------------------------------------ writer
 
 def _uniform_grid(t, name: str = "t") -> tuple[float, float]:
@@ -150,7 +209,7 @@ def _attr_value(key: str, val):
 
 def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau, tps_ppr, tps_d_ppr,
                       tps_delta_t, attrs: Mapping[str, Any] | None = None,
-                      extra: Mapping[str, np.ndarray] | None = None) -> pathlib.Path:
+                      extra: Mapping[str, np.ndarray] | None = None, frame_label: str = "GCRS") -> pathlib.Path:
     """Write a LISA orbit file (layout 2.x, see the module docstring), atomically.
 
     Parameters (N samples; float64; link axis in the order 12, 23, 31, 13,
@@ -182,6 +241,9 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
     extra : mapping, optional
         Extra float64 datasets (any path not used by the format, e.g.
         ``"tqdyn/ltt_lo"``), each with N rows.
+    frame_label : str
+        The frame named in the vector datasets' ``description`` attributes
+        (default "GCRS"; "BCRS" for barycentric files).
 
     Every array must be finite (lisainstrument rejects NaN).  Returns the
     absolute path written.  Raises ValueError (bad input, naming the field)
@@ -232,7 +294,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
                 ds = h5.create_dataset(name, data=arr)
                 if name in _DATASETS:
                     ds.attrs["units"] = _DATASETS[name][1]
-                    ds.attrs["description"] = _DATASETS[name][2]
+                    ds.attrs["description"] = _DATASETS[name][2].replace("GCRS", frame_label)
         fd = os.open(tmp, os.O_RDONLY)
         try:
             os.fsync(fd)
