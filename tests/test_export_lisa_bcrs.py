@@ -23,8 +23,8 @@ import pytest
 
 from tqdyn.astro.constants import C_LIGHT, L_B
 from tqdyn.formats import trajectory as io
-from tqdyn.workflows import export as E
-from tqdyn.workflows.export import TCB_SCALE, export_lisa
+from tqdyn.workflows import export_bcrs as E
+from tqdyn.workflows.export import export_lisa
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tools"))

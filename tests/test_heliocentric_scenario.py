@@ -12,8 +12,8 @@ from cli_support import run_cli
 from tqdyn.astro.reference import HELIOCENTRIC
 from tqdyn.astro.timescales import Epoch
 from tqdyn.dynamics.initial import initial_state, satellite_states
-from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, states_at, to_heliocentric
-from tqdyn.scenario import ScenarioError, load_scenario, loads_scenario
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, to_heliocentric
+from tqdyn.scenario import load_scenario, loads_scenario
 
 BASE = """
 [scenario]

@@ -11,11 +11,10 @@ Errors are :class:`ScenarioError` (a ``ValueError``) with one line
 
 from __future__ import annotations
 
-import datetime as _dt
 import math
 from dataclasses import dataclass, field
 from decimal import Decimal, localcontext
-from typing import Any, Sequence
+from typing import Any
 
 from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008

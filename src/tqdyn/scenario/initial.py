@@ -6,7 +6,7 @@ files into Cartesian satellites at the scenario epoch."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from decimal import Decimal
 
 from ..astro.timescales import Epoch
