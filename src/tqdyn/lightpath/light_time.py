@@ -45,6 +45,56 @@ constant (it varies with the arm lengths only).  GM defaults to
 :func:`tqdyn.lightpath.shapiro.shapiro_delay`; the instantaneous ranges
 (no light travel time): :func:`tqdyn.lightpath.ranges.instantaneous_ranges`.
 
+Heliocentric runs (``reference`` :data:`tqdyn.astro.reference.HELIOCENTRIC`:
+Sun-centred TDB-compatible BCRS, t in TDB seconds).  The light-time
+equation holds in the barycentric coordinates, in which the Sun -- the
+origin of the trajectory's coordinates -- moves at ~10-15 m/s: over the
+8.3 s of a 2.5e9 m arm that is ~100 m, i.e. up to ~3e-7 s in tau (2.3e-7 s
+measured for 12.4 m/s), more than the Sun's Shapiro delay.  So the solver (``_kernels._solve_bcrs``)
+subtracts the Sun's displacement dS = S(t) - S(t - tau) = V tau - A tau^2/2
+from the Sun-centred separation (V, A: the Sun's barycentric velocity and
+acceleration at the reception time, ``origin_velocity`` /
+``origin_acceleration``; the acceleration term is ~2e-14 s, the next one
+~3e-13 m, 1e-21 s) and solves
+
+    c (tau - s) = |x_e(t - tau) - dS - x_r(t)|,
+
+s = sum of Shapiro delays (1 + gamma) GM/c^3 ln((r_e + r_r + R)/(r_e + r_r - R))
+with R the barycentric separation and r_e, r_r the distances of emitter and
+receiver from the deflecting body:
+
+* the Sun, on by default (``shapiro``): r_e = |x_e(t - tau)|, r_r = |x_r(t)|
+  (the Sun's positions at the emission and the reception times,
+  exactly); ~1.6e-7 s (49 m) on LISA's arms at 1 au
+  (tests/test_lightpath_heliocentric.py);
+* optionally the Earth, the Moon and the planets (``deflectors``; from
+  :func:`light_travel_times_of` ``shapiro_bodies``), their positions taken
+  at the reception time t.  A moving deflector's position ought to be taken
+  somewhere between emission and reception (e.g. at closest approach);
+  moving it by its motion during tau, delta = v_B tau (250 m for the
+  Earth, 110 m for Jupiter), changes r_e + r_r by < 2 delta and the delay
+  by < (1 + gamma) GM/c^3 * 2R / (r_e + r_r)^2 * 2 delta: ~1e-20 s for the
+  Earth, ~1e-17 s for Jupiter (all bodies at t - tau instead of t:
+  7e-18 s measured), far below the 1e-12 s accuracy aimed at;
+  so are the velocity-dependent corrections (~v_B/c relative: ~7e-15 s for
+  the Sun's 13 m/s, ~1e-15 s for Jupiter) and the Sun's 2PN term
+  (~(GM_S)^2 / (c^5 r) x R/r ~ 1e-15 s), not modelled.
+  Sizes on LISA's arms: Jupiter ~3e-11 s, Saturn ~5e-12 s, the Earth ~1e-12 s
+  at 5e10 m, Venus 1e-13..1e-12 s, the Moon ~1e-14 s (measured in the tests).
+
+Accuracy (tests/test_lightpath_heliocentric.py): 2.5e-21 s against an mpmath
+fixed-point solution on exact Kepler orbits around a moving Sun; 2.9e-16 s
+on a 10-day LISA-like run at 3600 s against an mpmath iteration on
+Lagrange-interpolated positions with jplephem's Sun (limited by jplephem's
+float64 positions of the Sun, ~1e-7 m).
+
+Outputs of a heliocentric solution are BCRS vectors relative to the Sun at
+the reception time (:class:`~tqdyn.lightpath.results.LightTravelTimes`,
+``frame = "BCRS"``), tau in TDB seconds (``time_scale = "TDB"``;
+:meth:`~tqdyn.lightpath.results.LightTravelTimes.to_tcb` converts to TCB).
+Geocentric runs keep exactly the solver and the results of version 0.1
+(the same compiled kernel ``_kernels._solve``, bit for bit).
+
 Bodies: the core functions take arrays, either test masses ``(N, 3, 2, 3)``
 [time, satellite, MOSA/TM, xyz] or satellite centres ``(N, 3, 3)`` [time,
 satellite, xyz] (then receiver and emitter are the satellites' centres of
@@ -63,26 +113,15 @@ float64 arrays, as a float64 array with a trailing axis of length 2
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-
 import numpy as np
-from numba import njit
 
 from ..astro.constants import C_LIGHT
+from ..astro.reference import GEOCENTRIC
 from ..constellation.indices import LINK_EMITTER, LINK_EMITTER_MOSA, LINK_RECEIVER, LINK_RECEIVER_MOSA
-from ..numerics.hermite import hermite_eval
-from ..numerics.dd import (
-    add,
-    div,
-    ld,
-    mul,
-    np_dd_add,
-    np_two_prod,
-    np_two_sum,
-    sqrt,
-    st,
-    sub,
-)
+from ..numerics.dd import np_dd_add, np_two_prod, np_two_sum
+from ._kernels import _solve, _solve_bcrs
+from . import heliocentric as _helio
+from .results import LightTravelTimes
 from .shapiro import _default_gm
 
 __all__ = [
@@ -171,262 +210,99 @@ def _check_times(t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(th), np.ascontiguousarray(tl)
 
 
-# ------------------------------------------------------------------ compiled solver
-
-@njit(cache=True)
-def _norm_dd(D):
-    """|D| of a dd 3-vector stored as (3, 2) -> dd."""
-    s = mul(ld(D, 0), ld(D, 0))
-    s = add(s, mul(ld(D, 1), ld(D, 1)))
-    s = add(s, mul(ld(D, 2), ld(D, 2)))
-    return sqrt(s)
+def _origin_motion(x, name: str, N: int) -> np.ndarray:
+    arr = np.ascontiguousarray(np.broadcast_to(np.asarray(x, np.float64), (N, 3)))
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    return arr
 
 
-@njit(cache=True)
-def _interval(tgrid, n, te_hi):
-    """Grid interval k (0 <= k <= N-2) holding te, searching down from row n."""
-    N = tgrid.shape[0]
-    k = min(n, N - 2)
-    while k > 0 and tgrid[k] > te_hi:
-        k -= 1
-    while k < N - 2 and tgrid[k + 1] <= te_hi:
-        k += 1
-    return k
+def _deflector_arrays(deflectors, N: int, gamma: float) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+    """(names, (K,) (1 + gamma) GM / c^3 [s], (N, K, 3) positions [m]) of (name, gm, positions) triples."""
+    names, ks, pos = [], [], []
+    for item in deflectors:
+        try:
+            name, gm, p = item
+        except (TypeError, ValueError):
+            raise ValueError(f"deflectors: {item!r} is not a (name, gm, positions) triple") from None
+        gm = float(gm)
+        p = np.asarray(p, np.float64)
+        if not (np.isfinite(gm) and gm > 0):
+            raise ValueError(f"deflectors: gm of {name!r} = {gm!r} m^3/s^2; allowed: a positive finite number")
+        if p.shape != (N, 3) or not np.all(np.isfinite(p)):
+            raise ValueError(f"deflectors: positions of {name!r} must be finite, shape ({N}, 3), got {p.shape}")
+        names.append(str(name))
+        ks.append((1.0 + gamma) * gm / C_LIGHT ** 3)
+        pos.append(p)
+    P = np.ascontiguousarray(np.stack(pos, 1)) if pos else np.zeros((N, 0, 3))
+    return tuple(names), np.array(ks, dtype=np.float64), P
 
 
-@njit(cache=True)
-def _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v):
-    """Hermite (quintic) dd position / velocity of the emitter of ``link`` at dd time te."""
-    k = _interval(tgrid, n, te[0] + te[1])
-    t0 = ld(t_nodes, k)
-    h = sub(ld(t_nodes, k + 1), t0)
-    s = div(sub(te, t0), h)
-    hermite_eval(z, Re[k:k + 2, link], Ve[k:k + 2, link], Ae[k:k + 2, link], h, s, out_r, out_v)
-
-
-@njit(cache=True)
-def _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D):
-    """The emitter of ``link`` at t - tau (Hermite; into out_r, out_v) and the
-    dd vector D = r_e(t - tau) - r_r(t) (into D); returns (t - tau, |D|), dd."""
-    te = sub(t, tau)
-    _emitter_state(t_nodes, tgrid, n, te, Re, Ve, Ae, link, z, out_r, out_v)
-    for q in range(3):
-        st(D, sub(ld(out_r, q), ld(rr, q)), q)
-    return te, _norm_dd(D)
-
-
-@njit(cache=True)
-def _solve(t_nodes, Rr, Re, Ve, Ae, c, shap_k, tol, max_iter,
-           tau_out, re_out, ve_out, resid_out, shap_out, iters_out):
-    """Newton solution of c tau = |r_e(t - tau) - r_r(t)| (+ Shapiro) for every row and link.
-
-    t_nodes (N, 2) dd [s]; Rr, Re, Ve (N, L, 3, 2) dd [m, m, m/s]; Ae (N, L, 3)
-    [m/s^2]; c [m/s]; shap_k = 2 GM / c^3 [s] (0: no Shapiro term); tol [s].
-    Outputs: tau_out (N, L, 2) dd [s]; re_out (N, L, 3, 2) dd [m]; ve_out
-    (N, L, 3) [m/s]; resid_out, shap_out (N, L) [s]; iters_out (N, L).
-    Returns the number of (row, link) pairs that did not converge."""
-    N = t_nodes.shape[0]
-    L = Rr.shape[1]
-    z = np.array([0.0, 1.0])
-    tgrid = t_nodes[:, 0] + t_nodes[:, 1]
-    D = np.empty((3, 2))
-    out_r = np.empty((3, 2))
-    out_v = np.empty((3, 2))
-    t_first = ld(t_nodes, 0)
-    failed = 0
-    for n in range(N):
-        t = ld(t_nodes, n)
-        for link in range(L):
-            rr = Rr[n, link]
-            rr_norm = np.sqrt(rr[0, 0] ** 2 + rr[1, 0] ** 2 + rr[2, 0] ** 2)
-            for q in range(3):
-                st(D, sub(ld(Re, n, link, q), ld(rr, q)), q)
-            tau = div(_norm_dd(D), c)
-            shap = 0.0
-            it = 0
-            converged = False
-            while it < max_iter:
-                it += 1
-                te, dist = _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D)
-                dv = 0.0
-                for q in range(3):
-                    dv += D[q, 0] * out_v[q, 0]
-                if shap_k != 0.0:
-                    re_norm = np.sqrt(out_r[0, 0] ** 2 + out_r[1, 0] ** 2 + out_r[2, 0] ** 2)
-                    sr = re_norm + rr_norm
-                    shap = shap_k * np.log((sr + dist[0]) / (sr - dist[0]))
-                f = sub(sub(tau, div(dist, c)), shap)
-                step = (f[0] + f[1]) / (1.0 + dv / (dist[0] * c))
-                tau = sub(tau, step)
-                if abs(step) < tol:
-                    converged = True
-                    break
-            if not converged:
-                failed += 1
-            # emitter state and residual at the returned tau
-            te, dist = _emission(t_nodes, tgrid, n, t, tau, Re, Ve, Ae, link, z, rr, out_r, out_v, D)
-            res = sub(sub(tau, div(dist, c)), shap)
-            before = sub(te, t_first)
-            if before[0] + before[1] < 0.0:
-                tau_out[n, link, 0] = np.nan
-                tau_out[n, link, 1] = np.nan
-                for q in range(3):
-                    re_out[n, link, q, 0] = np.nan
-                    re_out[n, link, q, 1] = np.nan
-                    ve_out[n, link, q] = np.nan
-                resid_out[n, link] = np.nan
-                shap_out[n, link] = np.nan
-            else:
-                st(tau_out, tau, n, link)
-                for q in range(3):
-                    re_out[n, link, q, 0] = out_r[q, 0]
-                    re_out[n, link, q, 1] = out_r[q, 1]
-                    ve_out[n, link, q] = out_v[q, 0] + out_v[q, 1]
-                resid_out[n, link] = res[0] + res[1]
-                shap_out[n, link] = shap
-            iters_out[n, link] = it
-    return failed
-
-
-# ------------------------------------------------------------------ results
-
-@dataclass(frozen=True)
-class LightTravelTimes:
-    """Light travel times of the six links on a trajectory's time grid.
-
-    Link axis: LISA order 12, 23, 31, 13, 32, 21 (``Link.index``; link ab is
-    received on satellite a, emitted by satellite b).  Times are TT seconds
-    since the epoch; vectors GCRS [m, m/s]; dd quantities are ``(hi, lo)``
-    tuples of float64 arrays.  Rows whose emission time precedes the first
-    grid time are NaN.
-
-    Attributes
-    ----------
-    t : (hi, lo) of (N,)
-        Reception times (the grid) [s, TT].
-    tau : (hi, lo) of (N, 6)
-        Light travel time [s] (coordinate time, GCRS), dd.
-    range : (hi, lo) of (N, 6)
-        Light-path range c * tau [m], dd (c = 299792458 m/s exactly).
-    r_receive : (hi, lo) of (N, 6, 3)
-        Receiving body at t [m], GCRS, dd (the grid values).
-    v_receive : (N, 6, 3)
-        Receiving body's velocity at t [m/s], GCRS, float64.
-    r_emit : (hi, lo) of (N, 6, 3)
-        Emitting body at t - tau [m], GCRS, dd (Hermite dense output).
-    v_emit : (N, 6, 3)
-        Emitting body's velocity at t - tau [m/s], GCRS, float64.
-    residual : (N, 6)
-        tau - |r_emit - r_receive| / c - shapiro at the returned tau [s].
-    shapiro : (N, 6)
-        Shapiro delay of the Earth included in tau [s] (zeros if off).
-    iterations : (N, 6) int
-        Newton iterations used.
-    source : str
-        ``"tm"`` (test mass to test mass) or ``"sat"`` (satellite centres).
-    note : str
-        What the bodies are (and why, for a fallback).
-    shapiro_k : float
-        2 GM / c^3 [s] of the Shapiro term, 0.0 when it is off.
-    """
-
-    t: tuple[np.ndarray, np.ndarray]
-    tau: tuple[np.ndarray, np.ndarray]
-    range: tuple[np.ndarray, np.ndarray]
-    r_receive: tuple[np.ndarray, np.ndarray]
-    v_receive: np.ndarray
-    r_emit: tuple[np.ndarray, np.ndarray]
-    v_emit: np.ndarray
-    residual: np.ndarray
-    shapiro: np.ndarray
-    iterations: np.ndarray
-    source: str
-    note: str
-    shapiro_k: float = 0.0
-
-    def select(self, rows) -> "LightTravelTimes":
-        """The same light travel times at the rows ``rows`` only (a slice,
-        an index array or a boolean mask along the time axis)."""
-        pick = lambda x: (x[0][rows], x[1][rows]) if isinstance(x, tuple) else x[rows]  # noqa: E731
-        return replace(self, t=pick(self.t), tau=pick(self.tau), range=pick(self.range),
-                       r_receive=pick(self.r_receive), v_receive=pick(self.v_receive), r_emit=pick(self.r_emit),
-                       v_emit=pick(self.v_emit), residual=pick(self.residual), shapiro=pick(self.shapiro),
-                       iterations=pick(self.iterations))
-
-    @property
-    def tau_f64(self) -> np.ndarray:
-        """tau as float64 (N, 6) [s] (hi + lo; ~1e-16 relative)."""
-        return self.tau[0] + self.tau[1]
-
-    @property
-    def unit_vectors(self) -> np.ndarray:
-        """(N, 6, 3) unit vectors from the emitter at t - tau to the receiver at t
-        (the photon's direction of propagation, as in LISA orbit files), GCRS;
-        the difference is formed from the dd positions."""
-        d = (self.r_receive[0] - self.r_emit[0]) + (self.r_receive[1] - self.r_emit[1])
-        return d / np.linalg.norm(d, axis=-1, keepdims=True)
-
-    @property
-    def tau_rate(self) -> np.ndarray:
-        """d tau / dt (N, 6) [s/s]: differentiating c tau = |D| + c s (D = r_r(t) -
-        r_e(t - tau), n = D / |D| = :attr:`unit_vectors`, s the Shapiro delay)
-        gives (n . (v_r - v_e) + c ds/dt) / (c - n . v_e); ds/dt (< 1e-17 s/s
-        for TianQin) is included when the Shapiro delay is, with the geometric
-        rate inserted into it."""
-        n = self.unit_vectors
-        nve = np.einsum("...k,...k->...", n, self.v_emit)
-        nvr = np.einsum("...k,...k->...", n, self.v_receive)
-        rate = (nvr - nve) / (C_LIGHT - nve)
-        if self.shapiro_k == 0.0:
-            return rate
-        re = self.r_emit[0] + self.r_emit[1]
-        rr = self.r_receive[0] + self.r_receive[1]
-        a_e, a_r = np.linalg.norm(re, axis=-1), np.linalg.norm(rr, axis=-1)
-        A = a_e + a_r
-        L = C_LIGHT * (self.tau_f64 - self.shapiro)
-        A_dot = (np.einsum("...k,...k->...", re, self.v_emit) / a_e * (1.0 - rate)
-                 + np.einsum("...k,...k->...", rr, self.v_receive) / a_r)
-        L_dot = C_LIGHT * rate
-        s_dot = self.shapiro_k * ((A_dot + L_dot) / (A + L) - (A_dot - L_dot) / (A - L))
-        return (nvr - nve + C_LIGHT * s_dot) / (C_LIGHT - nve)
-
-
-def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = None, tol: float = 1e-24,
-                       max_iter: int = 10, note: str | None = None) -> LightTravelTimes:
+def light_travel_times(t, r, v, a, *, shapiro: bool | None = None, gm: float | None = None, tol: float = 1e-24,
+                       max_iter: int = 10, note: str | None = None, reference=None, origin_velocity=None,
+                       origin_acceleration=None, deflectors=(), gamma: float = 1.0) -> LightTravelTimes:
     """Solve the light-travel-time equation of the six links on the grid ``t``.
 
     Parameters
     ----------
     t : dd (N,)
-        Grid times [s, TT since the epoch], strictly increasing (any spacing):
-        a (hi, lo) tuple, an (N, 2) array or plain float64 (N,).
+        Grid times [s since the epoch, TT (geocentric) or TDB (heliocentric)],
+        strictly increasing (any spacing): a (hi, lo) tuple, an (N, 2) array
+        or plain float64 (N,).
     r, v : dd (N, 3, 2, 3) or (N, 3, 3)
-        Positions [m] and velocities [m/s], GCRS, of the test masses [time,
+        Positions [m] and velocities [m/s] relative to the central body (GCRS
+        geocentric, or Sun-centred BCRS) of the test masses [time,
         satellite, MOSA, xyz] or of the satellite centres [time, satellite,
         xyz] on the grid (dd: (hi, lo) tuple, trailing axis 2, or float64).
     a : float64, same shape as r
-        Total accelerations [m/s^2], GCRS, on the grid (for TMs: gravity +
-        self-gravity + suspension; for satellite centres: gravity + drag-free
-        control, if any).
-    shapiro : bool
-        Include the Earth's Shapiro delay (default False, as in the paper).
+        Total accelerations [m/s^2] on the grid, same frame (for TMs:
+        gravity + self-gravity + suspension; for satellite centres: gravity
+        + drag-free control, if any).
+    shapiro : bool or None
+        Include the central body's Shapiro delay (the Earth for geocentric,
+        the Sun for heliocentric); None (default): per reference system,
+        off for geocentric (as in the paper), on for heliocentric.
     gm : float
-        GM of the Earth for the Shapiro delay [m^3/s^2] (default
-        :data:`tqdyn.astro.constants.GM_EARTH_EGM2008`).
+        GM of the central body for its Shapiro delay [m^3/s^2] (default:
+        :data:`tqdyn.astro.constants.GM_EARTH_EGM2008` for geocentric,
+        the Sun's DE430 value of :func:`tqdyn.astro.ephemeris.planetary_gm`
+        for heliocentric).
     tol : float
         Convergence threshold on the Newton correction [s].
     max_iter : int
         Maximum number of Newton iterations; RuntimeError if not converged.
     note : str, optional
         Text for the result's ``note`` (default: describes the bodies).
+    reference : tqdyn.astro.reference.ReferenceSystem, optional
+        The coordinates of t, r, v, a: geocentric (default,
+        :data:`~tqdyn.astro.reference.GEOCENTRIC`, or any with central body
+        "earth": exactly the solver of version 0.1) or heliocentric
+        (central body "sun": the BCRS solver, see the module docstring).
+    origin_velocity, origin_acceleration : (N, 3) or (3,) float64, heliocentric only
+        The Sun's barycentric velocity [m/s] (required) and acceleration
+        [m/s^2] (default 0) at the grid times
+        (:func:`tqdyn.lightpath.heliocentric.sun_barycentric_motion`); zeros
+        for a Sun at rest.
+    deflectors : sequence of (name, gm, positions), heliocentric only
+        Further bodies whose Shapiro delays enter: GM [m^3/s^2] and
+        positions (N, 3) [m] relative to the Sun at the grid (reception)
+        times, BCRS.  Default none.
+    gamma : float
+        PPN parameter of every Shapiro term, (1 + gamma) GM/c^3 (default 1).
 
     Returns
     -------
     LightTravelTimes
         tau (N, 6) dd [s] and range c tau (N, 6) dd [m] in LISA link order,
         with emitter states and residuals; rows whose emission time precedes
-        t[0] are NaN.
+        t[0] are NaN.  Heliocentric: ``frame = "BCRS"`` (vectors as
+        :class:`~tqdyn.lightpath.results.LightTravelTimes` says),
+        ``shapiro_parts`` per body.
     """
+    ref = GEOCENTRIC if reference is None else reference
+    helio = ref.central_body == "sun"
+    if not helio and ref.central_body != "earth":
+        raise ValueError(f"reference: central body {ref.central_body!r}; allowed: 'earth', 'sun'")
     th, tl = _check_times(t)
     N = th.size
     rh, rl = _dd_input(r, "r")
@@ -447,9 +323,25 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
         raise ValueError(f"max_iter = {max_iter!r}; allowed: an integer >= 1")
     if not (isinstance(tol, (int, float)) and np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol = {tol!r} s; allowed: a positive finite number of seconds")
-    gm_v = _default_gm() if gm is None else float(gm)
+    if gm is None:
+        gm_v = float(_helio.gm_of(("sun",))[0]) if helio else _default_gm()
+    else:
+        gm_v = float(gm)
     if not (np.isfinite(gm_v) and gm_v > 0):
         raise ValueError(f"gm = {gm!r} m^3/s^2; allowed: a positive finite number")
+    gamma = float(gamma)
+    if not (np.isfinite(gamma) and gamma > -1):
+        raise ValueError(f"gamma = {gamma!r}; allowed: a finite number > -1")
+    if shapiro is None:
+        shapiro = helio
+    if not helio:
+        if origin_velocity is not None or origin_acceleration is not None or len(deflectors):
+            raise ValueError("origin_velocity, origin_acceleration and deflectors are for heliocentric (BCRS) "
+                             "links; in the GCRS the other bodies act through tidal potentials only, and their "
+                             "BCRS Shapiro delays do not apply")
+    elif origin_velocity is None:
+        raise ValueError("origin_velocity: required for heliocentric links (the Sun's barycentric velocity at the "
+                         "grid times, tqdyn.lightpath.heliocentric.sun_barycentric_motion; zeros for a Sun at rest)")
 
     def per_link(hi, lo):
         rec_h, emit_h = link_bodies(hi, layout)
@@ -466,10 +358,27 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
     resid = np.empty((N, 6))
     shap = np.empty((N, 6))
     iters = np.empty((N, 6), dtype=np.int64)
-    shap_k = 2.0 * gm_v / C_LIGHT ** 3 if shapiro else 0.0
-    failed = _solve(t_nodes, np.ascontiguousarray(Rr), np.ascontiguousarray(Re), np.ascontiguousarray(Ve),
-                    np.ascontiguousarray(Ae), C_LIGHT, shap_k, float(tol), int(max_iter),
-                    tau, r_emit, v_emit, resid, shap, iters)
+    shap_k = (1.0 + gamma) * gm_v / C_LIGHT ** 3 if shapiro else 0.0
+    central = ref.central_body
+    args = (t_nodes, np.ascontiguousarray(Rr), np.ascontiguousarray(Re), np.ascontiguousarray(Ve),
+            np.ascontiguousarray(Ae))
+    if not helio:
+        failed = _solve(*args, C_LIGHT, shap_k, float(tol), int(max_iter), tau, r_emit, v_emit, resid, shap, iters)
+        parts = {central: shap} if shapiro else {}
+        vo = ao = None
+        v_recv = Vr[..., 0] + Vr[..., 1]
+    else:
+        vo = _origin_motion(origin_velocity, "origin_velocity", N)
+        ao = _origin_motion(0.0 if origin_acceleration is None else origin_acceleration, "origin_acceleration", N)
+        names, defl_k, defl_p = _deflector_arrays(deflectors, N, gamma)
+        if central in names or len(set(names)) != len(names):
+            raise ValueError(f"deflectors: {', '.join(names)}: each body once, not the central body {central!r}")
+        part_arr = np.empty((N, 6, len(names) + 1))
+        failed = _solve_bcrs(*args, vo, ao, C_LIGHT, shap_k, defl_k, defl_p, float(tol), int(max_iter),
+                             tau, r_emit, v_emit, resid, shap, part_arr, iters)
+        parts = {central: part_arr[..., 0]} if shapiro else {}
+        parts.update({b: part_arr[..., k + 1] for k, b in enumerate(names)})
+        v_recv = Vr[..., 0] + Vr[..., 1] + vo[:, None, :]
     if failed:
         raise RuntimeError(f"light travel time: {failed} (row, link) pairs did not converge to tol = {tol} s "
                            f"in max_iter = {max_iter} Newton iterations")
@@ -481,25 +390,16 @@ def light_travel_times(t, r, v, a, *, shapiro: bool = False, gm: float | None = 
                 "facing a" if layout == "tm" else "satellite centre of mass to satellite centre of mass")
     return LightTravelTimes(
         t=(th, tl), tau=(tau_h, tau_l), range=rng,
-        r_receive=(Rr[..., 0], Rr[..., 1]), v_receive=Vr[..., 0] + Vr[..., 1],
+        r_receive=(Rr[..., 0], Rr[..., 1]), v_receive=v_recv,
         r_emit=(r_emit[..., 0], r_emit[..., 1]), v_emit=v_emit,
         residual=resid, shapiro=shap,
-        iterations=iters, source=layout, note=note, shapiro_k=shap_k)
+        iterations=iters, source=layout, note=note, shapiro_k=shap_k,
+        frame="BCRS" if helio else "GCRS", time_scale=ref.time_scale, origin_velocity=vo,
+        origin_acceleration=ao, shapiro_parts=parts, gamma=gamma)
 
 
-def light_travel_times_of(trajectory, **kwargs) -> LightTravelTimes:
-    """:func:`light_travel_times` for a trajectory object.
-
-    ``trajectory`` is duck-typed like :class:`tqdyn.formats.trajectory.Trajectory`
-    (``name in trajectory``, ``trajectory.dd(name)`` -> (hi, lo),
-    ``trajectory[name]`` -> float64).  With the test-mass fields ``tm/r``,
-    ``tm/v``, ``tm/a`` the links run TM to TM (``source = "tm"``).  Without
-    any ``tm/*`` state (pure-gravity runs) the satellite centres are used:
-    ``sat/r``, ``sat/v`` and ``sat/a_gravity`` (+ ``sat/a_dragfree`` if
-    present), ``source = "sat"``, and ``note`` says so.  A file with only
-    some of the TM state fields raises ValueError.  Needs 3 satellites.
-    ``kwargs`` go to :func:`light_travel_times`.
-    """
+def _trajectory_arrays(trajectory):
+    """(t, r, v, a, kwargs) of the light paths of a trajectory (TM to TM, else satellite centres)."""
     n_sat = getattr(trajectory, "n_sat", 3)
     if n_sat != 3:
         raise ValueError(f"trajectory: n_sat = {n_sat}; light paths need the 3 satellites of a constellation")
@@ -507,7 +407,7 @@ def light_travel_times_of(trajectory, **kwargs) -> LightTravelTimes:
     tm_fields = ("tm/r", "tm/v", "tm/a")
     present = [f for f in tm_fields if f in trajectory]
     if len(present) == 3:
-        return light_travel_times(t, trajectory.dd("tm/r"), trajectory.dd("tm/v"), trajectory["tm/a"], **kwargs)
+        return t, trajectory.dd("tm/r"), trajectory.dd("tm/v"), trajectory["tm/a"], {}
     if present:
         missing = [f for f in tm_fields if f not in trajectory]
         raise ValueError(f"trajectory: has {', '.join(present)} but not {', '.join(missing)}; test-mass light "
@@ -520,6 +420,62 @@ def light_travel_times_of(trajectory, **kwargs) -> LightTravelTimes:
     if "sat/a_dragfree" in trajectory:
         acc = acc + np.asarray(trajectory["sat/a_dragfree"], np.float64)
         parts += " + sat/a_dragfree"
-    kwargs.setdefault("note", "no test-mass fields (tm/r, tm/v, tm/a) in the trajectory: links between the "
-                              f"satellites' centres of mass (sat/r, sat/v, {parts})")
-    return light_travel_times(t, trajectory.dd("sat/r"), trajectory.dd("sat/v"), acc, **kwargs)
+    note = ("no test-mass fields (tm/r, tm/v, tm/a) in the trajectory: links between the satellites' centres of "
+            f"mass (sat/r, sat/v, {parts})")
+    return t, trajectory.dd("sat/r"), trajectory.dd("sat/v"), acc, {"note": note}
+
+
+def light_travel_times_of(trajectory, *, shapiro_bodies=None, ephemeris=None, **kwargs) -> LightTravelTimes:
+    """:func:`light_travel_times` for a trajectory object.
+
+    ``trajectory`` is duck-typed like :class:`tqdyn.formats.trajectory.Trajectory`
+    (``name in trajectory``, ``trajectory.dd(name)`` -> (hi, lo),
+    ``trajectory[name]`` -> float64; ``reference``, ``epoch`` and
+    ``scenario_toml`` when heliocentric; an object without ``reference`` is
+    geocentric).  With the test-mass fields ``tm/r``, ``tm/v``, ``tm/a`` the
+    links run TM to TM (``source = "tm"``).  Without any ``tm/*`` state
+    (pure-gravity runs) the satellite centres are used: ``sat/r``,
+    ``sat/v`` and ``sat/a_gravity`` (+ ``sat/a_dragfree`` if present),
+    ``source = "sat"``, and ``note`` says so.  A file with only some of the
+    TM state fields raises ValueError.  Needs 3 satellites.
+
+    Heliocentric trajectories (``trajectory.reference.central_body ==
+    "sun"``): the Sun's barycentric motion is read from the run's
+    ephemeris (``ephemeris``: an :class:`tqdyn.astro.ephemeris.Ephemeris`;
+    default the scenario's ``forces.ephemeris``) at the grid's TDB dates,
+    the Sun's Shapiro delay is on unless ``shapiro=False``, ``gm`` (if
+    given) must be the Sun's (within 1e-3: the Earth's GM that a geocentric
+    caller passes is refused), and ``shapiro_bodies`` adds the Shapiro
+    delays of other bodies: None (default: none), ``"third_bodies"`` (the
+    run's ``forces.third_bodies``), ``"all"`` (Earth, Moon, Mercury ..
+    Neptune) or a list of names of
+    :data:`tqdyn.astro.ephemeris.HELIOCENTRIC_BODIES`; their positions at
+    the grid (reception) times, GMs of DE430.  Geocentric trajectories
+    refuse ``shapiro_bodies`` (GCRS: tidal potentials only).  Other
+    ``kwargs`` (``shapiro``, ``gm``, ``tol``, ``max_iter``, ``gamma``) go
+    to :func:`light_travel_times`.
+    """
+    t, r, v, a, extra = _trajectory_arrays(trajectory)
+    for k, val in extra.items():
+        kwargs.setdefault(k, val)
+    ref = getattr(trajectory, "reference", None) or GEOCENTRIC
+    if ref.central_body != "sun":
+        if _helio.resolve_bodies(shapiro_bodies, trajectory):
+            raise ValueError(f"shapiro_bodies = {shapiro_bodies!r}: only for heliocentric trajectories; in the "
+                             "GCRS the other bodies act through tidal potentials only (the Earth's Shapiro delay "
+                             "is shapiro=True)")
+        return light_travel_times(t, r, v, a, **kwargs)
+    gm = kwargs.get("gm")
+    if gm is not None:
+        gm_sun = float(_helio.gm_of(("sun",))[0])
+        if not abs(float(gm) / gm_sun - 1.0) < 1e-3:
+            raise ValueError(f"gm = {gm!r} m^3/s^2: a heliocentric trajectory's Shapiro delay is the Sun's "
+                             f"(GM ~ {gm_sun:.6e} m^3/s^2); pass gm=None for the default")
+    eph = _helio.ephemeris_of(trajectory) if ephemeris is None else ephemeris
+    epoch = trajectory.epoch
+    _, vo, ao = _helio.sun_barycentric_motion(eph, epoch, t, ref)
+    bodies = _helio.resolve_bodies(shapiro_bodies, trajectory)
+    pos, _ = _helio.body_states(eph, epoch, t, bodies, ref, velocity=False)
+    defl = [(b, g, pos[:, k]) for k, (b, g) in enumerate(zip(bodies, _helio.gm_of(bodies)))]
+    return light_travel_times(t, r, v, a, reference=ref, origin_velocity=vo, origin_acceleration=ao,
+                              deflectors=defl, **kwargs)

@@ -32,6 +32,11 @@ against TT):
   derivatives (|delta_t| ~ 5e-4 s after 90 days; the neglected second-order
   terms are < 1e-19 s).
 
+Heliocentric runs: the clocks' proper times against TCB or TDB are
+:mod:`tqdyn.lightpath.proper_time_bcrs`; pass them to
+:func:`lisa_orbit_quantities` as ``proper_time`` (same coordinate time as t
+and the light travel times).
+
 Link order: 12, 23, 31, 13, 32, 21 (:class:`~tqdyn.constellation.indices.Link`,
 "ij" received by spacecraft i, emitted by spacecraft j).
 """
@@ -109,7 +114,8 @@ def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarr
 
 # ------------------------------------------------------------------ the quantities
 
-def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: float | None = None) -> dict[str, Any]:
+def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: float | None = None, *,
+                          proper_time=None) -> dict[str, Any]:
     """All datasets of a LISA orbit file from a tqdyn trajectory's arrays.
 
     t: dd (hi, lo) grid times (N,) [s, TT]; sat_r, sat_v, sat_a: (N, 3, 3)
@@ -117,6 +123,16 @@ def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: floa
     total accelerations [m/s^2], GCRS; lp: the light travel times on the
     same grid (:func:`tqdyn.lightpath.light_travel_times`); gm: Earth GM for
     the proper times [m^3/s^2].  Definitions: see the module docstring.
+
+    proper_time: optional (delta_tau, rate, rate_dot), each (N, 3), used
+    instead of the geocentric :func:`proper_time_deviation` (``gm`` is then
+    unused).  The formulas are those of the module docstring in whatever
+    single coordinate time t, lp and proper_time share: for a heliocentric
+    run either all in TDB (lp as solved, proper times of
+    :func:`tqdyn.lightpath.proper_time_bcrs.proper_time_deviation_bcrs`
+    with ``against="TDB"``) or all in TCB (t, positions, accelerations and
+    ``lp.to_tcb()`` converted, proper times ``against="TCB"``).  Mixing
+    them is wrong by ltt L_B ~ 1.3e-7 s in ppr.
 
     Returns a dict with ``t`` (N,) float64 and the arrays of the datasets
     of :mod:`tqdyn.formats.lisa` (keys ``"tcb/x"`` ...) for all N rows (rows
@@ -129,7 +145,13 @@ def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: floa
         return x[0] + x[1] if isinstance(x, tuple) else np.asarray(x, np.float64)
 
     x, v, a = f64(sat_r), f64(sat_v), np.asarray(sat_a, np.float64)
-    dtau, rate, rate_dot = proper_time_deviation((th, tl), x, v, a, gm)
+    if proper_time is None:
+        dtau, rate, rate_dot = proper_time_deviation((th, tl), x, v, a, gm)
+    else:
+        dtau, rate, rate_dot = (np.asarray(p, np.float64) for p in proper_time)
+        if not (dtau.shape == rate.shape == rate_dot.shape == x.shape[:2]):
+            raise ValueError(f"proper_time: shapes {dtau.shape}, {rate.shape}, {rate_dot.shape}; allowed: "
+                             f"{x.shape[:2]} each")
     ltt = lp.tau[0] + lp.tau[1]
     ltt_lo = lp.tau[1] - (ltt - lp.tau[0])
     d_ltt = lp.tau_rate

@@ -1,0 +1,136 @@
+"""The solar system around heliocentric light paths and clocks (physics, no I/O).
+
+Heliocentric trajectories (:data:`tqdyn.astro.reference.HELIOCENTRIC`) are
+Sun-centred coordinates of the TDB-compatible BCRS, t in TDB seconds since
+the epoch.  Their light-time equation and their clocks' proper times hold
+in the barycentric coordinates, in which the Sun moves; this module gives
+what they need from the JPL ephemeris, at the ephemeris dates
+:meth:`tqdyn.astro.reference.ReferenceSystem.ephemeris_jd` of the grid:
+
+* :func:`sun_barycentric_motion`: the Sun's barycentric position S [m],
+  velocity dS/dt [m/s] (~10-15 m/s, dominated by Jupiter and Saturn) and
+  acceleration [m/s^2] (~2e-7 m/s^2), ICRF axes.  S and dS/dt are the
+  barycentric minus the heliocentric state of the Earth (the public
+  :meth:`~tqdyn.astro.ephemeris.Ephemeris.earth_barycentric` and
+  :meth:`~tqdyn.astro.ephemeris.Ephemeris.heliocentric_states`; rounding
+  ~3e-5 m and ~4e-12 m/s), the acceleration the central difference of
+  dS/dt over +-300 s (truncation ~1e-16 m/s^2, rounding ~1e-14 m/s^2);
+* :func:`body_states`: Sun-centred positions and velocities of the Earth,
+  the Moon and the planets (system barycentres);
+* :func:`ephemeris_of`, :func:`run_third_bodies`, :func:`resolve_bodies`:
+  the run's ephemeris and third bodies from the trajectory's scenario, and
+  the body lists that the light-time and proper-time options accept.
+"""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+
+from ..astro.ephemeris import HELIOCENTRIC_BODIES, Ephemeris, default_ephemeris, planetary_gm
+from ..astro.reference import HELIOCENTRIC
+
+__all__ = ["BODY_SETS", "body_states", "ephemeris_of", "gm_of", "resolve_bodies", "run_third_bodies",
+           "sun_barycentric_motion"]
+
+#: Named body lists: ``"third_bodies"`` = the run's ``forces.third_bodies``
+#: (the heliocentric ones), ``"all"`` = every body of
+#: :data:`tqdyn.astro.ephemeris.HELIOCENTRIC_BODIES` (Earth, Moon, Mercury .. Neptune).
+BODY_SETS = ("third_bodies", "all")
+
+_FD_STEP = 300.0  # s, central difference of the Sun's barycentric velocity
+
+
+def _scenario(trajectory) -> dict:
+    text = str(getattr(trajectory, "scenario_toml", "") or "")
+    try:
+        return tomllib.loads(text) if text else {}
+    except tomllib.TOMLDecodeError:
+        return {}
+
+
+def ephemeris_of(trajectory) -> Ephemeris:
+    """The JPL ephemeris of the run that wrote ``trajectory``: its scenario's
+    ``forces.ephemeris`` ("de421", the shipped default, or a .bsp path);
+    the shipped DE421 when the trajectory has no scenario."""
+    name = str(_scenario(trajectory).get("forces", {}).get("ephemeris", "de421"))
+    return default_ephemeris() if name.lower() == "de421" else Ephemeris(name)
+
+
+def run_third_bodies(trajectory) -> tuple[str, ...]:
+    """The run's third bodies (scenario ``forces.third_bodies``) that the
+    ephemeris gives heliocentrically (the Sun, the central body, excluded); () without a scenario."""
+    names = _scenario(trajectory).get("forces", {}).get("third_bodies", ())
+    return tuple(str(b).lower() for b in names if str(b).lower() in HELIOCENTRIC_BODIES)
+
+
+def resolve_bodies(spec, trajectory=None) -> tuple[str, ...]:
+    """Body names from ``spec``: None or () -> (); ``"third_bodies"`` -> the
+    run's (:func:`run_third_bodies`); ``"all"`` -> :data:`HELIOCENTRIC_BODIES`;
+    a sequence of names -> those (lower case, checked).  ValueError for an
+    unknown name (the Sun, the origin, is not a deflector: its terms are
+    always the central body's)."""
+    if spec is None:
+        return ()
+    if isinstance(spec, str):
+        if spec == "third_bodies":
+            return run_third_bodies(trajectory) if trajectory is not None else ()
+        if spec == "all":
+            return HELIOCENTRIC_BODIES
+        spec = (spec,)
+    out = []
+    for b in spec:
+        key = str(b).lower()
+        if key not in HELIOCENTRIC_BODIES:
+            raise ValueError(f"body {b!r} is not allowed; allowed: {', '.join(HELIOCENTRIC_BODIES)}, or "
+                             f"{' / '.join(repr(s) for s in BODY_SETS)} (the Sun is the central body)")
+        if key not in out:
+            out.append(key)
+    return tuple(out)
+
+
+def gm_of(bodies) -> np.ndarray:
+    """(K,) GMs [m^3/s^2] of ``bodies`` (TDB-compatible DE430/DE431 values,
+    planets as systems: :func:`tqdyn.astro.ephemeris.planetary_gm`)."""
+    gm = planetary_gm()
+    return np.array([gm[b] for b in bodies], dtype=np.float64)
+
+
+def _times(t) -> tuple[np.ndarray, np.ndarray]:
+    if isinstance(t, tuple):
+        return tuple(np.asarray(p, np.float64) for p in t)
+    th = np.asarray(t, np.float64)
+    return th, np.zeros_like(th)
+
+
+def sun_barycentric_motion(ephemeris: Ephemeris, epoch, t, reference=HELIOCENTRIC):
+    """The Sun's barycentric position [m], velocity [m/s] and acceleration
+    [m/s^2] at t (dd (hi, lo) or float64 (N,) seconds of the reference's
+    time scale since ``epoch``, a :class:`tqdyn.astro.timescales.Epoch`),
+    BCRS (TDB-compatible), ICRF axes: three float64 arrays (N, 3)."""
+    th, tl = _times(t)
+
+    def state(dt):
+        jd1, jd2 = reference.ephemeris_jd(epoch, th, tl + dt)
+        pb, vb = ephemeris.earth_barycentric(jd1, jd2)
+        ph, vh = ephemeris.heliocentric_states(("earth",), jd1, jd2)
+        return pb - ph[..., 0, :], vb - vh[..., 0, :]
+
+    s, v = state(0.0)
+    _, vp = state(_FD_STEP)
+    _, vm = state(-_FD_STEP)
+    return s, v, (vp - vm) / (2.0 * _FD_STEP)
+
+
+def body_states(ephemeris: Ephemeris, epoch, t, bodies, reference=HELIOCENTRIC, *, velocity: bool = True):
+    """Sun-centred positions [m] and velocities [m/s] (or None) of ``bodies``
+    (names of :data:`HELIOCENTRIC_BODIES`) at t (as
+    :func:`sun_barycentric_motion`): float64 arrays (N, K, 3), BCRS
+    (TDB-compatible), ICRF axes."""
+    th, tl = _times(t)
+    if not bodies:
+        z = np.zeros(th.shape + (0, 3))
+        return z, (z.copy() if velocity else None)
+    jd1, jd2 = reference.ephemeris_jd(epoch, th, tl)
+    return ephemeris.heliocentric_states(tuple(bodies), jd1, jd2, velocity=velocity)
