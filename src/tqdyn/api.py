@@ -123,13 +123,19 @@ def open_trajectory(path) -> Trajectory:
     return read_trajectory(path)
 
 
-def light_travel_times(trajectory: Trajectory, *, shapiro: bool = False) -> LightTravelTimes:
+def light_travel_times(trajectory: Trajectory, *, shapiro: bool | None = None,
+                       shapiro_bodies=None) -> LightTravelTimes:
     """The six links' light travel times on the trajectory's time grid: test
     mass to test mass for coupled runs, satellite centre to centre for
     pure-gravity runs (solved in double-double on the Hermite dense output;
-    :func:`tqdyn.lightpath.light_travel_times`).  shapiro: add the Earth's
-    Shapiro delay (off by default, as in the paper)."""
-    return light_travel_times_of(trajectory, shapiro=shapiro)
+    :func:`tqdyn.lightpath.light_travel_times`).  shapiro: the central body's
+    Shapiro delay, None = its default (geocentric: off, as in the paper;
+    heliocentric: the Sun's, on); shapiro_bodies (heliocentric): other
+    bodies' Shapiro delays ("third_bodies", "all" or a list of names)."""
+    kw = {} if shapiro is None else {"shapiro": shapiro}
+    if shapiro_bodies is not None:
+        kw["shapiro_bodies"] = shapiro_bodies
+    return light_travel_times_of(trajectory, **kw)
 
 
 def range_asd(light_times: LightTravelTimes, link: str | int | Link = "13") -> _metrics.AsdResult:

@@ -1,4 +1,4 @@
-"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5``.
+"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5`` and ``--format oem OUT.oem``.
 
 A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
 It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`).  As
@@ -19,6 +19,7 @@ import click
 from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["FORMATS", "export"]
+
 
 def _export_lisa(run_file, out_file, opts) -> list[str]:
     """``--format lisa``: :func:`tqdyn.workflows.export.export_lisa`; returns the report lines."""
@@ -42,17 +43,29 @@ def _export_lisa(run_file, out_file, opts) -> list[str]:
     ]
 
 
-_EXPORTERS = {"lisa": _export_lisa}
+def _export_oem(run_file, out_file, opts) -> list[str]:
+    """``--format oem``: :func:`tqdyn.workflows.export_oem.export_oem`; returns the report lines."""
+    given = [f"--{k.replace('_', '-')}" for k, v in opts.items() if v is not None]
+    if given:
+        raise ValueError(f"{given[0]}: applies to --format lisa only; allowed with --format oem: no options")
+    from ..workflows.export_oem import export_oem
+
+    paths = export_oem(run_file, out_file)
+    return [f"CCSDS OEM 2.0: {len(paths)} file(s), one per satellite: " + ", ".join(str(p) for p in paths)]
+
+
+_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem}
 FORMATS = tuple(_EXPORTERS)
-"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x)."""
+"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files."""
 
 
 @click.command("export")
 @click.argument("run_file", metavar="RUN.h5")
-@click.argument("out_file", metavar="OUT.h5")
-@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa.")
-@click.option("--shapiro", is_flag=True, help="Include the Shapiro delay in the light travel times (GCRS: the "
-              "Earth's; BCRS: the Sun's, and the Earth's for a geocentric run).")
+@click.argument("out_file", metavar="OUT")
+@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem.")
+@click.option("--shapiro/--no-shapiro", default=None,
+              help="lisa: include the Shapiro delay in the light travel times (GCRS: the Earth's; BCRS: the Sun's, "
+                   "and the Earth's for a geocentric run).  Default: on for heliocentric runs, off for geocentric.")
 @click.option("--frame", type=click.Choice(["gcrs", "bcrs"]), default=None,
               help="lisa: gcrs = the run's geocentric GCRS and TT (default for geocentric runs); bcrs = barycentric "
                    "BCRS with TCB as coordinate time (default, and the only choice, for heliocentric runs).")
@@ -63,14 +76,18 @@ FORMATS = tuple(_EXPORTERS)
               help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
                    "Unix time of the first sample (as lisaorbits' OEM orbits).")
 def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
-    """Export the trajectory RUN.h5 to OUT.h5 in another tool's format.
+    """Export the trajectory RUN.h5 to OUT in another tool's format.
 
-    --format lisa writes a LISA orbit file (lisaorbits layout 2.x, read by
-    lisainstrument and pytdi): satellite states, light travel times between
-    the test masses (satellite centres for runs without test masses),
-    proper times and proper pseudoranges.  The frame stays tqdyn's GCRS and
-    the time TT seconds since the epoch; the file's attributes say how each
-    quantity is defined.
+    --format lisa writes a LISA orbit file OUT.h5 (lisaorbits layout 2.x,
+    read by lisainstrument and pytdi): satellite states, light travel times
+    between the test masses (satellite centres for runs without test
+    masses), proper times and proper pseudoranges, in the run's GCRS and TT
+    (geocentric default) or the BCRS with TCB (--frame bcrs; heliocentric
+    runs); the file's attributes say how each quantity is defined.
+
+    --format oem writes CCSDS OEM 2.0 files for mission-analysis tools
+    (GMAT, Orekit, STK), one per satellite (OUT-<name>.oem beside OUT.oem),
+    in the run's own system (SUN/ICRF/TDB or EARTH/GCRF/TT).
     """
     if fmt is None:
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")

@@ -111,11 +111,8 @@ def sun_barycentric_motion(ephemeris: Ephemeris, epoch, t, reference=HELIOCENTRI
     BCRS (TDB-compatible), ICRF axes: three float64 arrays (N, 3)."""
     th, tl = _times(t)
 
-    def state(dt):
-        jd1, jd2 = reference.ephemeris_jd(epoch, th, tl + dt)
-        pb, vb = ephemeris.earth_barycentric(jd1, jd2)
-        ph, vh = ephemeris.heliocentric_states(("earth",), jd1, jd2)
-        return pb - ph[..., 0, :], vb - vh[..., 0, :]
+    def state(dt):  # the ephemeris's segment 0 -> 10
+        return ephemeris.sun_barycentric(*reference.ephemeris_jd(epoch, th, tl + dt))
 
     s, v = state(0.0)
     _, vp = state(_FD_STEP)

@@ -83,7 +83,7 @@ def _resolve_frame(traj, frame, axes, time_origin, src) -> str:
     return frame
 
 
-def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None = None, frame: str | None = None,
+def export_lisa(trajectory, out_path, *, shapiro: bool | None = None, gm: float | None = None, frame: str | None = None,
                 axes: str = "icrf", time_origin: str = "epoch") -> LisaExport:
     """Export a tqdyn trajectory (file path or :class:`tqdyn.formats.trajectory.Trajectory`) to a LISA orbit file.
 
@@ -96,7 +96,8 @@ def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None
     The grid must be uniform and hold 3 satellites.  Leading rows whose
     emission time precedes the first sample are dropped (normally one).
     ``shapiro``: include the Shapiro delay in ltt (GCRS: the Earth's; BCRS:
-    the Sun's, plus the Earth's for a geocentric run).
+    the Sun's, plus the Earth's for a geocentric run); None (default): on
+    for heliocentric runs, off for geocentric ones.
 
     ``frame``: "gcrs" (geocentric runs only; their default: the GCRS and TT
     of the trajectory) or "bcrs" (heliocentric runs' default: barycentric,
@@ -130,6 +131,7 @@ def export_lisa(trajectory, out_path, *, shapiro: bool = False, gm: float | None
     attrs = dict(getattr(traj, "attrs", {}) or {})
     if frame == "bcrs":
         return export_bcrs(traj, out, src, attrs, shapiro=shapiro, gm=gm, axes=axes, time_origin=time_origin)
+    shapiro = bool(shapiro)
     gm_v = gm if gm is not None else _scenario_gm(str(attrs.get("scenario", "")))
     gm_v = float(GM_EARTH_EGM2008) if gm_v is None else float(gm_v)
     lp = light_travel_times_of(traj, shapiro=shapiro, gm=gm_v)

@@ -13,7 +13,7 @@ import erfa
 import numpy as np
 
 from .. import __version__ as _TQDYN_VERSION
-from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, J2000_JD, L_B, L_G
+from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, J2000_JD, L_B
 from ..astro.geocentric import gcrs_to_bcrs_offsets
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from ..formats.lisa import (
@@ -24,6 +24,7 @@ from ..formats.lisa import (
 )
 from ..lightpath import light_travel_times, shapiro_delay
 from ..lightpath.proper_time import proper_time_deviation
+from ..lightpath.proper_time_bcrs import proper_time_deviation_of
 from ..numerics.dd import np_dd_add, np_fast_two_sum, np_two_prod, np_two_sum
 
 __all__ = ["TCB_SCALE", "LisaExport", "export_bcrs"]
@@ -210,15 +211,12 @@ def _bcrs_states_geocentric(traj, bodies: dict, ephemeris) -> dict:
 
 def _bcrs_states_heliocentric(traj, bodies: dict, ephemeris) -> dict:
     """Heliocentric (Sun-centred BCRS, TDB) states -> BCRS states with the origin at the SSB: + the Sun's
-    barycentric position and velocity (ephemeris segment 0 -> 10) at the same TDB, + its acceleration (central
-    differences of the ephemeris velocity, +-300 s: error < 1e-16 m/s^2).  Same grid (TDB since the epoch)."""
-    from ..astro.timescales import tdb_after
+    barycentric position, velocity and acceleration at the same TDB
+    (:func:`tqdyn.lightpath.heliocentric.sun_barycentric_motion`).  Same grid (TDB since the epoch)."""
+    from ..lightpath.heliocentric import sun_barycentric_motion
 
-    epoch = traj.epoch
     th, tl = (np.asarray(p, np.float64) for p in traj.dd("t"))
-    x_s, v_s = ephemeris.sun_barycentric(*tdb_after(epoch, th, tl))
-    a_s = (ephemeris.sun_barycentric(*tdb_after(epoch, th + _DIFF_S, tl))[1]
-           - ephemeris.sun_barycentric(*tdb_after(epoch, th - _DIFF_S, tl))[1]) / (2 * _DIFF_S)
+    x_s, v_s, a_s = sun_barycentric_motion(ephemeris, traj.epoch, (th, tl), traj.reference)
     out = {}
     for name, (r, v, a) in bodies.items():
         rh, rl = (np.asarray(p, np.float64) for p in r)
@@ -241,24 +239,6 @@ def _shapiro_bcrs(lp, center, gm_tdb):
     re = (lp.r_emit[0] + lp.r_emit[1]) - center[:, None, :]
     rr = (lp.r_receive[0] + lp.r_receive[1]) - center[:, None, :]
     return shapiro_delay(re, rr, gm_tdb)
-
-
-def _clocks_tcb_heliocentric(traj, sat, gm_sun):
-    """Proper-time deviations against TCB of the satellites of a heliocentric (TDB) run.
-
-    The clock model is lightpath's (:func:`tqdyn.lightpath.proper_time.proper_time_deviation` with the Sun's GM
-    and the Sun-centred states, as lisaorbits' InterpolatedOrbits: U = GM_S / r, v heliocentric), which
-    references the clocks to L_G: delta_tau_G = -(int F dt - L_G dt) / (1 - L_G), F = (U + v^2/2)/c^2, dt the
-    trajectory's (TDB) time.  Against TCB (d tau / dTCB = 1 - F, t_c = S t, delta_tau = 0 at t_init) this is
-    exactly delta_tau_c = S (1 - L_G) delta_tau_G - L_G (t_c - t_c,init), rate_c = (1 - L_G) rate_G - L_G,
-    rate_dot_c = (1 - L_G) rate_dot_G / S.  Returns (delta_tau, rate, rate_dot) (N, 3) per unit TCB time."""
-    t = traj.dd("t")
-    r, v, a = sat
-    dtau, rate, rate_dot = proper_time_deviation(t, r[0] + r[1], v[0] + v[1], a, gm_sun)
-    th, tl = (np.asarray(p, np.float64) for p in t)
-    dt_c = ((th - th[0]) + (tl - tl[0])) * TCB_SCALE
-    dtau_c = TCB_SCALE * (1.0 - L_G) * dtau - L_G * dt_c[:, None]
-    return dtau_c, (1.0 - L_G) * rate - L_G, (1.0 - L_G) * rate_dot / TCB_SCALE
 
 
 def _clocks_tcb_geocentric(traj, sat, st, gm_earth):
@@ -329,6 +309,8 @@ def export_bcrs(traj, out, src, attrs, *, shapiro, gm, axes, time_origin) -> Lis
     ephemeris = default_ephemeris()
     ref = traj.reference
     helio = ref.origin == "sun"
+    if shapiro is None:  # default: the Sun's Shapiro delay in heliocentric files, none in geocentric ones
+        shapiro = helio
     gms = planetary_gm()
     gm_sun = float(gms["sun"])  # TDB-compatible (DE430/DE431), the heliocentric force model's value
     layout, lr, lv, la = _light_bodies(traj)
@@ -340,7 +322,8 @@ def export_bcrs(traj, out, src, attrs, *, shapiro, gm, axes, time_origin) -> Lis
     if helio:
         st = _bcrs_states_heliocentric(traj, bodies, ephemeris)
         x_sun = st["x_sun"]
-        dtau, rate, rate_dot = _clocks_tcb_heliocentric(traj, sat, gm_sun)
+        # tau - TCB, rates per TCB second: the Sun's and the planets' potentials, the barycentric velocity
+        dtau, rate, rate_dot = proper_time_deviation_of(traj, against="TCB", ephemeris=ephemeris)
         gm_e = None
     else:
         gm_e = gm if gm is not None else _scenario_gm(str(attrs.get("scenario", "")))
