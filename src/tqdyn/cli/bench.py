@@ -1,4 +1,4 @@
-"""Command line: ``tqdyn bench [--duration D] [--step S] [--model kepler|full|coupled|all] [--no-heyoka]``.
+"""Command line: ``tqdyn bench [--duration D] [--step S] [--model kepler|full|coupled|lisa|all] [--no-heyoka]``.
 
 Registered in :mod:`tqdyn.cli` with ``cli.add_command(bench)``.  It only
 composes :mod:`tqdyn.workflows.bench` and prints its tables; bad input exits
@@ -15,21 +15,26 @@ __all__ = ["bench"]
 
 
 @click.command("bench")
-@click.option("--duration", default="90d", show_default=True, help="Propagated span.")
+@click.option("--duration", default=None,
+              help="Propagated span [default: 90d; lisa: 3652.5d = 10 years, rounded up to whole 6 h steps].")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s].")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
-@click.option("--model", "which", type=click.Choice(["kepler", "full", "coupled", "all"]), default="all",
+@click.option("--model", "which", type=click.Choice(["kepler", "full", "coupled", "lisa", "all"]), default="all",
               show_default=True,
               help="kepler: monopole only; full: the full force model, pure gravity (and the reduced model vs "
-                   "heyoka); coupled: the full coupled run (attitude + drag-free control).")
+                   "heyoka); coupled: the full coupled run (attitude + drag-free control); lisa: the heliocentric "
+                   "lisa scenario (ESA's orbits and force model).")
 def bench(duration, step, no_heyoka, which):
     """Benchmarks: Kepler (3 TianQin satellites, Earth monopole: tqdyn dd vs
     float64 vs heyoka real128 on the same grid), the force model (full
-    model dd / float64, reduced model dd vs heyoka real128) and the coupled
-    constellation (dd / float64)."""
+    model dd / float64, reduced model dd vs heyoka real128), the coupled
+    constellation (dd / float64) and LISA (heliocentric, 10 years, dd /
+    float64)."""
     from ..workflows import bench as _bench
     from ..scenario import ScenarioError
 
+    lisa_duration = duration or _bench.LISA_DURATION
+    duration = duration or "90d"
     try:
         if which in ("kepler", "all"):
             click.echo(_bench.format_report(_bench.kepler_benchmark(duration=duration, step=step,
@@ -39,5 +44,7 @@ def bench(duration, step, no_heyoka, which):
                                                                                heyoka=not no_heyoka)))
         if which in ("coupled", "all"):
             click.echo(_bench.format_coupled_report(_bench.coupled_benchmark(duration=duration)))
+        if which in ("lisa", "all"):
+            click.echo(_bench.format_lisa_report(_bench.lisa_benchmark(duration=lisa_duration)))
     except (ScenarioError, ValueError) as exc:
         _fail(str(exc))

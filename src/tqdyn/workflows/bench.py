@@ -14,6 +14,11 @@ propagated by
 each in one process, after JIT compilation (compile time reported apart).
 All three are scored against the analytic two-body solution (mpmath, 50
 digits) at the final time, and dd is compared with heyoka directly.
+
+LISA benchmark (:func:`lisa_benchmark`): the built-in heliocentric ``lisa``
+scenario (ESA's CReMA 2.0 orbits, Sun + Earth + Moon + planetary
+barycentres from DE421, the self-gravity ramp toward the centre), 10 years
+at its fixed 6 h step by default, in dd and float64.
 """
 
 from __future__ import annotations
@@ -31,7 +36,10 @@ from ..numerics.dd import mp_from_dd
 from ..scenario import load_scenario
 
 __all__ = ["kepler_benchmark", "format_report", "force_model_benchmark", "format_force_report",
-           "coupled_benchmark", "format_coupled_report"]
+           "coupled_benchmark", "format_coupled_report", "lisa_benchmark", "format_lisa_report", "LISA_DURATION"]
+
+#: Default span of the LISA benchmark: 10 years (14,610 steps of 6 h).
+LISA_DURATION = "3652.5d"
 
 #: Pure-gravity constellation (no attitude, no drag-free control).
 PURE_GRAVITY = ["constellation.pointing=none", "constellation.control=off"]
@@ -229,4 +237,40 @@ def format_coupled_report(report: dict) -> str:
         lines.append(f"{name:<32} {r['wall_s']:>9.2f} {r['peak_rss_mb']:>14.0f}")
     ratio = runs["coupled, dd"]["wall_s"] / runs["coupled, float64"]["wall_s"]
     lines.append(f"dd / float64: {ratio:.2f} (target <= 2); dd wall time target <= 60 s for 90 days")
+    return "\n".join(lines)
+
+
+def lisa_benchmark(duration: str = LISA_DURATION) -> dict:
+    """The built-in ``lisa`` scenario (heliocentric, three point masses, ESA's
+    force model and self-gravity ramp) in dd and in float64: wall time of the
+    propagation [s] (ephemeris inputs included, JIT compilation excluded) and
+    peak resident memory [MB] of the process so far (no output file).  The
+    span is rounded up to whole steps of the scenario (6 h), at least one."""
+    from decimal import ROUND_CEILING
+
+    from ..scenario.loader import parse_duration
+
+    step = load_scenario("lisa").integrator.step_s
+    n = max(1, int((parse_duration(duration) / step).to_integral_value(ROUND_CEILING)))
+    scen = load_scenario("lisa", [f"run.duration={n * step}"])
+    report = {"duration_s": float(scen.run.duration_s), "step_s": float(step), "n_steps": scen.n_steps,
+              "n_sat": len(scen.satellites), "runs": {}}
+    for precision in ("dd", "float64"):
+        wall, rss, res = _timed_run(scen, precision)
+        report["runs"][f"lisa, {precision}"] = {"wall_s": wall, "peak_rss_mb": rss,
+                                                "us_per_step": wall / res.n_steps * 1e6}
+    return report
+
+
+def format_lisa_report(report: dict) -> str:
+    """Human-readable table of a :func:`lisa_benchmark` report."""
+    runs = report["runs"]
+    lines = [f"LISA benchmark: {report['n_sat']} spacecraft (lisa: ESA CReMA 2.0 start, Sun + Earth + Moon + "
+             f"planetary barycentres, self-gravity ramp), {report['duration_s'] / 86400:g} days "
+             f"({report['duration_s'] / 86400 / 365.25:.3g} years) at {report['step_s'] / 3600:g} h ({report['n_steps']} steps), after compilation",
+             f"{'run':<32} {'wall [s]':>9} {'us/step':>9} {'peak RSS [MB]':>14}"]
+    for name, r in runs.items():
+        lines.append(f"{name:<32} {r['wall_s']:>9.2f} {r['us_per_step']:>9.1f} {r['peak_rss_mb']:>14.0f}")
+    ratio = runs["lisa, dd"]["wall_s"] / runs["lisa, float64"]["wall_s"]
+    lines.append(f"dd / float64: {ratio:.2f}")
     return "\n".join(lines)
