@@ -54,7 +54,7 @@ def _esa(file_axes_icrf=False):
     out = []
     for path in esa_lisa_orbit_files("TDB"):
         tr = read_oem(path)
-        out.append(to_heliocentric(tr.replace(ref_frame="ICRF") if file_axes_icrf else tr))
+        out.append(to_heliocentric(tr, eme2000_frame_bias=not file_axes_icrf))
     return out
 
 
@@ -107,7 +107,8 @@ def _statistics(R, V):
 
 @pytest.fixture(scope="module")
 def esa():
-    return _esa()
+    # read as the built-in lisa scenario reads them (initial.oem_eme2000 = "icrf": the files' "EME2000" is ICRF)
+    return _esa(file_axes_icrf=True)
 
 
 @pytest.fixture(scope="module")
@@ -156,7 +157,7 @@ def test_self_gravity_sign_and_size():
     # ESA's ramp starts at -2 nm/s^2 (away from the centre): the opposite sign misses the files by 1.50-1.54 km
     # after 10 days, no self-gravity by 0.76-0.79 km (1/2 g t^2 = 0.75 km for 2 nm/s^2), the scenario's by
     # 24-72 m.  Bounds: flipped > 1.1 km, none in 0.5..1.1 km, nominal < 250 m.
-    esa = _esa()
+    esa = _esa(file_axes_icrf=True)
     out = {}
     for name, ov in (("nominal", []), ("flipped", ["spacecraft.self_gravity_center=[2e-9, -2e-9]"]),
                      ("none", ["spacecraft.self_gravity_center=[0, 0]"])):
@@ -203,18 +204,20 @@ def test_self_gravity_ramp_in_the_files_accelerations(esa):
 
 
 def test_one_year_and_whole_span(lisa_vs_esa):
-    # measured |dr| after 1 year 1543 / 321 / 6182 m, after 3926.5 d (10.75 years) 6.48 / 16.0 / 67.8 km,
-    # >= 96 % along-track; bounds 10 / 3 / 30 km and 30 / 80 / 300 km (4.4-9x).
+    # the files read as the lisa scenario reads them (their "EME2000" as ICRF axes): measured |dr| after 1 year
+    # 1580 / 354 / 6147 m, after 3926.5 d (10.75 years) 2.30 / 11.7 / 63.9 km, >= 99.4 % along-track;
+    # bounds 10 / 3 / 30 km and 15 / 80 / 300 km (4.7-8.5x).  With the frame bias applied to the files (the
+    # standard reading of EME2000) it would be 6.48 / 16.0 / 67.8 km (docs/lisa-orbits.md).
     t, r, _, R, V, d = lisa_vs_esa
     one = d[_row(t, YEAR_D)]
     end = d[-1]
     assert np.all(one < np.array([10e3, 3e3, 30e3])), one
-    assert np.all(end < np.array([30e3, 80e3, 300e3])), end
+    assert np.all(end < np.array([15e3, 80e3, 300e3])), end
     rh = R[-1] / np.linalg.norm(R[-1], axis=-1, keepdims=True)
     h = np.cross(R[-1], V[-1])
     th = np.cross(h / np.linalg.norm(h, axis=-1, keepdims=True), rh)
     along = np.abs(np.einsum("sk,sk->s", r[-1] - R[-1], th))
-    assert np.all(along > 0.96 * end), (along, end)
+    assert np.all(along > 0.98 * end), (along, end)
 
 
 def test_what_remains_is_the_rounding_and_esas_integration():

@@ -79,7 +79,7 @@ def esa_orbits(paths=None, file_axes_icrf: bool = False):
     out = []
     for p in paths or esa_lisa_orbit_files("TDB"):
         tr = read_oem(p)
-        out.append(to_heliocentric(tr.replace(ref_frame="ICRF") if file_axes_icrf else tr))
+        out.append(to_heliocentric(tr, eme2000_frame_bias=not file_axes_icrf))
     return out
 
 
@@ -233,7 +233,7 @@ def main():
     ap.add_argument("--out", type=pathlib.Path, default=OUT)
     args = ap.parse_args()
 
-    esa = esa_orbits()
+    esa = esa_orbits(file_axes_icrf=True)  # as the lisa scenario reads them (initial.oem_eme2000 = "icrf")
     esa_icrf = esa_orbits(file_axes_icrf=True)
     scen, t, r, v = run()
     ep = scen.epoch.tdb

@@ -505,18 +505,22 @@ def tcb_to_tdb(jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
     return jd1.copy(), jd2 + corr
 
 
-def _to_icrf_axes(traj: OemTrajectory, name: str) -> OemTrajectory:
-    if traj.ref_frame == "EME2000":
+def _to_icrf_axes(traj: OemTrajectory, name: str, frame_bias: bool = True) -> OemTrajectory:
+    if traj.ref_frame == "EME2000" and frame_bias:
         bt = frame_bias_matrix().T
         return traj.replace(r=traj.r @ bt.T, v=traj.v @ bt.T, a=None if traj.a is None else traj.a @ bt.T,
                             ref_frame=name)
     return traj.replace(ref_frame=name)
 
 
-def to_heliocentric(traj: OemTrajectory, *, tcb_scaled_coordinates: bool = False) -> OemTrajectory:
+def to_heliocentric(traj: OemTrajectory, *, tcb_scaled_coordinates: bool = False,
+                    eme2000_frame_bias: bool = True) -> OemTrajectory:
     """``traj`` in tqdyn's heliocentric system: CENTER_NAME SUN, ICRF axes, TDB.
 
-    REF_FRAME EME2000 is rotated by the frame bias (ICRF kept); TIME_SYSTEM
+    REF_FRAME EME2000 is rotated by the frame bias (ICRF kept) -- unless
+    ``eme2000_frame_bias`` is False: then EME2000 is taken as a label of
+    ICRF axes (ESA's CReMA 2.0 LISA files, whose "EME2000" states fit
+    ICRF-axes dynamics: tests/test_esa_lisa.py, docs/lisa-orbits.md); TIME_SYSTEM
     TCB tags become TDB (:func:`tcb_to_tdb`; TDB kept).  With
     ``tcb_scaled_coordinates`` the file's coordinates are taken as
     TCB-compatible and scaled to TDB-compatible ones: r (1 - L_B), a / (1 - L_B)
@@ -531,7 +535,7 @@ def to_heliocentric(traj: OemTrajectory, *, tcb_scaled_coordinates: bool = False
     if traj.time_system not in ("TDB", "TCB"):
         raise ValueError(f"{traj.source}: TIME_SYSTEM = {traj.time_system!r} for a heliocentric trajectory "
                          "(allowed here: TDB, TCB)")
-    out = _to_icrf_axes(traj, "ICRF")
+    out = _to_icrf_axes(traj, "ICRF", eme2000_frame_bias)
     if traj.time_system == "TCB":
         j1, j2 = tcb_to_tdb(traj.jd1, traj.jd2)
         (s1,), (s2,) = tcb_to_tdb([traj.start[0]], [traj.start[1]])

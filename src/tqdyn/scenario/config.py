@@ -420,7 +420,7 @@ class Scenario:
                      '["START", "END"] dates (the default, the span of initial.oem, needs OEM files)')
             from .initial import oem_common_span
 
-            _set(sc, "self_gravity_center_span", oem_common_span(self.initial.oem))
+            _set(sc, "self_gravity_center_span", oem_common_span(self.initial.oem, self.initial.oem_eme2000))
 
     def self_gravity_centre_ramp(self) -> tuple[float, float, float, float] | None:
         """(g_start, g_end, t_start, t_end) of ``spacecraft.self_gravity_center``:
@@ -504,7 +504,8 @@ class Scenario:
         out += ["[initial]", f"axes = {toml_str(i.axes)}", f"design = {toml_str(i.design)}",
                 f"arm_length = {toml_value(i.arm_length_m)}  # m", f"displacement_deg = {toml_value(i.displacement_deg)}",
                 f"rotation = {toml_str(i.rotation)}", f"semi_major_axis = {toml_value(i.semi_major_axis_m)}  # m",
-                "oem = [" + ", ".join(toml_str(x) for x in i.oem) + "]", ""]
+                "oem = [" + ", ".join(toml_str(x) for x in i.oem) + "]",
+                f"oem_eme2000 = {toml_str(i.oem_eme2000)}", ""]
         c = self.constellation
         out += ["[constellation]", f"pointing = {toml_str(c.pointing)}", f"control = {toml_str(c.control)}",
                 f"free_tms = {b(c.free_tms)}", ""]

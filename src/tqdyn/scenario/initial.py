@@ -12,7 +12,7 @@ from decimal import Decimal
 from ..astro.timescales import Epoch
 from .values import ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
 
-__all__ = ["AU_M", "INITIAL_AXES", "INITIAL_DESIGNS", "ROTATIONS", "InitialConfig", "SatelliteConfig",
+__all__ = ["AU_M", "INITIAL_AXES", "INITIAL_DESIGNS", "OEM_EME2000", "ROTATIONS", "InitialConfig", "SatelliteConfig",
            "derived_satellites", "epoch_from_label", "oem_first_common_epoch"]
 
 
@@ -67,6 +67,9 @@ class SatelliteConfig:
 INITIAL_AXES = ("equatorial", "ecliptic")
 INITIAL_DESIGNS = ("none", "keplerian")
 ROTATIONS = ("clockwise", "counterclockwise")
+#: How OEM states labelled REF_FRAME = EME2000 are read: rotated by the IAU 2006 frame bias to ICRF (the
+#: standard), or taken as ICRF axes already (ESA's CReMA 2.0 LISA files, docs/lisa-orbits.md).
+OEM_EME2000 = ("frame-bias", "icrf")
 AU_M = Decimal(149597870700)
 
 
@@ -99,7 +102,11 @@ class InitialConfig:
     "counterclockwise") and ``semi_major_axis_m`` [m] (default 1 au).
     ``oem``: CCSDS OEM files, one per satellite in satellite order (the
     states interpolated at the epoch as each file says; default epoch the
-    files' first common record).  ``names``: satellite names for a design
+    files' first common record); ``oem_eme2000``: how states labelled
+    REF_FRAME = EME2000 are read, "frame-bias" (rotated by the IAU 2006
+    frame bias, ~23 mas, to ICRF: the standard) or "icrf" (taken as ICRF
+    axes: ESA's CReMA 2.0 LISA files, whose states fit ICRF-axes dynamics,
+    docs/lisa-orbits.md).  ``names``: satellite names for a design
     or OEM files (default Sat1, Sat2, ...).
     """
 
@@ -110,12 +117,14 @@ class InitialConfig:
     rotation: str = "clockwise"
     semi_major_axis_m: Decimal = AU_M
     oem: tuple[str, ...] = ()
+    oem_eme2000: str = "frame-bias"
     names: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         _require_choice(self.axes, "initial.axes", INITIAL_AXES)
         _require_choice(self.design, "initial.design", INITIAL_DESIGNS)
         _require_choice(self.rotation, "initial.rotation", ROTATIONS)
+        _require_choice(self.oem_eme2000, "initial.oem_eme2000", OEM_EME2000)
         for f in ("arm_length_m", "displacement_deg", "semi_major_axis_m"):
             _set(self, f, _to_decimal(getattr(self, f), f"initial.{f}"))
         _require(self.semi_major_axis_m > 0, "initial.semi_major_axis", self.semi_major_axis_m, "is not positive",
@@ -169,7 +178,7 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
         rv = []
         for k, path in enumerate(initial.oem, start=1):
             try:
-                r, v = states_at(_heliocentric_oem(path), *epoch.tdb)
+                r, v = states_at(_heliocentric_oem(path, initial.oem_eme2000), *epoch.tdb)
             except (OSError, ValueError) as exc:
                 raise ScenarioError(f"initial.oem.{k}", path, f"cannot give a state at {epoch.iso} ({exc})",
                                     "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB) covering "
@@ -182,13 +191,13 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
     return tuple(SatelliteConfig(name=n, r_m=r, v_mps=v) for n, (r, v) in zip(names, rv))
 
 
-def oem_first_common_epoch(paths) -> str:
+def oem_first_common_epoch(paths, eme2000: str = "frame-bias") -> str:
     """The TDB ISO date of the OEM files' first common record (the latest
     of their first epochs), the default epoch of ``initial.oem``."""
     firsts = []
     for k, path in enumerate(paths, start=1):
         try:
-            traj = _heliocentric_oem(path)
+            traj = _heliocentric_oem(path, eme2000)
             firsts.append((traj.start, _tdb_text(traj.start)))
         except (OSError, ValueError) as exc:
             raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
@@ -196,14 +205,14 @@ def oem_first_common_epoch(paths) -> str:
     return max(firsts, key=lambda x: x[0][0] + x[0][1])[1]
 
 
-def oem_common_span(paths) -> tuple[str, str]:
+def oem_common_span(paths, eme2000: str = "frame-bias") -> tuple[str, str]:
     """The OEM files' common span (latest first epoch, earliest last epoch)
     as two TDB ISO dates with the suffix " TDB" (the default span of
     ``spacecraft.self_gravity_center``)."""
     spans = []
     for k, path in enumerate(paths, start=1):
         try:
-            traj = _heliocentric_oem(path)
+            traj = _heliocentric_oem(path, eme2000)
             spans.append(((traj.start, _tdb_text(traj.start)), (traj.stop, _tdb_text(traj.stop))))
         except (OSError, ValueError) as exc:
             raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
@@ -213,12 +222,13 @@ def oem_common_span(paths) -> tuple[str, str]:
     return f"{first[1]} TDB", f"{last[1]} TDB"
 
 
-def _heliocentric_oem(path: str):
+def _heliocentric_oem(path: str, eme2000: str = "frame-bias"):
     """An OEM file's single segment as Sun-centred ICRF/TDB states
-    (:func:`tqdyn.readers.oem.to_heliocentric`); ValueError naming the file."""
+    (:func:`tqdyn.readers.oem.to_heliocentric`; ``eme2000``: see
+    :class:`InitialConfig`); ValueError naming the file."""
     from ..readers.oem import read_oem, to_heliocentric
 
-    return to_heliocentric(read_oem(path))
+    return to_heliocentric(read_oem(path), eme2000_frame_bias=eme2000 == "frame-bias")
 
 
 def _tdb_text(jd) -> str:

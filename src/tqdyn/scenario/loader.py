@@ -105,7 +105,7 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY,
                    "self_gravity_center": _ANY, "self_gravity_center_span": _ANY},
     "initial": {"axes": _STR, "design": _STR, "arm_length": _NUM, "displacement_deg": _NUM, "rotation": _STR,
-                "semi_major_axis": _NUM, "oem": _STRLIST},
+                "semi_major_axis": _NUM, "oem": _STRLIST, "oem_eme2000": _STR},
     "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
 }
 _SAT_SCHEMA: dict[str, str] = {
@@ -268,7 +268,7 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     if not epoch_tdb and "epoch_utc" not in meta and initial.oem:
         from .initial import oem_first_common_epoch
 
-        epoch_tdb = oem_first_common_epoch(initial.oem)
+        epoch_tdb = oem_first_common_epoch(initial.oem, initial.oem_eme2000)
     body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
                     spacecraft=craft, constellation=const, satellites=sats, central_body=body,
