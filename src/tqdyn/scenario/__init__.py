@@ -21,9 +21,11 @@ TOML layout (every section and key optional except at least one
 ``[[satellites]]`` entry with ``a_km``)::
 
     [scenario]      name, description, epoch_utc, central_body ("earth"), extends (a built-in scenario
-                    whose tables this file updates key by key)
+                    whose tables this file updates key by key), allow_below_surface
+                    (false: every satellite starts outside the central body)
     [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
-                    precision ("dd" | "float64"), output, output_every
+                    precision ("dd" | "float64"), output, output_every,
+                    max_steps (default 1e9: the most steps a run may have)
     [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
                     tableau ("corrected" | "published"), rtol
     [forces]        earth_monopole, gm_earth [m^3/s^2]

@@ -26,7 +26,7 @@ __all__ = [
     "SatelliteConfig", "IntegratorConfig", "RunConfig", "ForcesConfig", "SpacecraftConfig",
     "ConstellationConfig", "POINTING_LAWS", "Scenario", "ScenarioError", "CONTROL_MODES", "LIBRATION_MODELS",
     "MAX_EARTH_DEGREE", "MAX_MOON_DEGREE", "MAX_OCEAN_TIDE_DEGREE", "SELF_GRAVITY_MODELS", "THIRD_BODIES",
-    "TM_AXES",
+    "TM_AXES", "MAX_STEPS", "BODY_RADII_M",
 ]
 
 _PRECISIONS = ("dd", "float64")
@@ -34,6 +34,18 @@ _METHODS = ("dp87",)
 _MODES = ("fixed", "adaptive")
 _TABLEAUS = ("corrected", "published")
 _RTOL_MAX = 1e-3
+#: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive
+#: mode) a run may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at the fastest
+#: rate measured (the Kepler model, ~1.3e5 steps/s) 1e9 steps take ~2 h and with the full TianQin
+#: model (~1.9e3 steps/s) ~6 days, and write ~1e11 bytes per satellite (output_every = 1).  A count above this is a mistyped
+#: duration or step (1e12 d at 50 s is 1.7e15 steps and would never finish); raise run.max_steps to override.
+MAX_STEPS = 1_000_000_000
+#: Radii [m] of the central bodies below which no satellite may start (unless
+#: ``scenario.allow_below_surface``): the Earth's equatorial radius (WGS84 / IERS 2010 a = 6378137 m;
+#: EGM2008's reference radius 6378136.3 m differs by 0.7 m) and the Sun's nominal radius (IAU 2015
+#: B3, 696000 km, as :data:`tqdyn.forces.sun.R_SUN_IAU_M`).
+BODY_RADII_M = {"earth": Decimal(6378137), "sun": Decimal(696000000)}
+_BODY_NAMES = {"earth": "the Earth", "sun": "the Sun"}
 from .initial import AU_M, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
 from .values import (  # noqa: F401  (re-exported for the loader)
     _EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require, _require_choice, _set, _to_decimal,
@@ -79,13 +91,17 @@ class RunConfig:
 
     ``duration_s`` [s] (> 0); ``precision``: ``"dd"`` (double-double)
     or ``"float64"``; ``output``: HDF5 file name (non-empty); ``output_every``:
-    write every N-th step (integer >= 1).
+    write every N-th step (integer >= 1); ``max_steps``: the most steps
+    (fixed mode) or output intervals (adaptive mode) the run may have,
+    default :data:`MAX_STEPS` = 1e9 (integer >= 1; checked by
+    :class:`Scenario`: a larger count cannot finish).
     """
 
     duration_s: Decimal = Decimal(864000)
     precision: str = "dd"
     output: str = "tqdyn-run.h5"
     output_every: int = 1
+    max_steps: int = MAX_STEPS
 
     def __post_init__(self) -> None:
         _set(self, "duration_s", _to_decimal(self.duration_s, "run.duration_s"))
@@ -94,6 +110,9 @@ class RunConfig:
         _require(isinstance(self.output, str) and self.output.strip() != "", "run.output", self.output, "is not a non-empty string", "a file name")
         oe = self.output_every
         _require(isinstance(oe, int) and not isinstance(oe, bool) and oe >= 1, "run.output_every", oe, "is not an integer >= 1", "an integer >= 1")
+        ms = self.max_steps
+        _require(isinstance(ms, int) and not isinstance(ms, bool) and ms >= 1, "run.max_steps", ms,
+                 "is not an integer >= 1", f"an integer >= 1 (default {MAX_STEPS})")
 
 
 #: Bodies available as point-mass third bodies (JPL DE ephemerides): all but
@@ -319,7 +338,14 @@ class Scenario:
     ``central_body``: the origin of the propagation (one of
     :data:`tqdyn.astro.reference.CENTRAL_BODIES`).
     In fixed mode ``run.duration_s`` is an exact multiple of
-    ``integrator.step_s``.
+    ``integrator.step_s``; ``integrator.step_s`` is at most
+    ``run.duration_s``, and the number of steps :attr:`n_steps` at most
+    ``run.max_steps``.
+    Every satellite starts outside the central body: pericentre
+    a (1 - e) (Cartesian states: |r|) at least :data:`BODY_RADII_M` (the
+    Earth's equatorial radius 6378137 m, the Sun's radius 696000 km),
+    unless ``allow_below_surface`` (TOML ``[scenario] allow_below_surface
+    = true``, for tests of the dynamics with point masses).
     """
 
     name: str
@@ -334,6 +360,7 @@ class Scenario:
     central_body: str = "earth"
     epoch_tdb: str = ""
     initial: InitialConfig = field(default_factory=InitialConfig)
+    allow_below_surface: bool = False
 
     def __post_init__(self) -> None:
         _require_choice(self.central_body, "scenario.central_body", CENTRAL_BODIES)
@@ -341,6 +368,8 @@ class Scenario:
                  "InitialConfig")
         _require(isinstance(self.name, str) and self.name.strip() != "", "scenario.name", self.name, "is not a non-empty string", "a non-empty string")
         _require(isinstance(self.description, str), "scenario.description", self.description, "is not a string", "a string")
+        _require(isinstance(self.allow_below_surface, bool), "scenario.allow_below_surface", self.allow_below_surface,
+                 "is not a boolean", "true or false")
         if self.epoch_tdb:
             try:
                 epoch = Epoch.from_tdb(self.epoch_tdb)
@@ -374,10 +403,16 @@ class Scenario:
                 raise ScenarioError(f"satellites.{k}.name", sat.name, f"duplicates satellites.{seen[sat.name]}.name", "unique satellite names")
             seen[sat.name] = k
         _set(self, "satellites", sats)
+        if not self.allow_below_surface:
+            self._check_above_surface()
         if self.constellation.coupled:
             _require(len(sats) == 3, "constellation.pointing", self.constellation.pointing,
                      f"needs exactly 3 satellites (the scenario has {len(sats)})",
                      '"none" for other constellations')
+        if self.integrator.step_s > self.run.duration_s:
+            raise ScenarioError("integrator.step", self.integrator.step_s,
+                                f"s is longer than run.duration = {self.run.duration_s} s",
+                                "0 < step <= run.duration")
         if self.integrator.mode == "fixed":
             with localcontext() as ctx:
                 ctx.prec = _EXACT
@@ -389,6 +424,55 @@ class Scenario:
                     f"s is not an integer multiple of integrator.step = {self.integrator.step_s} s (fixed mode)",
                     "a duration that is a whole number of steps",
                 )
+        self._check_steps()
+
+    def _check_steps(self) -> None:
+        """At most ``run.max_steps`` steps; the error names the step when it is
+        below 1 s while the duration would fit at 1 s steps, else the duration."""
+        n, top = self.n_steps, self.run.max_steps
+        if n <= top:
+            return
+        d, h = self.run.duration_s, self.integrator.step_s
+        what = "steps" if self.integrator.mode == "fixed" else "output intervals"
+        allowed = f"at most run.max_steps = {top} {what} (more cannot finish; raise run.max_steps to override)"
+        if h < 1 and d <= top:
+            raise ScenarioError("integrator.step", h, f"s makes run.duration = {d} s {n:.3g} {what}",
+                                f"a step >= {d / top:.3g} s: {allowed}")
+        raise ScenarioError("run.duration", d, f"s is {n:.3g} {what} of integrator.step = {h} s", allowed)
+
+    def _check_above_surface(self) -> None:
+        """Each satellite's pericentre (Cartesian: its distance) at least the central body's radius."""
+        radius = BODY_RADII_M[self.central_body]
+        body = _BODY_NAMES[self.central_body]
+        with localcontext() as ctx:
+            ctx.prec = _EXACT
+            r_km = radius / 1000
+            override = "or scenario.allow_below_surface = true"
+            for k, sat in enumerate(self.satellites, start=1):
+                where = f"satellites.{k}"
+                if sat.cartesian:
+                    dist = sum(x * x for x in sat.r_m).sqrt()
+                    if dist < radius:
+                        inside = f"inside {body}: |r| = {float(dist / 1000):.7g} km < its radius {r_km} km"
+                        if self.initial.derived:  # the state comes from a design or an OEM file
+                            key, value = ((f"initial.oem.{k}", self.initial.oem[k - 1]) if self.initial.oem
+                                          else ("initial.design", self.initial.design))
+                            raise ScenarioError(key, value, f"puts {where} ({sat.name!r}) {inside}",
+                                                f"states with |r| >= {r_km} km, {override}")
+                        raise ScenarioError(f"{where}.r_km", [x / 1000 for x in sat.r_m], f"is {inside}",
+                                            f"|r| >= {r_km} km, {override}")
+                    continue
+                if sat.a_m < radius:
+                    raise ScenarioError(f"{where}.a_km", sat.a_m / 1000,
+                                        f"is inside {body} (its radius {r_km} km)",
+                                        f"a_km >= {r_km} with the pericentre a (1 - e) >= {r_km} km, {override}")
+                peri = sat.a_m * (1 - sat.e)
+                if peri < radius:
+                    e_max = (1 - radius / sat.a_m).quantize(Decimal("1e-9"), rounding="ROUND_FLOOR")
+                    raise ScenarioError(f"{where}.e", sat.e,
+                                        f"puts the pericentre a (1 - e) = {float(peri / 1000):.7g} km inside {body} "
+                                        f"(its radius {r_km} km)",
+                                        f"e <= 1 - radius / a = {e_max}, {override}")
 
     def _check_central_body(self) -> None:
         """The force model, the initial states and the coupled dynamics against the central body."""
@@ -469,10 +553,12 @@ class Scenario:
         out += ["[scenario]", f"name = {toml_str(self.name)}", f"description = {toml_str(self.description)}",
                 (f"epoch_tdb = {toml_str(self.epoch_tdb)}  # TDB (UTC {self.epoch_utc})" if self.epoch_tdb
                  else f"epoch_utc = {toml_str(self.epoch_utc)}  # UTC"),
-                f"central_body = {toml_str(self.central_body)}", ""]
+                f"central_body = {toml_str(self.central_body)}",
+                f"allow_below_surface = {'true' if self.allow_below_surface else 'false'}", ""]
         r = self.run
         out += ["[run]", f"duration = {toml_value(r.duration_s)}  # s", f"precision = {toml_str(r.precision)}",
-                f"output = {toml_str(r.output)}", f"output_every = {r.output_every}", ""]
+                f"output = {toml_str(r.output)}", f"output_every = {r.output_every}",
+                f"max_steps = {r.max_steps}", ""]
         g = self.integrator
         out += ["[integrator]", f"method = {toml_str(g.method)}", f"mode = {toml_str(g.mode)}",
                 f"step = {toml_value(g.step_s)}  # s", f"tableau = {toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]

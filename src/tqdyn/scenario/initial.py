@@ -24,7 +24,10 @@ class SatelliteConfig:
     Either osculating Keplerian elements: ``a_m`` semi-major axis [m] (> 0),
     ``e`` eccentricity [-] (0 <= e < 1), ``i_deg``, ``raan_deg``,
     ``argp_deg``, ``nu_deg``: inclination, longitude (right ascension) of
-    the ascending node, argument of pericentre, true anomaly [deg], finite;
+    the ascending node, argument of pericentre, true anomaly [deg]; the
+    inclination in 0 <= i <= 180 (an angle between the orbit's normal and
+    the pole: 200 or -10 is no inclination), the other three any finite
+    value (they are angles around a circle and wrap: 370 = 10, -90 = 270);
     or a Cartesian state: ``r_m`` position [m] and ``v_mps`` velocity [m/s],
     3 numbers each (then the elements are None).  All numbers are exact
     ``Decimal``.
@@ -57,6 +60,8 @@ class SatelliteConfig:
             _set(self, f, _to_decimal(Decimal(0) if getattr(self, f) is None else getattr(self, f), f"satellite.{f}"))
         _require(self.a_m > 0, "satellite.a_m", self.a_m, "is not positive", "a > 0 m")
         _require(0 <= self.e < 1, "satellite.e", self.e, "is not an elliptic eccentricity", "0 <= e < 1")
+        _require(0 <= self.i_deg <= 180, "satellite.i_deg", self.i_deg, "is not an inclination",
+                 "0 <= i <= 180 deg (raan, argp and nu: any finite angle)")
 
     @property
     def cartesian(self) -> bool:

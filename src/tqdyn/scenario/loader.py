@@ -95,8 +95,8 @@ _ANY = "any"  # validated by the dataclass itself
 
 _SCHEMA: dict[str, dict[str, str]] = {
     "scenario": {"name": _STR, "description": _STR, "epoch_utc": _EPOCH, "epoch_tdb": _EPOCH, "central_body": _STR,
-                 "extends": _STR},
-    "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT},
+                 "extends": _STR, "allow_below_surface": _BOOL},
+    "run": {"duration": _DUR, "precision": _STR, "output": _STR, "output_every": _INT, "max_steps": _INT},
     "integrator": {"method": _STR, "mode": _STR, "step": _NUM, "tableau": _STR, "rtol": _NUM},
     "forces": {"earth_monopole": _BOOL, "sun_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
                "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "third_bodies_gcrs": _BOOL, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
@@ -270,9 +270,10 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
 
         epoch_tdb = oem_first_common_epoch(initial.oem, initial.oem_eme2000)
     body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
+    below = _typed(meta.get("allow_below_surface", False), _BOOL, "scenario.allow_below_surface")
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
                     spacecraft=craft, constellation=const, satellites=sats, central_body=body,
-                    epoch_tdb=epoch_tdb, initial=initial)
+                    epoch_tdb=epoch_tdb, initial=initial, allow_below_surface=below)
 
 
 # --------------------------------------------------------------------------- overrides

@@ -23,6 +23,8 @@ _NOVALUE = object()
 def _fmt(value: Any) -> str:
     if isinstance(value, Decimal):
         return str(value)
+    if isinstance(value, list) and any(isinstance(x, Decimal) for x in value):
+        return "[" + ", ".join(_fmt(x) for x in value) + "]"
     if isinstance(value, Path):
         return repr(str(value))
     return repr(value)
