@@ -212,9 +212,14 @@ class _Segment:
             if seg.daf.file.closed:
                 raise ValueError("ephemeris: the file was closed (Ephemeris.close) before this segment was read")
             n_comp = {2: 3, 3: 6}[self.data_type]
-            init, intlen, rsize, n = seg.daf.read_array(seg.end_i - 3, seg.end_i)
-            rsize, n = int(rsize), int(n)
-            raw = seg.daf.map_array(seg.start_i, seg.end_i - 4).reshape(n, rsize)
+            try:
+                init, intlen, rsize, n = seg.daf.read_array(seg.end_i - 3, seg.end_i)
+                rsize, n = int(rsize), int(n)
+                raw = seg.daf.map_array(seg.start_i, seg.end_i - 4).reshape(n, rsize)
+            except (TypeError, ValueError, OSError) as exc:  # e.g. "buffer is too small": a truncated file
+                name = getattr(seg.daf.file, "name", "the SPK file")
+                raise ValueError(f"ephemeris file {name}: segment {seg.center}->{seg.target} cannot be read "
+                                 f"({exc}); the file is truncated or damaged, download it again") from None
             n_coef = (rsize - 2) // n_comp
             self._coef = np.ascontiguousarray(raw[:, 2:].reshape(n, n_comp, n_coef), dtype=np.float64)
             self._init, self._intlen = float(init), float(intlen)
@@ -301,6 +306,17 @@ class Ephemeris:
             raise ValueError(f"ephemeris file {path}: not a readable SPK (DAF) file ({exc})") from None
         self.path = path
         self.name = os.path.splitext(os.path.basename(path))[0].upper()
+        # a truncated file: its summaries point past the end (8-byte words, 1-based)
+        size = os.path.getsize(path)
+        try:
+            need = max((int(seg.end_i) * 8 for seg in self._spk.segments), default=0)
+        except Exception as exc:  # noqa: BLE001
+            self._spk.close()
+            raise ValueError(f"ephemeris file {path}: not a readable SPK (DAF) file ({exc})") from None
+        if need > size:
+            self._spk.close()
+            raise ValueError(f"ephemeris file {path} is truncated: {size} bytes, its segments need {need}; "
+                             f"download it again")
         groups: dict[tuple[int, int], list] = {}
         for seg in self._spk.segments:
             if seg.data_type in (2, 3):

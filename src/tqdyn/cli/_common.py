@@ -7,14 +7,22 @@ import sys
 
 import click
 
-__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "fail"]
+__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_IO", "EXIT_INTERRUPTED", "EXIT_SIGHUP", "EXIT_SIGTERM", "fail"]
 
 #: some work failed (a sweep member, a study run) after the rest was written
 EXIT_FAILED = 1
 #: bad input: one line on stderr, nothing written
 EXIT_BAD_INPUT = 2
-#: interrupted (Ctrl-C)
+#: the output could not be written at run time (disk full, file-size limit,
+#: I/O error): one line on stderr, no file at the output path, the last
+#: checkpoint (if any) kept for --resume
+EXIT_IO = 3
+#: interrupted (Ctrl-C, SIGINT)
 EXIT_INTERRUPTED = 130
+#: stopped by SIGHUP (128 + 1), handled like Ctrl-C
+EXIT_SIGHUP = 129
+#: stopped by SIGTERM (128 + 15), handled like Ctrl-C
+EXIT_SIGTERM = 143
 
 
 def fail(message: str, status: int = EXIT_BAD_INPUT):

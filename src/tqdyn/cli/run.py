@@ -5,19 +5,72 @@ composes library calls: it resolves the scenario, checks the output path,
 runs the propagator (:func:`tqdyn.workflows.run.run_to_file`) with a
 progress bar, streams the rows into the HDF5 writer and prints a short
 summary.  Bad input exits with status 2 and one line on stderr (no
-traceback, no partial output file).
+traceback, no partial output file), checked before the banner; a failed
+write (disk full, file-size limit) exits with status 3, one line; Ctrl-C
+(130), SIGTERM (143) and SIGHUP (129) keep the last checkpoint for
+``--resume``.  See docs/reliability.md.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
 import sys
 
 import click
 
 from .. import __version__
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, _overrides, fail as _fail
+from ._common import (EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, EXIT_SIGHUP, EXIT_SIGTERM,
+                      _overrides, fail as _fail)
 
 __all__ = ["run"]
+
+
+class _Stopped(KeyboardInterrupt):
+    """SIGTERM / SIGHUP, raised where the run is and handled like Ctrl-C."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+_SIGNAL_EXIT = {signal.SIGTERM: EXIT_SIGTERM, **({signal.SIGHUP: EXIT_SIGHUP} if hasattr(signal, "SIGHUP") else {})}
+
+
+@contextlib.contextmanager
+def _stop_signals():
+    """While the run goes: SIGTERM and SIGHUP raise :class:`_Stopped` (a
+    KeyboardInterrupt: the checkpoint is kept as after Ctrl-C); a second one
+    during the clean-up is ignored.  No-op outside the main thread."""
+    def handler(signum, frame):
+        for s in _SIGNAL_EXIT:
+            signal.signal(s, signal.SIG_IGN)
+        raise _Stopped(signum)
+
+    try:
+        old = {s: signal.signal(s, handler) for s in _SIGNAL_EXIT}
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def _fail_io(message: str):
+    """One line, exit status 3; if HDF5 could not close a file, end without
+    the interpreter's exit handlers (HDF5 would crash in them)."""
+    from ..formats.trajectory import _h5safe
+
+    if _h5safe.HDF5_POISONED:  # pragma: no cover - the writer avoids it
+        click.echo(f"tqdyn: error: {message}", err=True)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_EXIT_IO)
+    _fail(message, _EXIT_IO)
 
 
 def _format_state_table(scenario, y_dd) -> list[str]:
@@ -59,6 +112,7 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     try:
         scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
         io.check_writable(scen.run.output)
+        runner.check_checkpoint(scen, resume)
         model = dynamics.check_inputs(scen)
     except (ScenarioError, io.OutputError, ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
@@ -85,8 +139,15 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
         state["bar"].update(n)
 
     try:
-        summary = runner.run_to_file(scen, model=model, progress=progress,
-                                     checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
+        with _stop_signals():
+            summary = runner.run_to_file(scen, model=model, progress=progress,
+                                         checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
+    except io.OutputIOError as exc:
+        if state["bar"] is not None:
+            state["bar"].close()
+        ckpt = getattr(exc, "tqdyn_checkpoint", None)
+        _fail_io(f"{exc}; " + (f"the checkpoint {ckpt} is kept: free space, then continue with the same "
+                               f"command and --resume" if ckpt else "no output file written"))
     except (ValueError, io.OutputError) as exc:
         if state["bar"] is not None:
             state["bar"].close()
@@ -97,8 +158,10 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
         if state["bar"] is not None:
             state["bar"].close()
         ckpt = getattr(exc, "tqdyn_checkpoint", None)
-        _fail(f"interrupted; continue with the same command and --resume (checkpoint {ckpt})"
-              if ckpt else "interrupted; no output file written", _EXIT_INTERRUPTED)
+        what, status = ((f"stopped by {signal.Signals(exc.signum).name}", _SIGNAL_EXIT[exc.signum])
+                        if isinstance(exc, _Stopped) else ("interrupted", _EXIT_INTERRUPTED))
+        _fail(f"{what}; continue with the same command and --resume (checkpoint {ckpt})"
+              if ckpt else f"{what}; no output file written", status)
     if state["bar"] is not None:
         state["bar"].close()
     result = summary.result

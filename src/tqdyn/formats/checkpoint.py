@@ -7,6 +7,11 @@ included in the free-TM mode) and its compensation, the partial trajectory
 file and how many of its rows the checkpoint covers.  What to do with it
 (checking that it belongs to the run, continuing the partial trajectory) is
 :mod:`tqdyn.workflows.run`'s job.
+
+Everything in it is a plain array (unicode strings, integers, float64): it
+is read with ``allow_pickle=False`` and never needs object data.  A damaged
+or foreign file raises :class:`CheckpointError` (a ``ValueError``) naming
+the file and saying what to do.
 """
 
 from __future__ import annotations
@@ -17,7 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CheckpointFile", "write_checkpoint", "read_checkpoint"]
+__all__ = ["CheckpointFile", "CheckpointError", "write_checkpoint", "read_checkpoint"]
+
+
+class CheckpointError(ValueError):
+    """A checkpoint file cannot be read (truncated, corrupted, not a
+    checkpoint): one-line message naming the file and the remedy."""
 
 
 @dataclass(frozen=True)
@@ -46,17 +56,48 @@ def write_checkpoint(path, *, scenario: str, precision: str, n: int, y, comp, pa
     its rows the checkpoint covers."""
     path = pathlib.Path(path)
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
-        np.savez(fh, scenario=np.array(scenario), precision=np.array(precision), n=np.array(n),
-                 y=y, comp=comp, partial=np.array(partial), rows=np.array(rows))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    arrays = dict(scenario=np.array(str(scenario)), precision=np.array(str(precision)),
+                  n=np.array(int(n), dtype=np.int64), y=np.asarray(y, dtype=np.float64),
+                  comp=np.asarray(comp, dtype=np.float64), partial=np.array(str(partial)),
+                  rows=np.array(int(rows), dtype=np.int64))
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:  # disk full, interrupted: the previous checkpoint stays valid
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
 
 
 def read_checkpoint(path) -> CheckpointFile:
-    """Read a checkpoint written by :func:`write_checkpoint`."""
-    with np.load(path, allow_pickle=False) as data:
-        return CheckpointFile(scenario=str(data["scenario"]), precision=str(data["precision"]),
-                              n=int(data["n"]), y=np.array(data["y"]), comp=np.array(data["comp"]),
-                              partial=str(data["partial"]), rows=int(data["rows"]))
+    """Read a checkpoint written by :func:`write_checkpoint`; a file that is
+    truncated, corrupted or not a checkpoint raises :class:`CheckpointError`."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            kinds = {"scenario": "U", "precision": "U", "partial": "U", "n": "iu", "rows": "iu",
+                     "y": "f", "comp": "f"}
+            arrays = {}
+            for key, kind in kinds.items():
+                a = data[key]
+                if a.dtype.kind not in kind or (kind in ("U", "iu") and a.ndim != 0):
+                    raise ValueError(f"entry {key!r} has dtype {a.dtype} shape {a.shape}")
+                arrays[key] = a
+            return CheckpointFile(scenario=str(arrays["scenario"]), precision=str(arrays["precision"]),
+                                  n=int(arrays["n"]), y=np.array(arrays["y"], dtype=np.float64),
+                                  comp=np.array(arrays["comp"], dtype=np.float64),
+                                  partial=str(arrays["partial"]), rows=int(arrays["rows"]))
+    except FileNotFoundError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - BadZipFile, EOFError, KeyError, numpy's pickle refusal, ...
+        reason = " ".join(str(exc).split())
+        if "allow_pickle" in reason:
+            reason = "it holds object data, which a checkpoint never does"
+        raise CheckpointError(
+            f"checkpoint {str(path)!r} is damaged or not a tqdyn checkpoint ({type(exc).__name__}: "
+            f"{reason[:160]}); remove it (and the hidden partial trajectory .<output>.*.tmp next to it) "
+            f"and run again without --resume") from None

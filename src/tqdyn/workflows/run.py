@@ -12,7 +12,12 @@ another run) raises ``ValueError`` /
 :class:`tqdyn.formats.trajectory.OutputError` before anything is written.
 Any exception during the propagation (including ``KeyboardInterrupt``) is
 re-raised after clean-up; its attribute ``tqdyn_checkpoint`` is the
-checkpoint path if the run can be resumed (``--resume``), else None.
+checkpoint path if the run can be resumed (``--resume``), else None.  A
+failed write (disk full, file-size limit) is an
+:class:`tqdyn.formats.trajectory.OutputIOError`; the last checkpoint (if
+any) and its partial trajectory stay valid for ``--resume``.
+:func:`check_checkpoint` checks the checkpoint side of a run before any
+work starts (the CLI calls it before its banner).
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
-           "checkpoint_path", "eop_attrs", "eop_warning"]
+           "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning"]
 
 
 @dataclass(frozen=True)
@@ -130,6 +135,26 @@ def checkpoint_path(output) -> Path:
     return p.with_name(p.name + ".checkpoint")
 
 
+def check_checkpoint(scen, resume: bool) -> None:
+    """Check, before any work, what the checkpoint of a run of ``scen``
+    needs: without ``resume`` there must be no checkpoint (it would be
+    lost); with it, the checkpoint must be readable, belong to the same
+    scenario and precision, and its partial trajectory must exist.
+    Raises ``ValueError`` (one line naming the file) otherwise."""
+    out_path = io.check_writable(scen.run.output)
+    ckpt = checkpoint_path(out_path)
+    if resume:
+        data = _read_own_checkpoint(ckpt, scen)
+        try:
+            io.TrajectoryWriter.check_partial(data.partial, data.rows)
+        except io.OutputError as exc:
+            raise ValueError(f"--resume: {exc} (checkpoint {ckpt}); remove the checkpoint and run again "
+                             f"without --resume") from None
+    elif ckpt.exists():
+        raise ValueError(f"{ckpt} holds the checkpoint of an interrupted run: continue it with "
+                         f"--resume, or delete it to start again")
+
+
 def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = None,
                 checkpoint_every: int = 0, resume: bool = False) -> RunSummary:
     """Propagate ``scen`` and write its trajectory to ``scen.run.output``.
@@ -163,10 +188,20 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         start = None
         writer_factory = None
     t0 = time.perf_counter()
-    dynamics.warm_up(scen.run.precision)
+    try:
+        dynamics.warm_up(scen.run.precision)
+    except OSError as exc:  # numba could not write its cache (disk full, file-size limit)
+        raise io.OutputIOError(f"JIT compilation could not write numba's cache: {exc.strerror or exc}; free "
+                               f"space, or set NUMBA_CACHE_DIR to a writable directory") from None
     compile_s = time.perf_counter() - t0
     if writer_factory is not None:
         writer = writer_factory()
+        try:
+            writer.check_headroom()
+        except io.OutputIOError as exc:
+            writer.keep_partial()
+            exc.tqdyn_checkpoint = ckpt
+            raise
     else:
         writer = io.TrajectoryWriter(out_path, output_attrs(scen, model), output_fields(scen),
                                      n_sat=len(scen.satellites),
@@ -176,8 +211,14 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
 
     def save_checkpoint(c: Checkpoint):
         partial = writer.sync()
-        write_checkpoint(ckpt, scenario=scen.to_toml(), precision=scen.run.precision, n=c.n, y=c.y,
-                         comp=c.comp, partial=partial, rows=writer.rows_written)
+        try:
+            write_checkpoint(ckpt, scenario=scen.to_toml(), precision=scen.run.precision, n=c.n, y=c.y,
+                             comp=c.comp, partial=partial, rows=writer.rows_written)
+        except OSError as exc:  # disk full: the previous checkpoint (if any) stays valid
+            raise io.OutputIOError(f"cannot write the checkpoint {str(ckpt)!r}: "
+                                   f"{exc.strerror or exc}") from None
+        # stop here, with a consistent partial file, rather than in the middle of a write
+        writer.check_headroom()
 
     try:
         result = dynamics.propagate(scen, sink=lambda rows: writer.append(io.row_fields(rows)), progress=progress, model=model, start=start,
@@ -219,15 +260,21 @@ def run_scenario_text(scenario_toml: str, source: str = "scenario") -> dict:
             "compile_s": float(summary.compile_s)}
 
 
-def _resume(ckpt_path, scen, out_path):
-    """(Checkpoint, writer factory) of an interrupted run; ValueError if
-    there is none or it belongs to another scenario."""
+def _read_own_checkpoint(ckpt_path, scen):
+    """The checkpoint of a run of ``scen`` (ValueError if missing, damaged or another run's)."""
     if not ckpt_path.exists():
         raise ValueError(f"--resume: no checkpoint {ckpt_path} to continue from")
     data = read_checkpoint(ckpt_path)
     if data.scenario != scen.to_toml() or data.precision != scen.run.precision:
         raise ValueError(f"--resume: the checkpoint {ckpt_path} belongs to a different scenario or "
                          f"precision; give the same arguments as the interrupted run")
+    return data
+
+
+def _resume(ckpt_path, scen, out_path):
+    """(Checkpoint, writer factory) of an interrupted run; ValueError if
+    there is none or it belongs to another scenario."""
+    data = _read_own_checkpoint(ckpt_path, scen)
     start = Checkpoint(data.n, data.y, data.comp)
     partial, rows = data.partial, data.rows
     return start, lambda: io.TrajectoryWriter.reopen(partial, out_path, rows)

@@ -220,7 +220,17 @@ def _read_array(obj, path: str, fname: str) -> np.ndarray:
         raise TrajectoryFormatError(f"{fname}: {path!r} is not a dataset")
     if obj.dtype != np.float64:
         raise TrajectoryFormatError(f"{fname}: {path!r} has dtype {obj.dtype}, expected float64")
-    arr = np.ascontiguousarray(obj[()], dtype=np.float64)
+    try:
+        raw = obj[()]
+    except (OSError, RuntimeError) as exc:  # Fletcher-32 mismatch, damaged chunk index, I/O error
+        text = " ".join(str(exc).split())
+        low = text.lower()
+        if "checksum" in low or "fletcher" in low or ("filter" in low and obj.fletcher32):
+            what = "fails its Fletcher-32 checksum: the file is corrupted"
+        else:
+            what = f"cannot be read, the file is damaged ({text[:160]})"
+        raise TrajectoryFormatError(f"{fname}: dataset {path!r} {what}; re-create it (run again)") from None
+    arr = np.ascontiguousarray(raw, dtype=np.float64)
     arr.setflags(write=False)
     return arr
 
@@ -243,6 +253,14 @@ def read_trajectory(path) -> Trajectory:
         h5 = h5py.File(p, "r")
     except OSError as exc:
         raise TrajectoryFormatError(f"{fname}: not a readable HDF5 file ({exc})") from None
+    try:
+        return _read_open(h5, p, fname)
+    except (OSError, RuntimeError, KeyError) as exc:  # damaged object headers / B-trees
+        raise TrajectoryFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
+                                    f"re-create it (run again)") from None
+
+
+def _read_open(h5, p, fname) -> Trajectory:
     with h5:
         attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
         fmt = attrs.get("format")

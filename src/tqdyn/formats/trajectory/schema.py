@@ -23,6 +23,7 @@ from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
+    "OutputIOError",
     "FieldSpec",
     "FIELDS",
     "ROOT_ATTRS",
@@ -202,6 +203,12 @@ def row_fields(rows) -> dict[str, Any]:
 
 class OutputError(OSError):
     """The output path cannot be written (one-line message naming the path)."""
+
+
+class OutputIOError(OutputError):
+    """Writing failed at run time (disk full, file-size limit, I/O error):
+    one-line message naming the file and the cause.  The temporary file is
+    no longer written to (HDF5 left in a state that closes safely)."""
 
 
 class TrajectoryFormatError(ValueError):

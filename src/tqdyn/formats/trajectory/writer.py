@@ -20,7 +20,8 @@ from typing import Any, Mapping, Sequence
 import h5py
 import numpy as np
 
-from .schema import FIELDS, FieldSpec, OutputError, _check_attrs, _fmt_shape, _spec, _symbolic, field_frame
+from ._h5safe import _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
+from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, field_frame
 
 __all__ = ["check_writable", "TrajectoryWriter"]
 
@@ -62,12 +63,7 @@ def _split_dd(value, name: str, shape: tuple) -> tuple[np.ndarray, np.ndarray]:
 
 def _cleanup(state: dict) -> None:
     """Close the HDF5 handle and delete the temporary file (idempotent)."""
-    h5 = state.pop("h5", None)
-    if h5 is not None:
-        try:
-            h5.close()
-        except Exception:  # pragma: no cover - best effort
-            pass
+    _close_h5(state, keep=False)
     tmp = state.pop("tmp", None)
     if tmp is not None:
         try:
@@ -165,6 +161,12 @@ class TrajectoryWriter:
 
     Data are float64 (SI units, TT seconds since the epoch, frames as in :data:`FIELDS`); each
     :meth:`append` adds ``rows`` time rows to every time-dependent field.
+    Every dataset carries a Fletcher-32 checksum.
+
+    A write that fails at run time (disk full, file-size limit) raises
+    :class:`OutputIOError`; the writer then writes nothing more to the
+    temporary file, and :meth:`abort` (as the with-block does) removes it or
+    :meth:`keep_partial` keeps it for a checkpoint.
     """
 
     def __init__(self, path, attrs: Mapping[str, Any], fields: Sequence[str], n_sat: int,
@@ -208,6 +210,7 @@ class TrajectoryWriter:
         try:
             h5 = h5py.File(tmp, "w")
             self._state["h5"] = h5
+            self._state["fd"] = _vfd(h5)
             for k, v in full_attrs.items():
                 h5.attrs[k] = v
             self._dsets: dict[str, tuple] = {}
@@ -216,7 +219,7 @@ class TrajectoryWriter:
                 trail = spec.resolved_shape(self._n_sat)
                 kw = dict(shape=(self._expected,) + trail, maxshape=(None,) + trail,
                           dtype=np.float64, chunks=(self._chunk_rows,) + trail,
-                          compression=compression)
+                          compression=compression, fletcher32=True)
                 if spec.kind == "dd":
                     g = h5.create_group(f)
                     self._field_attrs(g, spec)
@@ -258,6 +261,19 @@ class TrajectoryWriter:
         if self._status != "open":
             raise ValueError(f"{what}: writer for {str(self._path)!r} is already {self._status}")
         return self._state["h5"]
+
+    def _io_failed(self, exc: BaseException) -> OutputIOError:
+        """A write to the temporary file failed: stop writing to it (its
+        descriptor now points at /dev/null, see :func:`_neutralize`) and
+        return the one-line error.  The caller decides whether the partial
+        file is kept (:meth:`keep_partial`, for a checkpoint) or removed
+        (:meth:`abort`, as on any failure in a with-block)."""
+        _neutralize(self._state)
+        self._status = "failed"
+        err = OutputIOError(f"cannot write the trajectory {str(self._path)!r} (temporary file "
+                            f"{self._state.get('tmp')!r}): {_io_reason(exc)}")
+        self._failure = err
+        return err
 
     def _coerce(self, name: str, spec: FieldSpec, value, static: bool) -> tuple[np.ndarray, ...]:
         trail = spec.resolved_shape(self._n_sat)
@@ -359,9 +375,8 @@ class TrajectoryWriter:
                         ds.resize(r1, axis=0)
                     ds[r0:r1] = block
                 parts.clear()
-        except BaseException:
-            self.abort()
-            raise
+        except (OSError, RuntimeError) as exc:
+            raise self._io_failed(exc) from None
         self._buf_rows = 0
         self._rows_on_disk = r1
 
@@ -383,11 +398,13 @@ class TrajectoryWriter:
             if spec.kind == "dd":
                 g = h5.create_group(path)
                 self._field_attrs(g, spec)
-                g.create_dataset("hi", data=arrays[0])
-                g.create_dataset("lo", data=arrays[1])
+                g.create_dataset("hi", data=arrays[0], fletcher32=True)
+                g.create_dataset("lo", data=arrays[1], fletcher32=True)
             else:
-                ds = h5.create_dataset(path, data=arrays[0])
+                ds = h5.create_dataset(path, data=arrays[0], fletcher32=True)
                 self._field_attrs(ds, spec)
+        except (OSError, RuntimeError) as exc:
+            raise self._io_failed(exc) from None
         except BaseException:
             self.abort()
             raise
@@ -403,20 +420,27 @@ class TrajectoryWriter:
         """
         if self._status == "closed":
             return self._path
+        if self._status == "failed":
+            raise self._failure
         h5 = self._require_open("close")
         try:
             if self._static_pending:
                 raise ValueError(f"close: declared static field(s) {', '.join(sorted(self._static_pending))} "
                                  "never set with set_static()")
             self._flush()
-            for dsets in self._dsets.values():
-                for ds in dsets:
-                    if ds.shape[0] != self._rows:
-                        ds.resize(self._rows, axis=0)
-            h5.close()
-            self._state.pop("h5", None)
+            try:
+                for dsets in self._dsets.values():
+                    for ds in dsets:
+                        if ds.shape[0] != self._rows:
+                            ds.resize(self._rows, axis=0)
+                h5.flush()  # a failure here is caught while HDF5 can still close safely
+            except (OSError, RuntimeError) as exc:
+                raise self._io_failed(exc) from None
+            _close_h5(self._state, keep=True)
+            if self._state.get("neutralized"):  # pragma: no cover - the flush above succeeded
+                raise self._io_failed(OSError("closing failed"))
             tmp = self._state["tmp"]
-            _fsync_path(tmp)
+            _fsync_strict(tmp, self)
             try:
                 os.replace(tmp, self._path)
             except OSError as exc:
@@ -424,6 +448,10 @@ class TrajectoryWriter:
                                   f"{exc.strerror or exc}") from None
             self._state.pop("tmp", None)
             _fsync_path(self._path.parent, directory=True)
+        except OutputIOError:
+            # a failed write: the caller keeps the partial file for a checkpoint
+            # (keep_partial) or removes it (abort; a with-block does)
+            raise
         except BaseException:
             self.abort()
             raise
@@ -438,27 +466,39 @@ class TrajectoryWriter:
         returns the temporary file's path (for a checkpoint)."""
         h5 = self._require_open("sync")
         self._flush()
-        h5.flush()
-        _fsync_path(self._state["tmp"])
+        try:
+            h5.flush()
+        except (OSError, RuntimeError) as exc:
+            raise self._io_failed(exc) from None
+        _fsync_strict(self._state["tmp"], self)
         return self._state["tmp"]
+
+    def check_headroom(self) -> None:
+        """After a sync and its checkpoint (or a :meth:`reopen`): check that
+        the file can grow by what the next checkpoint interval needs (see
+        :func:`._h5safe.headroom_errno`); if not, stop now with an
+        :class:`OutputIOError`, while the partial file is consistent and the
+        checkpoint written for it valid for ``--resume``."""
+        chunk_bytes = sum(ds.chunks and int(np.prod(ds.chunks)) * 8 + 64
+                          for dsets in self._dsets.values() for ds in dsets)
+        num, self._synced_size = headroom_errno(self._state["tmp"], getattr(self, "_synced_size", None), chunk_bytes)
+        if num:
+            raise self._io_failed(OSError(num, os.strerror(num)))
 
     def keep_partial(self) -> str | None:
         """Close the temporary file WITHOUT deleting it (a run interrupted
         after a checkpoint keeps its partial trajectory for ``--resume``);
         :attr:`path` is untouched.  Returns the partial file's path."""
-        if self._status != "open":
+        if self._status not in ("open", "failed"):
             return None
         tmp = self._state.get("tmp")
-        h5 = self._state.pop("h5", None)
-        if h5 is not None:
-            try:
-                h5.close()
-            except Exception:  # pragma: no cover - best effort
-                pass
+        _close_h5(self._state, keep=True)
         self._state.pop("tmp", None)
         self._finalizer.detach()
         self._status = "aborted"
         return tmp
+
+    check_partial = staticmethod(check_partial)
 
     @classmethod
     def reopen(cls, partial, path, rows: int) -> "TrajectoryWriter":
@@ -478,6 +518,21 @@ class TrajectoryWriter:
             self._finalizer.detach()
             raise OutputError(f"cannot reopen partial trajectory {str(partial)!r}: {exc}") from None
         self._state["h5"] = h5
+        self._state["fd"] = _vfd(h5)
+        try:
+            self._reopen_datasets(h5, partial, rows)
+        except OutputError:
+            _close_h5(self._state, keep=True)
+            self._finalizer.detach()
+            raise
+        except Exception as exc:  # noqa: BLE001 - a damaged partial file
+            _close_h5(self._state, keep=True)
+            self._finalizer.detach()
+            raise OutputError(f"cannot continue partial trajectory {str(partial)!r}: {_io_reason(exc)}") from None
+        self._status = "open"
+        return self
+
+    def _reopen_datasets(self, h5, partial, rows: int) -> None:
         ts = h5.attrs.get("time_scale", "TT")
         self._time_scale = ts.decode() if isinstance(ts, bytes) else str(ts)
         fr = h5.attrs.get("frame", "GCRS")
@@ -499,11 +554,10 @@ class TrajectoryWriter:
         self._rows = self._rows_on_disk = rows
         self._buf = {f: [] for f in self._tfields}
         self._buf_rows = 0
-        self._status = "open"
-        return self
 
     def abort(self) -> None:
-        """Discard everything: close and delete the temporary file; :attr:`path` is untouched."""
+        """Discard everything: close and delete the temporary file; :attr:`path` is untouched.
+        (Also after a failed write: the file is closed without writing more.)"""
         if self._status == "closed":
             return
         for parts in getattr(self, "_buf", {}).values():
@@ -519,8 +573,12 @@ class TrajectoryWriter:
         if exc_type is not None:
             self.abort()
             return False
-        if self._status == "open":
-            self.close()
+        if self._status in ("open", "failed"):
+            try:
+                self.close()
+            except BaseException:
+                self.abort()
+                raise
         return False
 
     def __repr__(self) -> str:
