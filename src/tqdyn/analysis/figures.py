@@ -10,6 +10,8 @@ matplotlib is imported only inside the plotting functions (Agg backend).
 
 from __future__ import annotations
 
+import os
+import secrets
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -22,6 +24,8 @@ from .pointing_study import PointingStudy
 
 __all__ = [
     "FIGURE_FORMATS",
+    "check_figure_path",
+    "figure_extensions",
     "plot_asd",
     "plot_breathing",
     "plot_common_self_gravity",
@@ -52,8 +56,14 @@ def plot_force_budget(budget, t_s, path, title: str = "") -> None:
     """|a| of every term along the orbit (max over satellites) against time.
 
     budget: list of TermBudget (series (n_t, n_sat) [m/s^2]); t_s: (n_t,)
-    seconds since the epoch; path: PNG or PDF file name.
+    seconds since the epoch; path: a file name whose extension is one of
+    :func:`figure_extensions` (checked first by :func:`check_figure_path`).
+    The figure is written atomically: to a temporary file next to ``path``,
+    then renamed over it, so a failure leaves no partial file and an existing
+    ``path`` untouched.
     """
+    path = Path(path)
+    ext = check_figure_path(path)
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(10, 5.5))
     days = np.asarray(t_s) / 86400.0
@@ -68,8 +78,83 @@ def plot_force_budget(budget, t_s, path, title: str = "") -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        _savefig_atomic(fig, path, ext, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def figure_extensions() -> tuple[str, ...]:
+    """File extensions matplotlib can write (``png``, ``pdf``, ``svg``, ...), sorted."""
+    _pyplot()
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return tuple(sorted(FigureCanvasBase.get_supported_filetypes()))
+
+
+def check_figure_path(path) -> str:
+    """Check, before any work, that a figure can be written at ``path``; returns
+    its format (the extension, lower case).
+
+    Raises ValueError ``"--plot: <path> <problem>; allowed: <what>"`` when the
+    extension is missing or not one of :func:`figure_extensions`, the path is a
+    directory, or its directory is missing, not a directory or not writable
+    (tried by creating and removing a temporary file in it); ImportError when
+    matplotlib is missing.
+    """
+    shown = repr(str(path))
+    path = Path(path)
+    allowed = figure_extensions()
+    ext = path.suffix[1:].lower()
+    if str(path) in ("", ".") or path.is_dir():
+        raise ValueError(f"--plot: {shown} is a directory, not a file name; allowed: a file name ending in "
+                         + ", ".join(f".{e}" for e in allowed))
+    if ext not in allowed:
+        problem = "has no file extension" if not ext else f"has an unsupported extension .{path.suffix[1:]}"
+        raise ValueError(f"--plot: {shown} {problem}; allowed: a file name ending in "
+                         + ", ".join(f".{e}" for e in allowed))
+    parent = path.parent
+    if not parent.exists():
+        raise ValueError(f"--plot: {shown} is in a directory that does not exist ({str(parent)!r}); "
+                         "allowed: a file in an existing, writable directory")
+    if not parent.is_dir():
+        raise ValueError(f"--plot: {shown} is in {str(parent)!r}, which is not a directory; "
+                         "allowed: a file in an existing, writable directory")
+    try:
+        fd, probe = _open_temporary(path)
+    except OSError as exc:
+        raise ValueError(f"--plot: {shown} cannot be written in {str(parent)!r} ({exc.strerror or exc}); "
+                         "allowed: a file in an existing, writable directory") from None
+    os.close(fd)
+    os.unlink(probe)
+    return ext
+
+
+def _open_temporary(path: Path) -> tuple[int, Path]:
+    """A new hidden temporary file next to ``path`` (mode 0o666 less the umask): (fd, its path)."""
+    for _ in range(100):
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+        try:
+            return os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary file name next to {path}")  # pragma: no cover
+
+
+def _savefig_atomic(fig, path: Path, fmt: str, **kwargs) -> None:
+    """``fig.savefig`` to a temporary file next to ``path``, then rename it over ``path``;
+    on any failure the temporary file is removed and ``path`` left as it was."""
+    fd, tmp = _open_temporary(path)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format=fmt, **kwargs)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
 
 
 def _save(fig, out_dir: Path, stem: str) -> list[Path]:
