@@ -49,19 +49,33 @@ Modules: :mod:`.spec` (the sweep file: :class:`SweepSpec`, :func:`load_sweep`),
 :mod:`.plan` (members, :func:`member_done`, :func:`plan_sweep`),
 :mod:`.outcome` (:class:`MemberOutcome`), :mod:`.execute` (members on Dask,
 :func:`run_sweep`), :mod:`.gathering` (:func:`gather`); the netCDF file is
-written by :mod:`tqdyn.formats.netcdf`.
+written by :mod:`.integrity` (Fletcher-32 checksums; :func:`read_sweep_netcdf`
+verifies them).
 """
 
 from __future__ import annotations
 
 from ...formats.netcdf import netcdf_engine, write_netcdf
-from .execute import SweepResult, dask_client, default_workers, run_sweep
+from .execute import (DEFAULT_CONNECT_TIMEOUT, DEFAULT_DASHBOARD, SweepResult, check_dashboard, check_output_dir, connect,
+                      dask_client,
+                      default_workers, make_security, run_sweep)
 from .gathering import gather
+from .integrity import SweepFileError, checksum_encoding, read_sweep_netcdf, write_sweep_netcdf
 from .outcome import MemberOutcome
 from .plan import Member, SweepPlan, member_done, plan_sweep
 from .spec import MODES, Parameter, SweepError, SweepSpec, load_sweep, loads_sweep
 
 __all__ = [
+    "DEFAULT_CONNECT_TIMEOUT",
+    "DEFAULT_DASHBOARD",
+    "SweepFileError",
+    "check_dashboard",
+    "check_output_dir",
+    "checksum_encoding",
+    "connect",
+    "make_security",
+    "read_sweep_netcdf",
+    "write_sweep_netcdf",
     "MODES",
     "Member",
     "MemberOutcome",

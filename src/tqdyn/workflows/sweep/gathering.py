@@ -92,7 +92,8 @@ def gather(plan: SweepPlan, outcomes: Sequence[MemberOutcome]) -> tuple[Any, lis
         try:
             datasets[m.index] = io.read_trajectory(m.path).to_xarray()
         except (OSError, ValueError) as exc:
-            new = MemberOutcome(m, "failed", error=f"cannot read its trajectory file: {one_line(exc)}")
+            new = MemberOutcome(m, "failed", error=f"cannot read its trajectory file: {one_line(exc)}",
+                                lost_workers=o.lost_workers)
             outcomes[outcomes.index(o)] = new
             by_index[m.index] = new
     if not datasets:

@@ -17,7 +17,8 @@ class MemberOutcome:
     ``"<ExceptionType>: <message>"`` for failures; ``traceback``: the
     worker's traceback text (failures during the run); ``wall_s`` /
     ``compile_s``: propagation / JIT time of a run [s]; ``rows``: time rows
-    written."""
+    written; ``lost_workers``: times its worker was lost while running it
+    (Dask re-ran it elsewhere; its file is that of the complete re-run)."""
 
     member: Member
     status: str
@@ -26,6 +27,7 @@ class MemberOutcome:
     wall_s: float = 0.0
     compile_s: float = 0.0
     rows: int = 0
+    lost_workers: int = 0
 
     @property
     def ok(self) -> bool:
