@@ -40,12 +40,7 @@ _RTOL_MAX = 1e-3
 #: model (~1.9e3 steps/s) ~6 days, and write ~1e11 bytes per satellite (output_every = 1).  A count above this is a mistyped
 #: duration or step (1e12 d at 50 s is 1.7e15 steps and would never finish); raise run.max_steps to override.
 MAX_STEPS = 1_000_000_000
-#: Radii [m] of the central bodies below which no satellite may start (unless
-#: ``scenario.allow_below_surface``): the Earth's equatorial radius (WGS84 / IERS 2010 a = 6378137 m;
-#: EGM2008's reference radius 6378136.3 m differs by 0.7 m) and the Sun's nominal radius (IAU 2015
-#: B3, 696000 km, as :data:`tqdyn.forces.sun.R_SUN_IAU_M`).
-BODY_RADII_M = {"earth": Decimal(6378137), "sun": Decimal(696000000)}
-_BODY_NAMES = {"earth": "the Earth", "sun": "the Sun"}
+from .initial import BODY_RADII_M, check_above_surface  # noqa: F401
 from .initial import AU_M, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
 from .values import (  # noqa: F401  (re-exported for the loader)
     _EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require, _require_choice, _set, _to_decimal,
@@ -404,7 +399,7 @@ class Scenario:
             seen[sat.name] = k
         _set(self, "satellites", sats)
         if not self.allow_below_surface:
-            self._check_above_surface()
+            check_above_surface(self.satellites, self.initial, self.central_body)
         if self.constellation.coupled:
             _require(len(sats) == 3, "constellation.pointing", self.constellation.pointing,
                      f"needs exactly 3 satellites (the scenario has {len(sats)})",
@@ -439,40 +434,6 @@ class Scenario:
             raise ScenarioError("integrator.step", h, f"s makes run.duration = {d} s {n:.3g} {what}",
                                 f"a step >= {d / top:.3g} s: {allowed}")
         raise ScenarioError("run.duration", d, f"s is {n:.3g} {what} of integrator.step = {h} s", allowed)
-
-    def _check_above_surface(self) -> None:
-        """Each satellite's pericentre (Cartesian: its distance) at least the central body's radius."""
-        radius = BODY_RADII_M[self.central_body]
-        body = _BODY_NAMES[self.central_body]
-        with localcontext() as ctx:
-            ctx.prec = _EXACT
-            r_km = radius / 1000
-            override = "or scenario.allow_below_surface = true"
-            for k, sat in enumerate(self.satellites, start=1):
-                where = f"satellites.{k}"
-                if sat.cartesian:
-                    dist = sum(x * x for x in sat.r_m).sqrt()
-                    if dist < radius:
-                        inside = f"inside {body}: |r| = {float(dist / 1000):.7g} km < its radius {r_km} km"
-                        if self.initial.derived:  # the state comes from a design or an OEM file
-                            key, value = ((f"initial.oem.{k}", self.initial.oem[k - 1]) if self.initial.oem
-                                          else ("initial.design", self.initial.design))
-                            raise ScenarioError(key, value, f"puts {where} ({sat.name!r}) {inside}",
-                                                f"states with |r| >= {r_km} km, {override}")
-                        raise ScenarioError(f"{where}.r_km", [x / 1000 for x in sat.r_m], f"is {inside}",
-                                            f"|r| >= {r_km} km, {override}")
-                    continue
-                if sat.a_m < radius:
-                    raise ScenarioError(f"{where}.a_km", sat.a_m / 1000,
-                                        f"is inside {body} (its radius {r_km} km)",
-                                        f"a_km >= {r_km} with the pericentre a (1 - e) >= {r_km} km, {override}")
-                peri = sat.a_m * (1 - sat.e)
-                if peri < radius:
-                    e_max = (1 - radius / sat.a_m).quantize(Decimal("1e-9"), rounding="ROUND_FLOOR")
-                    raise ScenarioError(f"{where}.e", sat.e,
-                                        f"puts the pericentre a (1 - e) = {float(peri / 1000):.7g} km inside {body} "
-                                        f"(its radius {r_km} km)",
-                                        f"e <= 1 - radius / a = {e_max}, {override}")
 
     def _check_central_body(self) -> None:
         """The force model, the initial states and the coupled dynamics against the central body."""

@@ -7,13 +7,13 @@ files into Cartesian satellites at the scenario epoch."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from decimal import Decimal
+from decimal import Decimal, localcontext
 
 from ..astro.timescales import Epoch
-from .values import ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
+from .values import _EXACT, ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
 
-__all__ = ["AU_M", "INITIAL_AXES", "INITIAL_DESIGNS", "OEM_EME2000", "ROTATIONS", "InitialConfig", "SatelliteConfig",
-           "derived_satellites", "epoch_from_label", "oem_first_common_epoch"]
+__all__ = ["AU_M", "BODY_RADII_M", "INITIAL_AXES", "INITIAL_DESIGNS", "OEM_EME2000", "ROTATIONS", "InitialConfig", "SatelliteConfig",
+           "check_above_surface", "derived_satellites", "epoch_from_label", "oem_first_common_epoch"]
 
 
 @dataclass(frozen=True)
@@ -243,3 +243,49 @@ def _tdb_text(jd) -> str:
     y, mo, d, hmsf = erfa.d2dtf("TDB", 9, jd[0], jd[1])
     return (f"{int(y):04d}-{int(mo):02d}-{int(d):02d}T{int(hmsf['h']):02d}:{int(hmsf['m']):02d}:"
             f"{int(hmsf['s']):02d}.{int(hmsf['f']):09d}")
+
+
+#: Radii [m] of the central bodies below which no satellite may start (unless
+#: ``scenario.allow_below_surface``): the Earth's equatorial radius (WGS84 / IERS 2010 a = 6378137 m;
+#: EGM2008's reference radius 6378136.3 m differs by 0.7 m) and the Sun's nominal radius (IAU 2015
+#: B3, 696000 km, as :data:`tqdyn.forces.sun.R_SUN_IAU_M`).
+BODY_RADII_M = {"earth": Decimal(6378137), "sun": Decimal(696000000)}
+_BODY_NAMES = {"earth": "the Earth", "sun": "the Sun"}
+
+
+def check_above_surface(satellites, initial: "InitialConfig", central_body: str) -> None:
+    """Each satellite's pericentre (Cartesian: its distance) at least the
+    central body's radius (:data:`BODY_RADII_M`); ScenarioError naming the
+    key (the satellite's, or ``initial.design`` / ``initial.oem.N`` for a
+    derived state) otherwise."""
+    radius = BODY_RADII_M[central_body]
+    body = _BODY_NAMES[central_body]
+    with localcontext() as ctx:
+        ctx.prec = _EXACT
+        r_km = radius / 1000
+        override = "or scenario.allow_below_surface = true"
+        for k, sat in enumerate(satellites, start=1):
+            where = f"satellites.{k}"
+            if sat.cartesian:
+                dist = sum(x * x for x in sat.r_m).sqrt()
+                if dist < radius:
+                    inside = f"inside {body}: |r| = {float(dist / 1000):.7g} km < its radius {r_km} km"
+                    if initial.derived:  # the state comes from a design or an OEM file
+                        key, value = ((f"initial.oem.{k}", initial.oem[k - 1]) if initial.oem
+                                      else ("initial.design", initial.design))
+                        raise ScenarioError(key, value, f"puts {where} ({sat.name!r}) {inside}",
+                                            f"states with |r| >= {r_km} km, {override}")
+                    raise ScenarioError(f"{where}.r_km", [x / 1000 for x in sat.r_m], f"is {inside}",
+                                        f"|r| >= {r_km} km, {override}")
+                continue
+            if sat.a_m < radius:
+                raise ScenarioError(f"{where}.a_km", sat.a_m / 1000,
+                                    f"is inside {body} (its radius {r_km} km)",
+                                    f"a_km >= {r_km} with the pericentre a (1 - e) >= {r_km} km, {override}")
+            peri = sat.a_m * (1 - sat.e)
+            if peri < radius:
+                e_max = (1 - radius / sat.a_m).quantize(Decimal("1e-9"), rounding="ROUND_FLOOR")
+                raise ScenarioError(f"{where}.e", sat.e,
+                                    f"puts the pericentre a (1 - e) = {float(peri / 1000):.7g} km inside {body} "
+                                    f"(its radius {r_km} km)",
+                                    f"e <= 1 - radius / a = {e_max}, {override}")
