@@ -62,16 +62,20 @@ def test_every_bad_values(every, problem, tmp_path, capsys, monkeypatch):
 def test_every_too_many_samples(tmp_path, capsys, monkeypatch):
     """A sampling that would hold more than MAX_SAMPLES states in memory is refused up front."""
     monkeypatch.chdir(tmp_path)
-    line = _refused(["tianqin-kepler", "--duration", "1e12d", "--every", "1e9"], capsys, "--every")
+    # 4e10 s at 50 s steps is 8e8 steps (within run.max_steps), every 1000 s 4e7 samples
+    line = _refused(["tianqin-kepler", "--duration", "4e10s", "--every", "1000"], capsys, "--every")
     assert "samples" in line and "at most 10000000" in line
     assert _files(tmp_path) == []
 
 
 def test_duration_too_many_samples_at_default_every(tmp_path, capsys, monkeypatch):
-    """The same with the default --every: the duration is named (it used to fail in ERFA's taiutc)."""
+    """The same with the default --every: the duration is named (a duration beyond run.max_steps is refused by
+    the scenario first, naming run.duration: it used to fail in ERFA's taiutc)."""
     monkeypatch.chdir(tmp_path)
-    line = _refused(["tianqin-kepler", "--duration", "1e12d"], capsys, "--duration")
+    line = _refused(["tianqin-kepler", "--duration", "4e10s"], capsys, "--duration")
     assert "default --every 600 s" in line
+    line = _refused(["tianqin-kepler", "--duration", "1e12d"], capsys, "run.duration")
+    assert "run.max_steps" in line
 
 
 @pytest.mark.parametrize("name, problem", [

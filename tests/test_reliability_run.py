@@ -216,6 +216,27 @@ def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     assert _listing(tmp_path) == ["out.h5", "ref.h5"]
 
 
+def test_kill_9_after_a_checkpoint_resumes(tmp_path):
+    """kill -9 (no handler can run): the last checkpoint and its partial file
+    are what is left, nothing at the output path; `--resume` finishes to the
+    data of an uninterrupted run."""
+    args = KEPLER + ["--duration", "12d", "--checkpoint-every", "500"]
+    ref, out = tmp_path / "ref.h5", tmp_path / "out.h5"
+    p = _child(args + ["-o", str(out)])
+    _wait_for(tmp_path / "out.h5.checkpoint", p)
+    p.send_signal(signal.SIGKILL)
+    code, _, _ = _finish(p)
+    assert code == -signal.SIGKILL
+    left = _listing(tmp_path)
+    assert "out.h5" not in left and "out.h5.checkpoint" in left
+    code, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
+    assert code == 0, err
+    code, _, err = _finish(_child(args + ["-o", str(ref)]))
+    assert code == 0, err
+    _same_data(ref, out)
+    assert _listing(tmp_path) == ["out.h5", "ref.h5"]
+
+
 def test_sigterm_without_checkpoint_leaves_nothing(tmp_path):
     out = tmp_path / "out.h5"
     p = _child(KEPLER + ["--duration", "200d", "--checkpoint-every", "0", "-o", str(out)])
