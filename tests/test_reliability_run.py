@@ -191,6 +191,16 @@ def _wait_for(path: Path, p: subprocess.Popen, timeout=120):
         time.sleep(0.05)
 
 
+def _resume_matches_uninterrupted(tmp_path, args, out, ref):
+    """`--resume` of the interrupted run finishes; its data equal an uninterrupted run's; nothing else left."""
+    code, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
+    assert code == 0, err
+    code, _, err = _finish(_child(args + ["-o", str(ref)]))
+    assert code == 0, err
+    _same_data(ref, out)
+    assert _listing(tmp_path) == ["out.h5", "ref.h5"]
+
+
 @pytest.mark.parametrize("sig, status", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)], ids=["SIGTERM", "SIGHUP"])
 def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     """SIGTERM / SIGHUP after a checkpoint: like Ctrl-C (checkpoint and its
@@ -208,12 +218,7 @@ def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     left = _listing(tmp_path)
     assert "out.h5" not in left and "out.h5.checkpoint" in left
     assert len([n for n in left if n.endswith(".tmp")]) == 1  # the partial trajectory, as after Ctrl-C
-    code, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
-    assert code == 0, err
-    code, _, err = _finish(_child(args + ["-o", str(ref)]))
-    assert code == 0, err
-    _same_data(ref, out)
-    assert _listing(tmp_path) == ["out.h5", "ref.h5"]
+    _resume_matches_uninterrupted(tmp_path, args, out, ref)
 
 
 def test_kill_9_after_a_checkpoint_resumes(tmp_path):
@@ -229,12 +234,7 @@ def test_kill_9_after_a_checkpoint_resumes(tmp_path):
     assert code == -signal.SIGKILL
     left = _listing(tmp_path)
     assert "out.h5" not in left and "out.h5.checkpoint" in left
-    code, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
-    assert code == 0, err
-    code, _, err = _finish(_child(args + ["-o", str(ref)]))
-    assert code == 0, err
-    _same_data(ref, out)
-    assert _listing(tmp_path) == ["out.h5", "ref.h5"]
+    _resume_matches_uninterrupted(tmp_path, args, out, ref)
 
 
 def test_sigterm_without_checkpoint_leaves_nothing(tmp_path):
