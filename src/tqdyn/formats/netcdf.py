@@ -22,14 +22,15 @@ def netcdf_engine() -> str:
     raise ImportError("writing the sweep's netCDF file needs the h5netcdf package (pip install h5netcdf)")
 
 
-def write_netcdf(dataset, path: str | os.PathLike) -> Path:
+def write_netcdf(dataset, path: str | os.PathLike, encoding: dict | None = None) -> Path:
     """Write ``dataset`` atomically as netCDF-4 (engine :func:`netcdf_engine`)
-    to ``path`` (temporary file in the same directory, then renamed).
+    to ``path`` (temporary file in the same directory, then renamed), with
+    xarray's per-variable ``encoding`` (e.g. checksums) if given.
     Returns the absolute path."""
     path = Path(os.path.abspath(os.fspath(path)))
     tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
     try:
-        dataset.to_netcdf(tmp, engine=netcdf_engine())
+        dataset.to_netcdf(tmp, engine=netcdf_engine(), encoding=encoding)
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)

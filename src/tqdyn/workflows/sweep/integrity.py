@@ -6,10 +6,9 @@ every checksum verified (:func:`read_sweep_netcdf`, one-line
 from __future__ import annotations
 
 import os
-import secrets
 from pathlib import Path
 
-from ...formats.netcdf import netcdf_engine
+from ...formats.netcdf import netcdf_engine, write_netcdf
 from ..run import one_line
 
 __all__ = ["SweepFileError", "checksum_encoding", "read_sweep_netcdf", "write_sweep_netcdf"]
@@ -34,14 +33,7 @@ def write_sweep_netcdf(dataset, path: str | os.PathLike) -> Path:
     """Write ``dataset`` atomically as netCDF-4 (temporary file in the same
     directory, then renamed) with Fletcher-32 checksums (:func:`checksum_encoding`).
     Returns the absolute path."""
-    path = Path(os.path.abspath(os.fspath(path)))
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
-    try:
-        dataset.to_netcdf(tmp, engine=netcdf_engine(), encoding=checksum_encoding(dataset))
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return write_netcdf(dataset, path, encoding=checksum_encoding(dataset))
 
 
 def read_sweep_netcdf(path: str | os.PathLike):
