@@ -64,9 +64,7 @@ file at the destination is left untouched.
 
 from __future__ import annotations
 
-import os
 import pathlib
-import secrets
 import warnings
 from collections.abc import Mapping
 from typing import Any
@@ -76,6 +74,7 @@ import h5py
 import numpy as np
 
 from . import trajectory as _io
+from .atomic import replacing
 
 __all__ = [
     "AXES",
@@ -285,29 +284,13 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
         root[key] = _attr_value(key, val)
     root.update(version=LISA_ORBIT_FORMAT_VERSION, t0=float(t0), dt=float(dt), size=int(N))
 
-    tmp = out.parent / f".{out.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with h5py.File(tmp, "x") as h5:
-            for key, val in root.items():
-                h5.attrs[key] = val
-            for name, arr in arrays.items():
-                ds = h5.create_dataset(name, data=arr)
-                if name in _DATASETS:
-                    ds.attrs["units"] = _DATASETS[name][1]
-                    ds.attrs["description"] = _DATASETS[name][2].replace("GCRS", frame_label)
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-        os.replace(tmp, out)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        if isinstance(exc, OSError) and not isinstance(exc, _io.OutputError):
-            raise _io.OutputError(f"cannot write LISA orbit file {str(out)!r}: {exc}") from None
-        raise
+    with replacing(out, "LISA orbit file") as tmp, h5py.File(tmp, "x") as h5:
+        for key, val in root.items():
+            h5.attrs[key] = val
+        for name, arr in arrays.items():
+            ds = h5.create_dataset(name, data=arr)
+            if name in _DATASETS:
+                ds.attrs["units"] = _DATASETS[name][1]
+                ds.attrs["description"] = _DATASETS[name][2].replace("GCRS", frame_label)
     return out
 

@@ -41,7 +41,6 @@ import dataclasses
 import datetime as _dt
 import os
 import pathlib
-import secrets
 from collections.abc import Sequence
 
 import erfa
@@ -51,6 +50,7 @@ import tqdyn
 
 from ..readers.oem import GEOCENTRIC, HELIOCENTRIC, INTERPOLATIONS, REF_FRAMES, TIME_SYSTEMS
 from . import trajectory as _io
+from .atomic import replacing
 
 __all__ = ["OEM_VERSION", "OemSegment", "write_oem", "write_oem_files"]
 
@@ -239,21 +239,8 @@ def _default_comments(parts: list[dict]) -> list[str]:
 
 
 def _write_atomic(out: pathlib.Path, text: str) -> None:
-    tmp = out.parent / f".{out.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with open(tmp, "x", encoding="ascii", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, out)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        if isinstance(exc, OSError) and not isinstance(exc, _io.OutputError):
-            raise _io.OutputError(f"cannot write OEM file {str(out)!r}: {exc}") from None
-        raise
+    with replacing(out, "OEM file") as tmp, open(tmp, "x", encoding="ascii", newline="\n") as fh:
+        fh.write(text)
 
 
 def _header_args(originator, creation_date):
