@@ -40,24 +40,36 @@ _SIGNAL_EXIT = {signal.SIGTERM: EXIT_SIGTERM, **({signal.SIGHUP: EXIT_SIGHUP} if
 
 @contextlib.contextmanager
 def _stop_signals():
-    """While the run goes: SIGTERM and SIGHUP raise :class:`_Stopped` (a
-    KeyboardInterrupt: the checkpoint is kept as after Ctrl-C); a second one
-    during the clean-up is ignored.  No-op outside the main thread."""
+    """While the run goes: SIGTERM and SIGHUP are recorded in the yielded
+    dict (``"signum"``) and :func:`_check_stop` raises :class:`_Stopped` (a
+    KeyboardInterrupt: the checkpoint is kept as after Ctrl-C) at the next
+    chunk of steps.  The handler itself does not raise: an exception raised
+    by a signal handler while Python runs a callback (a weakref's, the
+    garbage collector's) is printed as "Exception ignored ..." and lost.  A
+    second signal is ignored.  No-op outside the main thread."""
+    pending: dict = {}
+
     def handler(signum, frame):
         for s in _SIGNAL_EXIT:
             signal.signal(s, signal.SIG_IGN)
-        raise _Stopped(signum)
+        pending["signum"] = signum
 
     try:
         old = {s: signal.signal(s, handler) for s in _SIGNAL_EXIT}
     except ValueError:  # not the main thread
-        yield
+        yield pending
         return
     try:
-        yield
+        yield pending
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+
+
+def _check_stop(pending: dict) -> None:
+    """Raise :class:`_Stopped` if :func:`_stop_signals` recorded a signal."""
+    if "signum" in pending:
+        raise _Stopped(pending["signum"])
 
 
 def _fail_io(message: str):
@@ -129,9 +141,10 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     note = runner.eop_warning(scen, model)
     if note:
         click.echo(f"tqdyn: warning: {note}", err=True)
-    state = {"bar": None}
+    state = {"bar": None, "stop": {}}
 
     def progress(n):
+        _check_stop(state["stop"])  # SIGTERM / SIGHUP: stop here, between two chunks of steps
         if state["bar"] is None:
             state["bar"] = tqdm(total=n_total if fixed else float(scen.run.duration_s),
                                 disable=True if quiet else None, unit="step" if fixed else "s",
@@ -139,7 +152,7 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
         state["bar"].update(n)
 
     try:
-        with _stop_signals():
+        with _stop_signals() as state["stop"]:
             summary = runner.run_to_file(scen, model=model, progress=progress,
                                          checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
     except io.OutputIOError as exc:
