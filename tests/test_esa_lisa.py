@@ -68,7 +68,7 @@ def _full_digit_y0(file_axes_icrf):
 
 
 def _run(overrides=(), duration=SPAN, y0=None, model=None):
-    scen = load_scenario("lisa", [f"run.duration={duration}", *overrides])
+    scen = load_scenario("lisa-esa", [f"run.duration={duration}", *overrides])
     blocks = []
     dynamics.propagate(scen, sink=blocks.append, y0=y0, model=model)
     rows = dynamics.Rows.concatenate(blocks)
@@ -115,7 +115,7 @@ def esa():
 def lisa_file(tmp_path_factory):
     """``tqdyn run lisa --set run.duration=3926.5d`` to a trajectory file, read back."""
     out = tmp_path_factory.mktemp("esa-lisa") / "lisa.h5"
-    scen = load_scenario("lisa", [f"run.duration={SPAN}", f"run.output={out}"])
+    scen = load_scenario("lisa-esa", [f"run.duration={SPAN}", f"run.output={out}"])
     run_to_file(scen)
     return read_trajectory(out)
 
@@ -177,7 +177,7 @@ def test_self_gravity_ramp_in_the_files_accelerations(esa):
     from tqdyn.dynamics import layout
     from tqdyn.dynamics.rhs import evaluate_rhs
 
-    scen = load_scenario("lisa", [f"run.duration={SPAN}"])
+    scen = load_scenario("lisa-esa", [f"run.duration={SPAN}"])
     model = build_force_model(scen.forces, scen.reference)
     ep = scen.epoch.tdb
     t = np.clip(((esa[0].jd1 - ep[0]) + (esa[0].jd2 - ep[1])) * DAY, 0.0, None)

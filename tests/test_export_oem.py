@@ -18,7 +18,7 @@ from tqdyn.workflows.run import run_to_file
 def runs(tmp_path_factory):
     d = tmp_path_factory.mktemp("oem")
     helio = d / "lisa.h5"
-    run_to_file(load_scenario("lisa", ["run.duration=2d", f"run.output={helio}"]))
+    run_to_file(load_scenario("lisa-esa", ["run.duration=2d", f"run.output={helio}"]))
     geo = d / "tq.h5"
     run_to_file(load_scenario("tianqin-kepler", ["run.duration=2h", "integrator.step=600", f"run.output={geo}"]))
     return d, helio, geo

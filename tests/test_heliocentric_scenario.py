@@ -28,12 +28,15 @@ step = 21600
 
 
 def test_builtins_resolve_and_round_trip():
-    for name in ("lisa", "lisa-kepler", "taiji"):
+    for name in ("lisa", "lisa-esa", "lisa-gravity", "lisa-kepler", "taiji"):
         scen = load_scenario(name)
         assert scen.reference is HELIOCENTRIC and len(scen.satellites) == 3
         again = loads_scenario(scen.to_toml())
         assert again == scen, name
     lisa = load_scenario("lisa")
+    assert lisa.constellation.coupled and lisa.spacecraft.architecture == "lisa"
+    assert not load_scenario("lisa-gravity").constellation.coupled
+    assert load_scenario("lisa-gravity").spacecraft.self_gravity_center is None
     # the default epoch of initial.oem: the files' first common record (ESA's 2036-12-09T00:00:00.00000094 TDB)
     assert lisa.epoch_tdb == "2036-12-09T00:00:00.000000940"
     assert lisa.spacecraft.self_gravity_center_span == ("2036-12-09T00:00:00.000000940 TDB",
@@ -42,7 +45,7 @@ def test_builtins_resolve_and_round_trip():
 
 def test_oem_initial_states_are_the_files_records():
     # reference: the files' first records (km, km/s), their "EME2000" read as ICRF axes (initial.oem_eme2000)
-    scen = load_scenario("lisa")
+    scen = load_scenario("lisa-esa")
     y0 = initial_state(scen)
     for k, path in enumerate(esa_lisa_orbit_files("TDB")):
         traj = to_heliocentric(read_oem(path), eme2000_frame_bias=False)
@@ -112,13 +115,13 @@ def test_self_gravity_ramp_shortens_the_arms():
     (["scenario.epoch_tdb=2050-01-01"], "initial.oem.1"),
     (['forces.third_bodies=["sun"]'], "forces.third_bodies"),
     (["forces.earth_degree=4"], "forces.earth_degree"),
-    (["constellation.pointing=global"], "constellation.pointing"),
+    (["spacecraft.architecture=lisa", "spacecraft.d_tm=0.4"], "spacecraft.d_tm"),
     (["initial.rotation=sideways"], "initial.rotation"),
     (["initial.axes=galactic"], "initial.axes"),
 ])
 def test_bad_heliocentric_input_one_line(tmp_path, capsys, override, field):
     out = tmp_path / "x.h5"
-    args = ["run", "lisa", "--set", "run.duration=1d", "--output", str(out)]
+    args = ["run", "lisa-esa", "--set", "run.duration=1d", "--output", str(out)]
     for o in override:
         args += ["--set", o]
     status, _, err = run_cli(args, capsys)
@@ -138,7 +141,7 @@ def test_bad_oem_files_one_line(tmp_path, capsys, edit, what):
     bad = tmp_path / "bad.oem"
     bad.write_text(edit(open(files[0], encoding="utf-8").read()), encoding="utf-8")
     out = tmp_path / "x.h5"
-    status, _, err = run_cli(["run", "lisa", "--set", f'initial.oem=["{bad}", "{files[1]}", "{files[2]}"]',
+    status, _, err = run_cli(["run", "lisa-esa", "--set", f'initial.oem=["{bad}", "{files[1]}", "{files[2]}"]',
                               "--set", "run.duration=1d", "--output", str(out)], capsys)
     assert status == 2 and err.count("\n") == 1 and "initial.oem.1" in err and what in err, err
     assert not out.exists()
@@ -151,11 +154,11 @@ def test_set_initial_oem_relative_to_cwd(tmp_path, monkeypatch, capsys):
     for k, f in enumerate(files):
         shutil.copy(f, tmp_path / f"sc{k + 1}.oem")
     monkeypatch.chdir(tmp_path)
-    scen = load_scenario("lisa", ['initial.oem=["sc1.oem", "sc2.oem", "sc3.oem"]'])
+    scen = load_scenario("lisa-esa", ['initial.oem=["sc1.oem", "sc2.oem", "sc3.oem"]'])
     # TCB time tags: the first common record converted to TDB (IAU 2006 B3) is ESA's TDB first record
     # within the TCB files' 1-us tag rounding
     e = scen.epoch
-    ref = load_scenario("lisa").epoch
+    ref = load_scenario("lisa-esa").epoch
     assert abs(((e.tdb[0] - ref.tdb[0]) + (e.tdb[1] - ref.tdb[1])) * 86400) < 2e-6
     assert all(str(tmp_path) in p for p in scen.initial.oem)
 

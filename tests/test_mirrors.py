@@ -22,6 +22,7 @@ from tqdyn.constellation import geometry as geo
 from tqdyn.constellation._control_jit import housing_geometry, satellite_control
 from tqdyn.constellation._kinematics_jit import LAW_CODES, sat_kinematics
 from tqdyn.constellation.spacecraft import Spacecraft
+from tqdyn.dynamics.layout import SCHEME_CODES
 from tqdyn.dynamics.rhs import _breathing_angle
 from tqdyn.forces.central import central_jerk_snap, monopole_jerk_snap
 from tqdyn.numerics import dd
@@ -60,30 +61,41 @@ def kinematics(law):
 
 
 def control():
-    """_control_jit.housing_geometry / satellite_control vs spacecraft.Spacecraft and the control module."""
+    """_control_jit.housing_geometry / satellite_control vs spacecraft.Spacecraft and the control module,
+    for both drag-free schemes (tianqin line layout with a pivot offset; lisa optical-axis layout with
+    tilted sensitive axes)."""
     rng = np.random.default_rng(7)
-    craft = Spacecraft(d_tm=0.4, d_p=0.05, tm_axis="y", self_gravity_on=False)
-    theta = np.pi / 3 + 1e-3 * rng.standard_normal(3)
-    th1, th2 = 1e-9 * rng.standard_normal(3), 1e-15 * rng.standard_normal(3)
-    w = np.array([1e-9, -2e-9, 2e-5]) + 1e-10 * rng.standard_normal((3, 3))
-    wd = 1e-13 * rng.standard_normal((3, 3))
-    dg = 1e-10 * rng.standard_normal((3, 2, 3))
-    sg = 1e-10 * rng.standard_normal((3, 2, 3))
-    r0, rho, vel = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 2, 3))
-    g, A, G, alpha = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 3)), np.zeros((3, 2, 3))
-    for i in range(3):
-        housing_geometry(i, theta[i], th1[i], craft.d_p, craft.nominal_housing_centers, craft.theta_nominal,
-                         w, r0, rho, vel)
-        satellite_control(i, dg, sg, w, wd, theta[i], th1[i], th2[i], r0, rho, g, A, G, alpha)
-    np.testing.assert_allclose(r0, craft.housing_centers(theta), rtol=0, atol=1e-16)   # m, |r0| 0.2 m
-    np.testing.assert_allclose(rho, craft.lever_arms(theta), rtol=0, atol=1e-16)
-    wm, wmd = ctl.mosa_angular_rates(th1, th2)
-    np.testing.assert_allclose(vel, np.cross(w[:, None, :], r0) + np.cross(wm, rho), rtol=0, atol=1e-21)  # m/s
-    g_ref = ctl.tm_relative_acceleration(dg, w, wd, wm, wmd, r0, rho, sg)
-    np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-24)              # m/s^2, |g| ~ 1e-10
-    np.testing.assert_allclose(A, ctl.suspension_acceleration(g_ref, theta), rtol=0, atol=1e-23)
-    np.testing.assert_allclose(G, ctl.dragfree_acceleration(g_ref, theta), rtol=0, atol=1e-23)
-    np.testing.assert_allclose(alpha, ctl.tm_angular_acceleration(w, wd, wm, wmd, theta), rtol=0, atol=1e-26)
+    crafts = (Spacecraft(d_tm=0.4, d_p=0.05, tm_axis="y", self_gravity_on=False),
+              Spacecraft.preset("lisa", tm_distance=0.3, self_gravity_on=False,
+                                sensitive_axes=[[1.0, 0.1, -0.05], [0.98, -0.2, 0.1]]))
+    for craft in crafts:
+        theta = np.pi / 3 + 1e-3 * rng.standard_normal(3)
+        th1, th2 = 1e-9 * rng.standard_normal(3), 1e-15 * rng.standard_normal(3)
+        w = np.array([1e-9, -2e-9, 2e-5]) + 1e-10 * rng.standard_normal((3, 3))
+        wd = 1e-13 * rng.standard_normal((3, 3))
+        dg = 1e-10 * rng.standard_normal((3, 2, 3))
+        sg = 1e-10 * rng.standard_normal((3, 2, 3))
+        r0, rho, vel = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 2, 3))
+        g, A, G, alpha = np.zeros((3, 2, 3)), np.zeros((3, 2, 3)), np.zeros((3, 3)), np.zeros((3, 2, 3))
+        code = SCHEME_CODES[craft.scheme]
+        for i in range(3):
+            housing_geometry(i, theta[i], th1[i], craft.nominal_housing_centers, craft.pivots, craft.theta_nominal,
+                             w, r0, rho, vel)
+            satellite_control(i, code, craft.sensitive_axes_array, dg, sg, w, wd, theta[i], th1[i], th2[i], r0, rho,
+                              g, A, G, alpha)
+        np.testing.assert_allclose(r0, craft.housing_centers(theta), rtol=0, atol=1e-16)   # m, |r0| 0.2-0.3 m
+        np.testing.assert_allclose(rho, craft.lever_arms(theta), rtol=0, atol=1e-16)
+        wm, wmd = ctl.mosa_angular_rates(th1, th2)
+        np.testing.assert_allclose(vel, np.cross(w[:, None, :], r0) + np.cross(wm, rho), rtol=0, atol=1e-21)  # m/s
+        g_ref = ctl.tm_relative_acceleration(dg, w, wd, wm, wmd, r0, rho, sg)
+        np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-24)              # m/s^2, |g| ~ 1e-10
+        if craft.scheme == "tianqin":
+            A_ref, G_ref = ctl.suspension_acceleration(g_ref, theta), ctl.dragfree_acceleration(g_ref, theta)
+        else:
+            G_ref, A_ref = ctl.dragfree_general(g_ref, theta, craft.sensitive_axes_array)
+        np.testing.assert_allclose(A, A_ref, rtol=0, atol=1e-23)
+        np.testing.assert_allclose(G, G_ref, rtol=0, atol=1e-23)
+        np.testing.assert_allclose(alpha, ctl.tm_angular_acceleration(w, wd, wm, wmd, theta), rtol=0, atol=1e-26)
 
 
 def breathing_angle():

@@ -104,8 +104,8 @@ def y0_of(orbits) -> np.ndarray:
 
 
 def run(overrides=(), duration=SPAN, y0=None, model=None):
-    """Propagate the ``lisa`` scenario; (scenario, t [s TDB], r, v (N, 3, 3) float64)."""
-    scen = load_scenario("lisa", [f"run.duration={duration}", *overrides])
+    """Propagate the ``lisa-esa`` scenario; (scenario, t [s TDB], r, v (N, 3, 3) float64)."""
+    scen = load_scenario("lisa-esa", [f"run.duration={duration}", *overrides])
     blocks = []
     dynamics.propagate(scen, sink=blocks.append, y0=y0, model=model)
     rows = dynamics.Rows.concatenate(blocks)
@@ -233,7 +233,7 @@ def main():
     ap.add_argument("--out", type=pathlib.Path, default=OUT)
     args = ap.parse_args()
 
-    esa = esa_orbits(file_axes_icrf=True)  # as the lisa scenario reads them (initial.oem_eme2000 = "icrf")
+    esa = esa_orbits(file_axes_icrf=True)  # as the lisa-esa scenario reads them (initial.oem_eme2000 = "icrf")
     esa_icrf = esa_orbits(file_axes_icrf=True)
     scen, t, r, v = run()
     ep = scen.epoch.tdb
@@ -354,11 +354,11 @@ def _partial_fit(orbits, scen, res, de440=None):
     _, base = gravity_at_records(orbits, scen)
     parts = {}
     for name, ov in (("Sun Schwarzschild", ["forces.relativity=true"]), ("Sun J2", ["forces.sun_j2=true"])):
-        parts[name] = gravity_at_records(orbits, load_scenario("lisa", [f"run.duration={SPAN}", *ov]))[1] - base
+        parts[name] = gravity_at_records(orbits, load_scenario("lisa-esa", [f"run.duration={SPAN}", *ov]))[1] - base
     parts["GM_Sun x (1 + 1e-12)"] = gravity_at_records(orbits, scen, gm_sun_scaled(scen, 1.0 + 1e-12))[1] - base
     if de440:
         parts["DE440 - DE421"] = gravity_at_records(
-            orbits, load_scenario("lisa", [f"run.duration={SPAN}", f"forces.ephemeris={de440}"]))[1] - base
+            orbits, load_scenario("lisa-esa", [f"run.duration={SPAN}", f"forces.ephemeris={de440}"]))[1] - base
     M = np.stack([p.ravel() for p in parts.values()], 1)
     coef, *_ = np.linalg.lstsq(M, res.ravel(), rcond=None)
     after = np.sqrt(np.mean((res.ravel() - M @ coef) ** 2))
@@ -440,7 +440,7 @@ def _figure(out, t, d, curves, hi_curve, r, R, every=4):
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, fontsize=7, ncol=2, loc="lower left")
-    fig.suptitle("tqdyn lisa scenario (ESA's force model and self-gravity ramp, DE421) vs ESA CReMA 2.0 "
+    fig.suptitle("tqdyn lisa-esa scenario (ESA's force model and self-gravity ramp, DE421) vs ESA CReMA 2.0 "
                  "trailing orbits, 2036-12-09 .. 2047-09-09", fontsize=10)
     fig.tight_layout()
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -2,9 +2,10 @@
 
 Scalar numba versions of :func:`tqdyn.constellation.control.nominal_control`
 and :meth:`tqdyn.constellation.spacecraft.Spacecraft.housing_centers` for one
-satellite at one instant; the derivation (eq:TMforce bracket, eq:E1, eq:E2
-and G from the three control conditions with tan(theta/2), cot(theta/2)) is
-in :mod:`tqdyn.constellation.control`.  The numpy module is the reference
+satellite at one instant; the derivations (eq:TMforce bracket, eq:E1, eq:E2
+and G from the three control conditions with tan(theta/2), cot(theta/2); the
+general scheme for any sensitive axes by Cramer's rule) are in
+:mod:`tqdyn.constellation.control`.  The numpy module is the reference
 the tests compare these kernels with.
 
 Frames: S (satellite), OA_l (MOSA/TM l: X_S rotated by +theta/2 for l = 1,
@@ -25,28 +26,30 @@ __all__ = ["housing_geometry", "satellite_control"]
 
 
 @njit(cache=True)
-def housing_geometry(i, theta, theta_dot, d_p, r0_nom, theta_nom, w, r0, rho, vel):
+def housing_geometry(i, theta, theta_dot, r0_nom, piv, theta_nom, w, r0, rho, vel):
     """EH centers of satellite ``i`` and their velocity relative to the CoM, in S.
 
     theta, theta_dot : MOSA opening angle [rad] and its rate [rad/s].
-    d_p : pivot distance [m]; r0_nom : (2, 3) EH centers at theta_nom [m, S];
-    theta_nom : nominal opening angle [rad] (places the pivots).
+    r0_nom : (2, 3) EH centers at theta_nom [m, S]; piv : (2, 3) MOSA pivots
+    [m, S, fixed in S]; theta_nom : nominal opening angle [rad].
     w : (n, 3) satellite angular velocities [rad/s, S] (row i is used).
-    Outputs (in place, S frame, rows [i] of (n, 2, 3) arrays): r0 EH centers
-    [m]; rho lever arms r0 - pivot [m]; vel inertial velocity of the EH
-    center relative to the CoM, expressed in S: w x r0 + w_oa x rho [m/s],
-    with the MOSA rate w_oa = (0, 0, +/-theta_dot/2).  (Arrays are indexed,
-    not sliced, so the hot path creates no array views.)
+    Outputs (in place, S frame, rows [i] of (n, 2, 3) arrays): rho lever arms
+    R_z(+/-(theta - theta_nom)/2) (r0_nom - piv) [m]; r0 = piv + rho EH
+    centers [m]; vel inertial velocity of the EH center relative to the CoM,
+    expressed in S: w x r0 + w_oa x rho [m/s], with the MOSA rate w_oa =
+    (0, 0, +/-theta_dot/2).  (Arrays are indexed, not sliced, so the hot
+    path creates no array views.)
     """
     for l in range(2):
         s = MOSA_SIGN[l]
-        ang_nom = s * 0.5 * theta_nom
-        ang = s * 0.5 * theta
-        rx, ry = d_p * math.cos(ang), d_p * math.sin(ang)
-        rho[i, l, 0], rho[i, l, 1], rho[i, l, 2] = rx, ry, 0.0
-        r0[i, l, 0] = r0_nom[l, 0] - d_p * math.cos(ang_nom) + rx
-        r0[i, l, 1] = r0_nom[l, 1] - d_p * math.sin(ang_nom) + ry
-        r0[i, l, 2] = r0_nom[l, 2]
+        d = s * 0.5 * (theta - theta_nom)
+        c, sn = math.cos(d), math.sin(d)
+        px, py, pz = r0_nom[l, 0] - piv[l, 0], r0_nom[l, 1] - piv[l, 1], r0_nom[l, 2] - piv[l, 2]
+        rx, ry = c * px - sn * py, sn * px + c * py
+        rho[i, l, 0], rho[i, l, 1], rho[i, l, 2] = rx, ry, pz
+        r0[i, l, 0] = piv[l, 0] + rx
+        r0[i, l, 1] = piv[l, 1] + ry
+        r0[i, l, 2] = piv[l, 2] + pz
         cx, cy, cz = cross((w[i, 0], w[i, 1], w[i, 2]), (r0[i, l, 0], r0[i, l, 1], r0[i, l, 2]))
         wm = s * 0.5 * theta_dot
         vel[i, l, 0] = cx - wm * ry
@@ -55,10 +58,14 @@ def housing_geometry(i, theta, theta_dot, d_p, r0_nom, theta_nom, w, r0, rho, ve
 
 
 @njit(cache=True)
-def satellite_control(i, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rho, g, A, G_S, alpha):
+def satellite_control(i, scheme, sens, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rho, g, A, G_S,
+                      alpha):
     """g_l, suspension A_c,l, drag-free G and TM angular acceleration of satellite ``i``.
 
-    Every array has a leading satellite axis; row i is read / written.
+    scheme : 0 = the "tianqin" closed form (sensitive axes X_OA_l), 1 = the
+    general "lisa" solution with the sensitive axes ``sens`` (2, 3) [unit
+    vectors in OA_l] (derivations in :mod:`tqdyn.constellation.control`).
+    Every other array has a leading satellite axis; row i is read / written.
     Inputs (S frame): dg_S (n, 2, 3) a_grav(TM_l) - a_grav(CoM) [m/s^2];
     sg_S (n, 2, 3) self-gravity of TM l [m/s^2]; w, wd (n, 3) satellite
     angular velocity [rad/s] and acceleration [rad/s^2]; theta, theta_dot,
@@ -86,18 +93,40 @@ def satellite_control(i, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rh
         g[i, l, 1] = dg_S[i, l, 1] + sg_S[i, l, 1] - 2.0 * c1[1] - mdy - mmy - c2[1] - c3[1]
         g[i, l, 2] = dg_S[i, l, 2] + sg_S[i, l, 2] - 2.0 * c1[2] - c2[2] - c3[2]
     h = 0.5 * theta
-    sh, ch, sn = math.sin(h), math.cos(h), math.sin(theta)
-    dx, dy, dz = g[i, 1, 0] - g[i, 0, 0], g[i, 1, 1] - g[i, 0, 1], g[i, 1, 2] - g[i, 0, 2]
-    A[i, 0, 0] = 0.0
-    A[i, 0, 1] = (dy * sh - dx * ch) / sn
-    A[i, 0, 2] = 0.5 * dz
-    A[i, 1, 0] = 0.0
-    A[i, 1, 1] = (-dy * sh - dx * ch) / sn
-    A[i, 1, 2] = -0.5 * dz
-    t = sh / ch
-    G_S[i, 0] = 0.5 * (g[i, 0, 0] + g[i, 1, 0]) - 0.5 * t * dy
-    G_S[i, 1] = 0.5 * (g[i, 0, 1] + g[i, 1, 1]) - 0.5 * dx / t
-    G_S[i, 2] = 0.5 * (g[i, 0, 2] + g[i, 1, 2])
+    if scheme == 0:
+        sh, ch, sn = math.sin(h), math.cos(h), math.sin(theta)
+        dx, dy, dz = g[i, 1, 0] - g[i, 0, 0], g[i, 1, 1] - g[i, 0, 1], g[i, 1, 2] - g[i, 0, 2]
+        A[i, 0, 0] = 0.0
+        A[i, 0, 1] = (dy * sh - dx * ch) / sn
+        A[i, 0, 2] = 0.5 * dz
+        A[i, 1, 0] = 0.0
+        A[i, 1, 1] = (-dy * sh - dx * ch) / sn
+        A[i, 1, 2] = -0.5 * dz
+        t = sh / ch
+        G_S[i, 0] = 0.5 * (g[i, 0, 0] + g[i, 1, 0]) - 0.5 * t * dy
+        G_S[i, 1] = 0.5 * (g[i, 0, 1] + g[i, 1, 1]) - 0.5 * dx / t
+        G_S[i, 2] = 0.5 * (g[i, 0, 2] + g[i, 1, 2])
+    else:
+        # e_l = T_S_OA_l s_l; G = [b1 (e2 x n) + b2 (n x e1) + b3 (e1 x e2)] / (e1 . (e2 x n)), n = Z_S
+        c1_, s1_ = math.cos(h), math.sin(h)
+        c2_, s2_ = math.cos(-h), math.sin(-h)
+        e1x, e1y, e1z = c1_ * sens[0, 0] - s1_ * sens[0, 1], s1_ * sens[0, 0] + c1_ * sens[0, 1], sens[0, 2]
+        e2x, e2y, e2z = c2_ * sens[1, 0] - s2_ * sens[1, 1], s2_ * sens[1, 0] + c2_ * sens[1, 1], sens[1, 2]
+        b1 = e1x * g[i, 0, 0] + e1y * g[i, 0, 1] + e1z * g[i, 0, 2]
+        b2 = e2x * g[i, 1, 0] + e2y * g[i, 1, 1] + e2z * g[i, 1, 2]
+        b3 = 0.5 * (g[i, 0, 2] + g[i, 1, 2])
+        # e2 x n = (e2y, -e2x, 0), n x e1 = (-e1y, e1x, 0), det = e1 . (e2 x n) = e1x e2y - e1y e2x
+        ux, uy, uz = cross((e1x, e1y, e1z), (e2x, e2y, e2z))
+        det = e1x * e2y - e1y * e2x
+        G_S[i, 0] = (b1 * e2y - b2 * e1y + b3 * ux) / det
+        G_S[i, 1] = (-b1 * e2x + b2 * e1x + b3 * uy) / det
+        G_S[i, 2] = b3 * uz / det
+        for l in range(2):
+            c, sp = math.cos(MOSA_SIGN[l] * h), math.sin(MOSA_SIGN[l] * h)
+            ax, ay, az = G_S[i, 0] - g[i, l, 0], G_S[i, 1] - g[i, l, 1], G_S[i, 2] - g[i, l, 2]
+            A[i, l, 0] = c * ax + sp * ay
+            A[i, l, 1] = -sp * ax + c * ay
+            A[i, l, 2] = az
     # TM angular acceleration: T_OA_S (w' + w_oa' + w x w_oa)
     for l in range(2):
         s = MOSA_SIGN[l]

@@ -49,6 +49,27 @@ The printed eq:Greal has tan(theta), cot(theta) instead: that violates (a)
 (:func:`dragfree_as_printed` reproduces it for comparison; the tests measure
 the violation).
 
+General scheme (``scheme = "lisa"``; any sensitive axes)
+-------------------------------------------------------
+The same kind of conditions for sensitive axes e_l (unit vectors fixed in
+OA_l, in S: e_l = T_S_OA_l s_l) and the out-of-plane direction n = Z_S:
+(a) G = A_l + g_l (l = 1, 2), (b) e_l . A_l = 0 (the spacecraft follows TM l
+along its own sensitive axis: no electrostatic actuation there), (c)
+n . A_1 = -n . A_2 (equal and opposite out-of-plane actuation).  Nine linear
+equations for the nine unknowns G, A_1, A_2.  Dotting (a) with e_l and using
+(b): e_l . G = e_l . g_l; adding the two n-components of (a) and using (c):
+n . G = n . (g_1 + g_2) / 2.  With M = (e_1; e_2; n) (rows) and det M =
+e_1 . (e_2 x n) != 0, Cramer's rule (M^-1 has the columns e_2 x n, n x e_1,
+e_1 x e_2 over det M) gives
+
+    G = [ (e_1.g_1) (e_2 x n) + (e_2.g_2) (n x e_1) + (n.(g_1+g_2)/2) (e_1 x e_2) ] / det M,
+    A_l = G - g_l.
+
+For e_l = X_OA_l this is the closed form above (tests/test_control.py checks
+both, and a sympy solution of the nine equations, to round-off).  det M = 0
+(parallel sensitive axes, or both in a plane containing n) leaves G
+undetermined: :class:`~tqdyn.constellation.spacecraft.Spacecraft` refuses it.
+
 TM attitude: each TM is kept aligned with OA_l, whose inertial angular
 velocity is W = w_S + w_oa (in S).  Its inertial angular acceleration, in S,
 is dW/dt = w_S' + w_oa' + w_S x w_oa; expressed in OA_l it is the angular
@@ -79,6 +100,7 @@ __all__ = [
     "NominalControl",
     "dragfree_acceleration",
     "dragfree_as_printed",
+    "dragfree_general",
     "mosa_angular_rates",
     "nominal_control",
     "oa_rotation",
@@ -190,6 +212,31 @@ def dragfree_acceleration(g, theta) -> np.ndarray:
     return out
 
 
+def dragfree_general(g, theta, sensitive_axes=None) -> tuple[np.ndarray, np.ndarray]:
+    """Drag-free G and suspensions A_l of the general scheme (module docstring).
+
+    ``g``: (..., 2, 3) m/s^2, g_l in S; ``theta``: (...) rad;
+    ``sensitive_axes``: (2, 3) unit vectors in OA_l (None: X_OA_l).  Returns
+    (G_S (..., 3) m/s^2 in S, A (..., 2, 3) m/s^2 with ``A[..., l, :]`` in OA_l).
+    """
+    g = _f64(g, "g", (2, 3))
+    th = np.asarray(theta, dtype=np.float64)
+    sens = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]) if sensitive_axes is None else \
+        _f64(sensitive_axes, "sensitive_axes", (2, 3))
+    T = oa_rotation(th)                                   # (..., 2, 3, 3): S -> OA_l
+    e = np.einsum("...lji,lj->...li", T, sens)            # e_l in S
+    n = np.array([0.0, 0.0, 1.0])
+    e1, e2 = e[..., 0, :], e[..., 1, :]
+    det = np.einsum("...i,...i->...", e1, np.cross(e2, n))
+    b1 = np.einsum("...i,...i->...", e1, g[..., 0, :])
+    b2 = np.einsum("...i,...i->...", e2, g[..., 1, :])
+    b3 = 0.5 * (g[..., 0, 2] + g[..., 1, 2])
+    G = (b1[..., None] * np.cross(e2, n) + b2[..., None] * np.cross(n, e1)
+         + b3[..., None] * np.cross(e1, e2)) / det[..., None]
+    A_S = G[..., None, :] - g
+    return G, np.einsum("...lij,...lj->...li", T, A_S)
+
+
 def dragfree_as_printed(g, theta) -> np.ndarray:
     """eq:Greal exactly as printed (tan(theta), cot(theta)) -- WRONG, for comparison only.
 
@@ -259,7 +306,8 @@ def nominal_control(T_S_I, omega_S, omega_dot_S, theta, omega_mosa, omega_dot_mo
     dg_gravity : (N, 3, 2, 3) m/s^2, GCRS, a_grav(TM_l) - a_grav(satellite),
         formed by the caller without cancellation (double-double).  Gravity at
         the actual TM positions (the EH centers in the nominal state).
-    spacecraft : architecture (default ``Spacecraft()``: Table IV self-gravity).
+    spacecraft : architecture and drag-free scheme (default ``Spacecraft()``:
+        the ``tianqin`` preset with Table IV self-gravity).
     tm_torque : (N, 3, 2, 3) rad/s^2 in OA_l or None, external angular
         acceleration on the TMs.
 
@@ -277,8 +325,11 @@ def nominal_control(T_S_I, omega_S, omega_dot_S, theta, omega_mosa, omega_dot_mo
     r0 = sc.housing_centers(th)
     rho = sc.lever_arms(th)
     g = tm_relative_acceleration(dg_S, omega_S, omega_dot_S, omega_mosa, omega_dot_mosa, r0, rho, sg_S)
-    A = suspension_acceleration(g, th)
-    G_S = dragfree_acceleration(g, th)
+    if sc.scheme == "tianqin":
+        A = suspension_acceleration(g, th)
+        G_S = dragfree_acceleration(g, th)
+    else:
+        G_S, A = dragfree_general(g, th, sc.sensitive_axes_array)
     G_I = np.einsum("...ji,...j->...i", T, G_S)
     alpha = tm_angular_acceleration(omega_S, omega_dot_S, omega_mosa, omega_dot_mosa, th, tm_torque)
     return NominalControl(g=g, a_suspension=A, a_dragfree_S=G_S, a_dragfree=G_I, alpha_suspension=alpha)

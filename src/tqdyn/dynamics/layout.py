@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN", "SYSTEM_TDAT_BODIES",
-           "N_SYSTEM_TDAT", "make_cpar", "workspace", "aux_views"]
+__all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
+           "SCHEME_CODES", "SYSTEM_TDAT_BODIES", "N_SYSTEM_TDAT", "JERK_BODIES_MAX", "make_cpar", "workspace",
+           "aux_views"]
 
 #: Arithmetic of a propagation: double-double states (trailing axis 2) or plain float64.
 PRECISIONS = ("dd", "float64")
@@ -35,15 +36,23 @@ MODE_COUPLED = 1
 MODE_FREE_TM = 2
 
 # cpar layout (float64)
-CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_DP, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
+CP_MODE, CP_LAW, CP_CONTROL, CP_GM, CP_C, CP_SCHEME, CP_THNOM = 0, 1, 2, 3, 4, 5, 6
 CP_R0 = 7          # (2, 3) EH centers at theta_nom, S [m]
 CP_SG_OA = 13      # (3, 2, 3) self-gravity, OA_l [m/s^2]
 CP_SG_S = 31       # (3, 3) common self-gravity, S [m/s^2]
-CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_TD = 40, 41, 42, 43   # jerk model (see _jerk_perturbation)
-CP_SGC = 44        # tdat column of the self-gravity toward the constellation centre [m/s^2], -1 if off
-CP_LEN = 45
-#: time-only inputs of the coupled system, appended to the force model's:
-#: geocentric GCRS position [m] and velocity [m/s] of the Moon, then the Sun
+CP_J2K, CP_TD = 40, 41   # jerk model (see _jerk_perturbation)
+CP_SGC = 42        # tdat column of the self-gravity toward the constellation centre [m/s^2], -1 if off
+CP_PIV = 43        # (2, 3) MOSA pivots, S [m]
+CP_SENS = 49       # (2, 3) sensitive axes, unit vectors in OA_l
+CP_NJB = 55        # number of jerk bodies (their states in tdat from CP_TD, 6 values each)
+CP_JGM = 56        # (JERK_BODIES_MAX,) their GMs [m^3/s^2]
+JERK_BODIES_MAX = 10
+CP_GMREL = CP_JGM + JERK_BODIES_MAX   # GM [m^3/s^2] of the central body's Schwarzschild jerk, 0 = off
+CP_LEN = CP_GMREL + 1
+#: drag-free scheme codes of cpar[CP_SCHEME] (names: spacecraft.DRAGFREE_SCHEMES)
+SCHEME_CODES = {"tianqin": 0, "lisa": 1}
+#: jerk bodies of the geocentric coupled system (time-only inputs appended
+#: to the force model's: GCRS position [m] and velocity [m/s] of each)
 SYSTEM_TDAT_BODIES = ("moon", "sun")
 N_SYSTEM_TDAT = 12
 
@@ -62,34 +71,48 @@ _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), 
               ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
 
 
-def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, d_p=0.0, theta_nom=np.pi / 3,
-              r0_nom=None, sg_oa=None, sg_s=None, gm_moon=0.0, gm_sun=0.0, j2k=0.0, tdat_offset=-1,
-              centre_column=-1) -> np.ndarray:
+def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta_nom=np.pi / 3,
+              r0_nom=None, pivots=None, sensitive_axes=None, sg_oa=None, sg_s=None, jerk_gms=(), j2k=0.0,
+              tdat_offset=-1, centre_column=-1, gm_relativity=0.0) -> np.ndarray:
     """Pack the constellation parameters for :func:`system_rhs`.
 
     mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
-    control : apply G_i to the orbits; gm : Earth GM [m^3/s^2] (jerk/snap of
-    the remote satellite in the local pointing laws); c : m/s; d_p : pivot
-    distance [m]; theta_nom : nominal MOSA angle [rad]; r0_nom : (2, 3) EH
-    centers in S [m]; sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2];
-    sg_s : (3, 3) common self-gravity in S [m/s^2].
-    gm_moon, gm_sun : [m^3/s^2], j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth:
-    the jerk model of the local pointing laws (0 = term absent);
-    tdat_offset : column of the system's time-only inputs (Moon, Sun states,
-    :data:`N_SYSTEM_TDAT` values) in tdat, -1 if none;
+    control : apply G_i to the orbits; gm : central body's GM [m^3/s^2]
+    (jerk/snap of the remote satellite in the local pointing laws); c : m/s;
+    scheme : drag-free scheme code (:data:`SCHEME_CODES`); theta_nom :
+    nominal MOSA angle [rad]; r0_nom : (2, 3) EH centers at theta_nom in S
+    [m]; pivots : (2, 3) MOSA pivots in S [m] (default: r0_nom, no lever
+    arm); sensitive_axes : (2, 3) unit vectors in OA_l (default X_OA_l);
+    sg_oa : (3, 2, 3) self-gravity in OA_l [m/s^2]; sg_s : (3, 3) common
+    self-gravity in S [m/s^2].
+    jerk_gms : GMs [m^3/s^2] of the third bodies of the jerk model of the
+    local pointing laws (at most :data:`JERK_BODIES_MAX`; their states,
+    relative to the central body, are 6 tdat columns each from
+    ``tdat_offset``); j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth (0 = absent);
+    gm_relativity : GM [m^3/s^2] of the central body's Schwarzschild term
+    in the jerk model (0 = off; heliocentric runs with relativity);
+    tdat_offset : column of the system's time-only inputs in tdat, -1 if none;
     centre_column : column in tdat of the magnitude [m/s^2] of the
     self-gravity toward the constellation centre (positive toward it), -1 if off.
     """
     p = np.zeros(CP_LEN)
     p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
-    p[CP_GM], p[CP_C], p[CP_DP], p[CP_THNOM] = gm, c, d_p, theta_nom
+    p[CP_GM], p[CP_C], p[CP_SCHEME], p[CP_THNOM] = gm, c, scheme, theta_nom
     if r0_nom is not None:
         p[CP_R0:CP_R0 + 6] = np.asarray(r0_nom, np.float64).ravel()
+    p[CP_PIV:CP_PIV + 6] = p[CP_R0:CP_R0 + 6] if pivots is None else np.asarray(pivots, np.float64).ravel()
+    p[CP_SENS:CP_SENS + 6] = ([1.0, 0.0, 0.0] * 2 if sensitive_axes is None
+                              else np.asarray(sensitive_axes, np.float64).ravel())
     if sg_oa is not None:
         p[CP_SG_OA:CP_SG_OA + 18] = np.asarray(sg_oa, np.float64).ravel()
     if sg_s is not None:
         p[CP_SG_S:CP_SG_S + 9] = np.asarray(sg_s, np.float64).ravel()
-    p[CP_GM_MOON], p[CP_GM_SUN], p[CP_J2K], p[CP_TD] = gm_moon, gm_sun, j2k, tdat_offset
+    gms = [float(x) for x in jerk_gms]
+    if len(gms) > JERK_BODIES_MAX:
+        raise ValueError(f"jerk model: {len(gms)} bodies; allowed: at most {JERK_BODIES_MAX}")
+    p[CP_NJB] = len(gms)
+    p[CP_JGM:CP_JGM + len(gms)] = gms
+    p[CP_J2K], p[CP_TD], p[CP_GMREL] = j2k, tdat_offset, gm_relativity
     p[CP_SGC] = centre_column
     return p
 

@@ -60,11 +60,12 @@ from ..constellation._kinematics_jit import sat_kinematics
 from ..constellation.indices import MOSA_SIGN
 from ..forces.earth import j2_jerk_gcrs_z
 from ..forces.model import ForceModel, gravity
+from ..forces.relativity import schwarzschild_jerk
 from ..forces.third_body import third_body_jerk
 from ..numerics.dd import add, ld, lo_part, st, sub, to_f64
 from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX_TMLEN, AX_W, AX_WD, CP_CONTROL,
-                     CP_C, CP_DP, CP_GM, CP_GM_MOON, CP_GM_SUN, CP_J2K, CP_LAW, CP_MODE, CP_R0, CP_SG_OA, CP_SG_S,
-                     CP_SGC, CP_TD, CP_THNOM, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
+                     CP_C, CP_GM, CP_GMREL, CP_J2K, CP_JGM, CP_LAW, CP_MODE, CP_NJB, CP_PIV, CP_R0, CP_SCHEME, CP_SENS,
+                     CP_SG_OA, CP_SG_S, CP_SGC, CP_TD, CP_THNOM, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
                      TM_SUSP, TM_VHI, TM_VLO, make_cpar, workspace)
 
 __all__ = ["system_rhs", "point_masses", "evaluate_rhs", "toward_centre"]
@@ -108,12 +109,19 @@ def _breathing_angle(r_hi, r_lo, i):
 
 @njit(cache=True)
 def _jerk_perturbation(cpar, tdat, fw):
-    """Jerk of each satellite beyond the Earth monopole [m/s^3, GCRS] into fw[19].
+    """Jerk of each satellite beyond the central monopole [m/s^3] into fw[19].
 
     The local pointing laws need the remote satellites' jerk for omega_dot
-    (it enters as jerk / c).  Modelled: the Moon and Sun tidal terms (with
-    the bodies' ephemeris velocities) and the Earth's J2 about the GCRS z
-    axis.  Left out, with their jerk: the Earth rotation of the sectorial
+    (it enters as jerk / c).  Modelled: the tidal terms of the jerk bodies
+    (cpar[CP_NJB] bodies, states relative to the central body from tdat,
+    with the bodies' ephemeris velocities) and the Earth's J2 about the GCRS
+    z axis.  Geocentric: the Moon and the Sun.  Heliocentric: every third
+    body of the force model (the Earth's tidal jerk on LISA is ~3e-14 m/s^3,
+    1e-22 rad/s^2 of omega_dot, Venus' and Jupiter's are of that order too)
+    and, heliocentric with relativity, the Sun's Schwarzschild jerk (~3e-17
+    m/s^3: without it free TMs drift 3e-11 m in a year, with it 4e-14 m;
+    the geocentric one, ~1e-17 m/s^3, is left out).
+    The geocentric budget:  Left out, with their jerk: the Earth rotation of the sectorial
     degree-2 terms (~1e-13 m/s^3), the CIP tilt from GCRS z in J2 (~2e-14),
     degree >= 3 (~2e-14), planets, tides, relativity (< 1e-15), G (~1e-17):
     omega_dot is the derivative of omega to ~4e-22 rad/s^2 (measured 1.5e-21
@@ -125,17 +133,24 @@ def _jerk_perturbation(cpar, tdat, fw):
     v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
     o = int(cpar[CP_TD])
     k = cpar[CP_J2K]
+    nb = int(cpar[CP_NJB])
     for i in range(3):
         rx, ry, rz = r_hi[i, 0] + r_lo[i, 0], r_hi[i, 1] + r_lo[i, 1], r_hi[i, 2] + r_lo[i, 2]
         vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
         jx = jy = jz = 0.0
         if o >= 0:
-            for b, gm in ((0, cpar[CP_GM_MOON]), (1, cpar[CP_GM_SUN])):
+            for b in range(nb):
+                gm = cpar[CP_JGM + b]
                 if gm != 0.0:
                     c = o + 6 * b
                     tx, ty, tz = third_body_jerk(gm, rx, ry, rz, vx, vy, vz, tdat[c], tdat[c + 1], tdat[c + 2],
                                                  tdat[c + 3], tdat[c + 4], tdat[c + 5])
                     jx, jy, jz = jx + tx, jy + ty, jz + tz
+        if cpar[CP_GMREL] != 0.0:
+            tx, ty, tz = schwarzschild_jerk(rx, ry, rz, vx, vy, vz, cpar[CP_GMREL], cpar[CP_C], 1.0, 1.0)
+            jx += tx
+            jy += ty
+            jz += tz
         if k != 0.0:
             tx, ty, tz = j2_jerk_gcrs_z(k, rx, ry, rz, vx, vy, vz)
             jx += tx
@@ -152,13 +167,16 @@ def _control_pass(cpar, fw):
         fw[8], fw[9], fw[10]
     sat_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, fw[19], cpar[CP_GM], cpar[CP_C], T, om, omd, th)
     r0_nom = cpar[CP_R0:CP_R0 + 6].reshape((2, 3))
+    piv = cpar[CP_PIV:CP_PIV + 6].reshape((2, 3))
     for i in range(3):
-        housing_geometry(i, th[i, 0], th[i, 1], cpar[CP_DP], r0_nom, cpar[CP_THNOM], om, r0, rho, vel)
+        housing_geometry(i, th[i, 0], th[i, 1], r0_nom, piv, cpar[CP_THNOM], om, r0, rho, vel)
 
 
 @njit(cache=True)
-def _control_laws(cpar, fw):
-    """g, A, G (S and GCRS), alpha of the three satellites from the work arrays."""
+def _control_laws(cpar, tdat, fw):
+    """g, A, G (S and GCRS), alpha of the three satellites from the work arrays
+    (and, when cpar[CP_SGC] >= 0, the self-gravity ramp from tdat: a common
+    self-gravity of both TMs along +X_S, toward the constellation's incentre)."""
     T, om, omd, th, r0, rho = fw[4], fw[5], fw[6], fw[7], fw[8], fw[9]
     dgI, dgS, sgS, g, A, GS, alp, GI = fw[11], fw[12], fw[13], fw[14], fw[15], fw[16], fw[17], fw[18]
     for i in range(3):
@@ -170,11 +188,14 @@ def _control_laws(cpar, fw):
             sx, sy, sz = cpar[o], cpar[o + 1], cpar[o + 2]
             # T_S_OA sg (columns of T_OA_S) + the common part fixed in S
             sgS[i, l, 0] = c * sx - sp * sy + cpar[CP_SG_S + 3 * i]
+            if cpar[CP_SGC] >= 0.0:
+                sgS[i, l, 0] += tdat[int(cpar[CP_SGC])]
             sgS[i, l, 1] = sp * sx + c * sy + cpar[CP_SG_S + 3 * i + 1]
             sgS[i, l, 2] = sz + cpar[CP_SG_S + 3 * i + 2]
             for q in range(3):
                 dgS[i, l, q] = T[i, q, 0] * dgI[i, l, 0] + T[i, q, 1] * dgI[i, l, 1] + T[i, q, 2] * dgI[i, l, 2]
-        satellite_control(i, dgS, sgS, om, omd, th[i, 0], th[i, 1], th[i, 2], r0, rho, g, A, GS, alp)
+        satellite_control(i, int(cpar[CP_SCHEME]), cpar[CP_SENS:CP_SENS + 6].reshape((2, 3)), dgS, sgS, om, omd,
+                          th[i, 0], th[i, 1], th[i, 2], r0, rho, g, A, GS, alp)
         for q in range(3):
             GI[i, q] = T[i, 0, q] * GS[i, 0] + T[i, 1, q] * GS[i, 1] + T[i, 2, q] * GS[i, 2]
 
@@ -236,14 +257,14 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
                 aux[b + TM_OFF + 1] = to_f64(sub(ld(y, tb, 1), hy))
                 aux[b + TM_OFF + 2] = to_f64(sub(ld(y, tb, 2), hz))
     # 4. control
-    _control_laws(cpar, fw)
+    _control_laws(cpar, tdat, fw)
     # 5. G feedback into omega_dot / theta_ddot (the orbit's accelerations contain G)
     if control_on:
         for i in range(3):
             for q in range(3):
                 a[i, q] = to_f64(add(ld(gw, i, q), GI[i, q]))
         _control_pass(cpar, fw)
-        _control_laws(cpar, fw)
+        _control_laws(cpar, tdat, fw)
     # derivatives of the satellites
     for i in range(3):
         for q in range(3):

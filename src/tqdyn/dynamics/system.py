@@ -5,8 +5,9 @@
 drag-free constellation, or its free-TM verification mode) and the packed
 constellation parameters (:mod:`tqdyn.dynamics.layout`): pointing law,
 control switch, spacecraft geometry, self-gravity, and the jerk model of the
-local pointing laws (the Moon's and Sun's tidal jerks from their ephemeris
-states, the Earth's J2).
+local pointing laws (the tidal jerks of the third bodies from their
+ephemeris states -- geocentric: the Moon and the Sun; heliocentric: every
+third body of the force model -- and the Earth's J2).
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ import numpy as np
 
 from ..astro.constants import C_LIGHT
 from ..astro.ephemeris import planetary_gm
-from ..astro.timescales import tdb_jd
 from ..constellation._kinematics_jit import LAW_CODES
 from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
 from ..forces.earth import EarthField
@@ -42,6 +42,9 @@ class System:
     free_tms: bool
     ephemeris: object = None
     centre_ramp: tuple | None = None
+    jerk_bodies: tuple = ()
+    reference: object = None
+    spacecraft: Spacecraft | None = None
 
     def with_inputs(self, model: ForceModel):
         """The force model, extended by the system's own time-only inputs
@@ -55,15 +58,16 @@ class System:
 
 class _SystemInputs:
     """A force model whose time-only inputs are followed by the coupled
-    system's: geocentric GCRS position [m] and velocity [m/s] of the Moon and
-    the Sun (at TDB(t)), :data:`tqdyn.dynamics.layout.N_SYSTEM_TDAT` columns starting at
-    the force model's ``n_tdat`` (= ``cpar[CP_TD]``).  Everything else is the
-    force model's."""
+    system's: the position [m] and velocity [m/s] relative to the central
+    body of each jerk body (:attr:`System.jerk_bodies`; geocentric GCRS
+    Moon and Sun at TDB(t), or Sun-centred BCRS bodies at the TDB axis), 6
+    columns each starting at the force model's ``n_tdat`` (= ``cpar[CP_TD]``),
+    then the self-gravity ramp.  Everything else is the force model's."""
 
     def __init__(self, model: ForceModel, system: System):
         self._model = model
         self._system = system
-        self.n_tdat = (model.n_tdat + (_lay.N_SYSTEM_TDAT if system.ephemeris is not None else 0)
+        self.n_tdat = (model.n_tdat + (6 * len(system.jerk_bodies) if system.ephemeris is not None else 0)
                        + (1 if system.centre_ramp is not None else 0))
 
     def __getattr__(self, name):
@@ -75,10 +79,13 @@ class _SystemInputs:
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         cols = [self._model.precompute(epoch, t_hi, t_lo)]
-        if self._system.ephemeris is not None:
-            jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
-            pos, vel = self._system.ephemeris.geocentric_states(_lay.SYSTEM_TDAT_BODIES, jd1, jd2, velocity=True)
-            cols.append(np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (_lay.N_SYSTEM_TDAT,)))
+        sy = self._system
+        if sy.ephemeris is not None:
+            jd1, jd2 = sy.reference.ephemeris_jd(epoch, t_hi, t_lo)
+            states = (sy.ephemeris.heliocentric_states if sy.reference.origin == "sun"
+                      else sy.ephemeris.geocentric_states)
+            pos, vel = states(sy.jerk_bodies, jd1, jd2, velocity=True)
+            cols.append(np.concatenate([pos, vel], axis=-1).reshape(np.shape(t_hi) + (6 * len(sy.jerk_bodies),)))
         if self._system.centre_ramp is not None:
             cols.append(centre_ramp(self._system.centre_ramp, np.asarray(t_hi) + np.asarray(t_lo))[..., None])
         return np.concatenate(cols, axis=-1)
@@ -111,25 +118,34 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
         model = build_force_model(scenario.forces, scenario.reference) if model is None else model
         return System(_lay.make_cpar(_lay.MODE_POINT_MASS, centre_column=model.n_tdat), False, False,
                       centre_ramp=ramp)
-    sc = scenario.spacecraft
-    craft = Spacecraft(d_tm=float(sc.d_tm_m), d_p=float(sc.d_p_m), tm_axis=sc.tm_axis)
-    _, common = sc.self_gravity_values()
+    craft = scenario.spacecraft.craft(self_gravity_oa(scenario))
+    _, common = scenario.spacecraft.self_gravity_values()
     mode = _lay.MODE_FREE_TM if c.free_tms else _lay.MODE_COUPLED
-    # jerk model of the local laws: the Moon / Sun tidal terms and J2 that the force model has
-    f = scenario.forces
+    # jerk model of the local laws: the tidal terms of the force model's third bodies (geocentric: the
+    # Moon and the Sun; heliocentric: all of them) and the Earth's J2
+    f, ref = scenario.forces, scenario.reference
     law = LAW_CODES[c.pointing]
-    bodies = [b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies] if law else []
+    if ref.origin == "sun":
+        bodies = tuple(f.third_bodies) if law else ()
+    else:
+        bodies = tuple(b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies) if law else ()
     eph = _ephemeris(f.ephemeris) if bodies else None
     gms = planetary_gm() if bodies else {}
     if law and model is None:
-        model = build_force_model(f, scenario.reference)
+        model = build_force_model(f, ref)
     earth = next((t for t in model.terms if isinstance(t, EarthField)), None) if law else None
     j2k = earth.j2_jerk_coefficient() if earth is not None else 0.0
-    cpar = _lay.make_cpar(mode, law=law, control=c.control == "on",
-                          gm=float(f.gm_earth), c=C_LIGHT, d_p=craft.d_p,
-                          theta_nom=craft.theta_nominal, r0_nom=craft.nominal_housing_centers,
-                          sg_oa=self_gravity_oa(scenario), sg_s=common,
-                          gm_moon=gms.get("moon", 0.0), gm_sun=gms.get("sun", 0.0), j2k=j2k,
-                          tdat_offset=model.n_tdat if eph is not None else -1)
-    return System(cpar, True, c.free_tms, eph)
-
+    gm = float(gms.get("sun", planetary_gm()["sun"])) if ref.origin == "sun" else float(f.gm_earth)
+    ramp = scenario.self_gravity_centre_ramp()
+    if ramp is not None and model is None:
+        model = build_force_model(f, ref)
+    centre = model.n_tdat + (6 * len(bodies) if eph is not None else 0) if ramp is not None else -1
+    cpar = _lay.make_cpar(mode, law=law, control=c.control == "on", gm=gm, c=C_LIGHT,
+                          scheme=_lay.SCHEME_CODES[craft.scheme], theta_nom=craft.theta_nominal,
+                          r0_nom=craft.nominal_housing_centers, pivots=craft.pivots,
+                          sensitive_axes=craft.sensitive_axes_array, sg_oa=craft.self_gravity_array, sg_s=common,
+                          jerk_gms=[gms[b] for b in bodies], j2k=j2k,
+                          gm_relativity=gm if (law and ref.origin == "sun" and f.relativity) else 0.0,
+                          tdat_offset=model.n_tdat if eph is not None else -1, centre_column=centre)
+    return System(cpar, True, c.free_tms, eph, centre_ramp=ramp, jerk_bodies=bodies, reference=ref,
+                  spacecraft=craft)

@@ -97,6 +97,31 @@ def schwarzschild_accel(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
 
 
 @njit(cache=True)
+def schwarzschild_jerk(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
+    """Time derivative [m/s^3] of :func:`schwarzschild_accel` along the
+    Kepler motion (r' = v, v' = -gm r/r^3; the post-Newtonian part of v'
+    changes it by ~1e-8 relative): with k = gm/(c^2 r^3), s = r.v,
+    P = 2(beta+gamma) gm/r - gamma v.v, Q = 2(1+gamma) s, a0 = -gm r/r^3:
+    k' = -3 k s/r^2, P' = -2 beta gm s/r^3, Q' = 2(1+gamma)(v.v - gm/r),
+    jerk = k' (P r + Q v) + k (P' r + (P + Q') v + Q a0).
+    Same frame and units as the acceleration; float64 scalars."""
+    r2 = rx * rx + ry * ry + rz * rz
+    r = math.sqrt(r2)
+    v2 = vx * vx + vy * vy + vz * vz
+    s = rx * vx + ry * vy + rz * vz
+    k = gm / (c * c * r2 * r)
+    kd = -3.0 * k * s / r2
+    p = 2.0 * (beta + gamma) * gm / r - gamma * v2
+    q = 2.0 * (1.0 + gamma) * s
+    pd = -2.0 * beta * gm * s / (r2 * r)
+    qd = 2.0 * (1.0 + gamma) * (v2 - gm / r)
+    m = -gm / (r2 * r)
+    return (kd * (p * rx + q * vx) + k * (pd * rx + (p + qd) * vx + q * m * rx),
+            kd * (p * ry + q * vy) + k * (pd * ry + (p + qd) * vy + q * m * ry),
+            kd * (p * rz + q * vz) + k * (pd * rz + (p + qd) * vz + q * m * rz))
+
+
+@njit(cache=True)
 def lense_thirring_accel(rx, ry, rz, vx, vy, vz, jx, jy, jz, gm, c, gamma):
     """Lense-Thirring term of IERS 2010 eq. (10.12) [m/s^2], GCRS:
     (1+gamma) GM/(c^2 r^3) [(3/r^2)(r x v)(r.J) + v x J].

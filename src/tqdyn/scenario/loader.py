@@ -103,7 +103,9 @@ _SCHEMA: dict[str, dict[str, str]] = {
                "atmospheric_tides": _BOOL, "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
                "earth_field_indirect": _BOOL, "eop": _BOOL_OR_STR},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY,
-                   "self_gravity_center": _ANY, "self_gravity_center_span": _ANY},
+                   "self_gravity_center": _ANY, "self_gravity_center_span": _ANY, "architecture": _STR,
+                   "dragfree": _STR, "tm_distance": _NUM, "housing_centers": _ANY, "pivots": _ANY,
+                   "sensitive_axes": _ANY, "envelope_radius": _NUM},
     "initial": {"axes": _STR, "design": _STR, "arm_length": _NUM, "displacement_deg": _NUM, "rotation": _STR,
                 "semi_major_axis": _NUM, "oem": _STRLIST, "oem_eme2000": _STR},
     "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
@@ -118,6 +120,7 @@ _TOP_KEYS = tuple(_SCHEMA) + ("satellites",)
 _EPOCH_KEYS = ("epoch_utc", "epoch_tdb")
 # TOML key -> dataclass field, where they differ
 _FIELD_OF = {"step": "step_s", "duration": "duration_s", "d_tm": "d_tm_m", "d_p": "d_p_m",
+             "tm_distance": "tm_distance_m", "envelope_radius": "envelope_radius_m",
              "arm_length": "arm_length_m", "semi_major_axis": "semi_major_axis_m"}
 
 

@@ -250,9 +250,9 @@ def lisa_benchmark(duration: str = LISA_DURATION) -> dict:
 
     from ..scenario.loader import parse_duration
 
-    step = load_scenario("lisa").integrator.step_s
+    step = load_scenario("lisa-esa").integrator.step_s
     n = max(1, int((parse_duration(duration) / step).to_integral_value(ROUND_CEILING)))
-    scen = load_scenario("lisa", [f"run.duration={n * step}"])
+    scen = load_scenario("lisa-esa", [f"run.duration={n * step}"])
     report = {"duration_s": float(scen.run.duration_s), "step_s": float(step), "n_steps": scen.n_steps,
               "n_sat": len(scen.satellites), "runs": {}}
     for precision in ("dd", "float64"):
