@@ -36,10 +36,13 @@ from ..numerics.dd import mp_from_dd
 from ..scenario import load_scenario
 
 __all__ = ["kepler_benchmark", "format_report", "force_model_benchmark", "format_force_report",
-           "coupled_benchmark", "format_coupled_report", "lisa_benchmark", "format_lisa_report", "LISA_DURATION"]
+           "coupled_benchmark", "format_coupled_report", "lisa_benchmark", "format_lisa_report", "LISA_DURATION",
+           "LISA_COUPLED_DURATION"]
 
 #: Default span of the LISA benchmark: 10 years (14,610 steps of 6 h).
 LISA_DURATION = "3652.5d"
+#: Span of the coupled LISA benchmark (``tqdyn bench --model lisa-coupled``): one year.
+LISA_COUPLED_DURATION = "365d"
 
 #: Pure-gravity constellation (no attitude, no drag-free control).
 PURE_GRAVITY = ["constellation.pointing=none", "constellation.control=off"]
@@ -240,21 +243,24 @@ def format_coupled_report(report: dict) -> str:
     return "\n".join(lines)
 
 
-def lisa_benchmark(duration: str = LISA_DURATION) -> dict:
-    """The built-in ``lisa`` scenario (heliocentric, three point masses, ESA's
-    force model and self-gravity ramp) in dd and in float64: wall time of the
+def lisa_benchmark(duration: str = LISA_DURATION, scenario: str = "lisa-esa") -> dict:
+    """A heliocentric LISA scenario in dd and in float64: wall time of the
     propagation [s] (ephemeris inputs included, JIT compilation excluded) and
-    peak resident memory [MB] of the process so far (no output file).  The
-    span is rounded up to whole steps of the scenario (6 h), at least one."""
+    peak resident memory [MB] of the process so far (no output file).
+    ``scenario``: "lisa-esa" (three point masses, ESA's force model and
+    self-gravity ramp) or "lisa" (the coupled constellation: LISA
+    architecture, iterative pointing, drag-free control).  The span is
+    rounded up to whole steps of the scenario (6 h), at least one."""
     from decimal import ROUND_CEILING
 
     from ..scenario.loader import parse_duration
 
-    step = load_scenario("lisa-esa").integrator.step_s
+    step = load_scenario(scenario).integrator.step_s
     n = max(1, int((parse_duration(duration) / step).to_integral_value(ROUND_CEILING)))
-    scen = load_scenario("lisa-esa", [f"run.duration={n * step}"])
+    scen = load_scenario(scenario, [f"run.duration={n * step}"])
     report = {"duration_s": float(scen.run.duration_s), "step_s": float(step), "n_steps": scen.n_steps,
-              "n_sat": len(scen.satellites), "runs": {}}
+              "n_sat": len(scen.satellites), "scenario": scenario, "coupled": scen.constellation.coupled,
+              "runs": {}}
     for precision in ("dd", "float64"):
         wall, rss, res = _timed_run(scen, precision)
         report["runs"][f"lisa, {precision}"] = {"wall_s": wall, "peak_rss_mb": rss,
@@ -265,8 +271,11 @@ def lisa_benchmark(duration: str = LISA_DURATION) -> dict:
 def format_lisa_report(report: dict) -> str:
     """Human-readable table of a :func:`lisa_benchmark` report."""
     runs = report["runs"]
-    lines = [f"LISA benchmark: {report['n_sat']} spacecraft (lisa: ESA CReMA 2.0 start, Sun + Earth + Moon + "
-             f"planetary barycentres, self-gravity ramp), {report['duration_s'] / 86400:g} days "
+    what = ("coupled: LISA architecture, iterative pointing, drag-free control, 6 TMs"
+            if report.get("coupled") else "point masses")
+    lines = [f"LISA benchmark: {report['n_sat']} spacecraft ({report.get('scenario', 'lisa-esa')}: ESA CReMA 2.0 "
+             f"start, Sun + Earth + Moon + planetary barycentres, self-gravity ramp; {what}), "
+             f"{report['duration_s'] / 86400:g} days "
              f"({report['duration_s'] / 86400 / 365.25:.3g} years) at {report['step_s'] / 3600:g} h ({report['n_steps']} steps), after compilation",
              f"{'run':<32} {'wall [s]':>9} {'us/step':>9} {'peak RSS [MB]':>14}"]
     for name, r in runs.items():
