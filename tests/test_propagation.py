@@ -296,7 +296,7 @@ def test_energy_conserved_10_days(which, request):
     with mpmath.workdps(DPS):
         drift = float((e1 - e0) / abs(e0))
         # the initial state is the dd rounding of the exact elements: E = -GM / (2a)
-        e_exact = -mpf(GM) / (2 * mpf(scen.satellites[0].a_m))
+        e_exact = -mpf(GM) / (2 * mpf(str(scen.satellites[0].a_m)))
         init = float((e0 - e_exact) / abs(e_exact))
     print(f"\n[{which}] 10 d energy: relative drift (mpmath) {drift:.3e}, RunResult {res.energy_rel_drift[0]:.3e}; "
           f"initial-state rounding {init:.3e}")
