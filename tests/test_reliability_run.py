@@ -237,6 +237,21 @@ def test_kill_9_after_a_checkpoint_resumes(tmp_path):
     _resume_matches_uninterrupted(tmp_path, args, out, ref)
 
 
+def test_wall_clock_checkpoint_resumes(tmp_path):
+    """`--checkpoint-interval`: a checkpoint at the first chunk boundary (4096 steps) after the wall-clock
+    interval, with step-count checkpoints off; kill -9 after it and `--resume` finishes to the data of an
+    uninterrupted run (where a checkpoint falls does not change the steps)."""
+    args = KEPLER + ["--duration", "40d", "--checkpoint-every", "0", "--checkpoint-interval", "0.001"]
+    ref, out = tmp_path / "ref.h5", tmp_path / "out.h5"
+    p = _child(args + ["-o", str(out)])
+    _wait_for(tmp_path / "out.h5.checkpoint", p)
+    p.send_signal(signal.SIGKILL)
+    code, _, _ = _finish(p)
+    assert code == -signal.SIGKILL
+    assert "out.h5.checkpoint" in _listing(tmp_path)
+    _resume_matches_uninterrupted(tmp_path, args, out, ref)
+
+
 def test_sigterm_without_checkpoint_leaves_nothing(tmp_path):
     out = tmp_path / "out.h5"
     p = _child(KEPLER + ["--duration", "200d", "--checkpoint-every", "0", "-o", str(out)])

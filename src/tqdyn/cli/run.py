@@ -97,6 +97,23 @@ def _format_state_table(scenario, y_dd) -> list[str]:
     return lines
 
 
+def _checkpoint_interval(text) -> float:
+    """``--checkpoint-interval`` in seconds (>= 0, finite); ValueError naming the option."""
+    import math
+
+    from ..scenario import ScenarioError
+    from ..scenario.loader import parse_duration
+
+    try:
+        v = float(parse_duration(text))
+    except (ScenarioError, ValueError, ArithmeticError):
+        v = float("nan")
+    if not (math.isfinite(v) and v >= 0):
+        raise ValueError(f"--checkpoint-interval: {text!r} is not a duration; allowed: >= 0 seconds, or with a unit "
+                         "(30min, 2h, 1d); 0 = never")
+    return v
+
+
 @click.command("run")
 @click.argument("scenario", required=False)
 @click.option("--duration", help="Propagation span: seconds, or with a unit: 90d, 12h, 30min, 3600s.")
@@ -109,8 +126,11 @@ def _format_state_table(scenario, y_dd) -> list[str]:
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
 @click.option("--checkpoint-every", type=click.IntRange(min=0), default=20000, show_default=True,
               help="Write a resumable checkpoint every N steps (fixed mode; 0 = never).")
+@click.option("--checkpoint-interval", default="0", show_default=True, metavar="DURATION",
+              help="Also write a checkpoint after this much wall-clock time since the last one, at the next chunk "
+                   "of steps (fixed mode): seconds or 30min, 2h; 0 = never.")
 @click.option("--resume", is_flag=True, help="Continue an interrupted run from its checkpoint (same arguments).")
-def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_every, resume):
+def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_every, checkpoint_interval, resume):
     """Propagate SCENARIO (a built-in name or a TOML file; default: tianqin)
     and write the trajectory file.  Interrupted runs (Ctrl-C, a crash) keep
     their last checkpoint; `--resume` continues them to a bit-identical file."""
@@ -122,6 +142,7 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     from ..scenario import ScenarioError, load_scenario
 
     try:
+        interval_s = _checkpoint_interval(checkpoint_interval)
         scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
         io.check_writable(scen.run.output)
         runner.check_checkpoint(scen, resume)
@@ -154,7 +175,8 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     try:
         with _stop_signals() as state["stop"]:
             summary = runner.run_to_file(scen, model=model, progress=progress,
-                                         checkpoint_every=checkpoint_every if fixed else 0, resume=resume)
+                                         checkpoint_every=checkpoint_every if fixed else 0, resume=resume,
+                                         checkpoint_interval_s=interval_s if fixed else 0.0)
     except io.OutputIOError as exc:
         if state["bar"] is not None:
             state["bar"].close()

@@ -135,7 +135,7 @@ def warm_up(precision: str = "dd") -> None:
 
 
 def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                     start=None, checkpoint=None, checkpoint_every=0, system=None):
+                     start=None, checkpoint=None, checkpoint_every=0, system=None, checkpoint_interval_s=0.0):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
     n_total = scenario.n_steps
     every = scenario.run.output_every
@@ -155,6 +155,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
     gw, fw, aux = _lay.workspace(y)
     n_aux = _lay.AUX_LEN if system.coupled else 0
     t_start = _time.perf_counter()
+    t_ckpt = t_start
     extremes: dict = {}
     # chunk boundaries (fixed by chunk and checkpoint_every, so a resumed run
     # takes the same steps); the time-only inputs of the next chunk are
@@ -193,8 +194,12 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
             n = n0 + m
             if progress is not None:
                 progress(m)
-            if checkpoint is not None and checkpoint_every and n % checkpoint_every == 0 and n < n_total:
+            now = _time.perf_counter()
+            due = ((checkpoint_every and n % checkpoint_every == 0)
+                   or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
+            if checkpoint is not None and due and n < n_total:
                 checkpoint(Checkpoint(n, y.copy(), comp.copy()))
+                t_ckpt = now
     # the final state and its acceleration
     t_end = np.empty((1, 2))
     t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))

@@ -46,7 +46,7 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
               progress: Callable[[int], None] | None = None, chunk: int = DEFAULT_CHUNK,
               y0: np.ndarray | None = None, model: ForceModel | None = None,
               start: Checkpoint | None = None, checkpoint: Callable[[Checkpoint], None] | None = None,
-              checkpoint_every: int = 0) -> RunResult:
+              checkpoint_every: int = 0, checkpoint_interval_s: float = 0.0) -> RunResult:
     """Propagate the scenario's satellites over ``scenario.run.duration_s``.
 
     precision: "dd" | "float64" (default: the scenario's run.precision).
@@ -61,8 +61,11 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     model: optional force model instead of the one built from scenario.forces.
     start: resume a fixed-step run from this checkpoint (its rows before
     start.n are not emitted again).  checkpoint(Checkpoint): called every
-    ``checkpoint_every`` steps (fixed mode; 0 = never) after the rows up to
-    that step went to the sink.
+    ``checkpoint_every`` steps (fixed mode; 0 = never), and at the first
+    chunk boundary (``chunk`` steps) after ``checkpoint_interval_s`` seconds
+    of wall-clock time since the last one (0 = never), after the rows up to
+    that step went to the sink.  Where the checkpoints fall does not change
+    the steps: a run resumed from any of them is bit-identical.
     """
     precision = precision or scenario.run.precision
     check_precision(precision)
@@ -73,12 +76,12 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)
     if scenario.integrator.mode == "adaptive":
-        if start is not None or checkpoint_every:
+        if start is not None or checkpoint_every or checkpoint_interval_s:
             raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
         result = propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system)
     else:
         result = propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                                  start, checkpoint, checkpoint_every, system)
+                                  start, checkpoint, checkpoint_every, system, checkpoint_interval_s)
     if [t.name for t in model.terms] in (["earth_monopole"], ["sun_monopole"]) and not system.coupled \
             and system.centre_ramp is None:
         e0 = two_body_energy(result.y0, model.terms[0].gm)

@@ -156,7 +156,7 @@ def check_checkpoint(scen, resume: bool) -> None:
 
 
 def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = None,
-                checkpoint_every: int = 0, resume: bool = False) -> RunSummary:
+                checkpoint_every: int = 0, resume: bool = False, checkpoint_interval_s: float = 0.0) -> RunSummary:
     """Propagate ``scen`` and write its trajectory to ``scen.run.output``.
 
     Parameters
@@ -169,6 +169,9 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         many steps (fixed mode; 0 = never).  An interrupted run keeps it and
         its partial trajectory; ``resume=True`` continues it to the same file
         bit for bit.
+    checkpoint_interval_s : also write one at the first chunk boundary after
+        this many seconds of wall-clock time since the last (fixed mode; 0 =
+        never).
     resume : continue from the checkpoint (it must belong to the same
         resolved scenario and precision).
     """
@@ -177,7 +180,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         model = dynamics.check_inputs(scen)
     fixed = scen.integrator.mode == "fixed"
     if not fixed:
-        checkpoint_every = 0
+        checkpoint_every, checkpoint_interval_s = 0, 0.0
     ckpt = checkpoint_path(out_path)
     if resume:
         start, writer_factory = _resume(ckpt, scen, out_path)
@@ -222,7 +225,8 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
 
     try:
         result = dynamics.propagate(scen, sink=lambda rows: writer.append(io.row_fields(rows)), progress=progress, model=model, start=start,
-                                      checkpoint=save_checkpoint, checkpoint_every=checkpoint_every)
+                                      checkpoint=save_checkpoint, checkpoint_every=checkpoint_every,
+                                      checkpoint_interval_s=checkpoint_interval_s)
         rows = writer.rows_written
         writer.close()
     except BaseException as exc:
