@@ -2,9 +2,11 @@
 dependency, `pip install tqdyn[plot]`).
 
 The force budget, and the figures of ``tqdyn report``
-(:mod:`tqdyn.workflows.report`): pointing-law errors, control, breathing
-angles, range ASDs, orbit deviations.  Every report figure is written as PNG
-and PDF (:data:`FIGURE_FORMATS`); time axes in days (TT) since the epoch.
+(:mod:`tqdyn.workflows.report`): pointing-law errors, control, actuation
+per axis, arm lengths, breathing angles, range ASDs, orbit deviations.
+Every report figure is written as PNG and PDF (:data:`FIGURE_FORMATS`);
+time axes in days since the epoch in the file's time scale (``time_scale``:
+"TT" geocentric, the default, "TDB" heliocentric).
 matplotlib is imported only inside the plotting functions (Agg backend).
 """
 
@@ -26,6 +28,8 @@ __all__ = [
     "FIGURE_FORMATS",
     "check_figure_path",
     "figure_extensions",
+    "plot_actuation",
+    "plot_arms",
     "plot_asd",
     "plot_breathing",
     "plot_common_self_gravity",
@@ -177,11 +181,21 @@ def _days(t):
     return np.asarray(t) / 86400.0
 
 
+def _time_label(time_scale: str = "TT") -> str:
+    return f"time since epoch [days, {time_scale}]"
+
+
+def _time_scale_of(traj) -> str:
+    ref = getattr(traj, "reference", None)
+    return ref.time_scale if ref is not None else str(traj.attrs.get("time_scale", "TT"))
+
+
 _SAT_COLORS = ("tab:blue", "tab:orange", "tab:green")
 
 
-def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str) -> list[Path]:
-    """Fig. 5: per-beam, X_S and theta errors [rad] of each approximate law vs the iterative law."""
+def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str, time_scale: str = "TT") -> list[Path]:
+    """Fig. 5: per-beam, X_S and theta errors [rad] of each approximate law vs the iterative law
+    against time (days since the epoch in ``time_scale``)."""
     plt = _pyplot()
     laws = list(study.laws)
     fig, axes = plt.subplots(len(laws), 1, figsize=(8, 2.6 * len(laws) + 0.6), sharex=True, squeeze=False)
@@ -201,7 +215,7 @@ def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str) ->
                      fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
     axes[0, 0].legend(fontsize=6.5, ncol=4, loc="center right")
-    axes[-1, 0].set_xlabel("time since epoch [days, TT]")
+    axes[-1, 0].set_xlabel(_time_label(time_scale))
     fig.suptitle(title, fontsize=10)
     return _save(fig, out_dir, stem)
 
@@ -209,7 +223,7 @@ def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str) ->
 def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) -> list[Path]:
     """Figs. 7/8: TM suspension acceleration [m/s^2] and angular acceleration
     [rad/s^2] (components in OA_l) of both TMs of ``sat``, and |A|, |G| of
-    every satellite, against time."""
+    every satellite, against time (days since the epoch in the file's time scale)."""
     plt = _pyplot()
     t = _t(traj)
     k = _stride(t.size)
@@ -233,15 +247,18 @@ def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) 
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=3, loc="best")
-    axes[-1].set_xlabel("time since epoch [days, TT]")
+    axes[-1].set_xlabel(_time_label(_time_scale_of(traj)))
     fig.suptitle(title, fontsize=10)
     return _save(fig, out_dir, stem)
 
 
 def plot_breathing(series: Sequence[tuple[str, np.ndarray, np.ndarray, str]], out_dir: Path, stem: str, title: str,
-                   band: bool = True) -> list[Path]:
-    """Fig. 9: breathing angles [deg] against time; ``series`` of (label, t [s],
-    alpha (N, 3) [rad], line style); the 60 +- 0.1 deg band if ``band``."""
+                   band: bool = True, band_deg: tuple | None = BREATHING_BAND_DEG, band_label: str = "",
+                   time_scale: str = "TT") -> list[Path]:
+    """Fig. 9: breathing angles [deg] against time (days since the epoch in
+    ``time_scale``); ``series`` of (label, t [s], alpha (N, 3) [rad], line
+    style); the band ``band_deg`` (min, max) [deg] (default 60 +- 0.1 deg,
+    TianQin's) if ``band``, labelled ``band_label`` after its values."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.4))
     for label, t, alpha, ls in series:
@@ -249,15 +266,108 @@ def plot_breathing(series: Sequence[tuple[str, np.ndarray, np.ndarray, str]], ou
         for s in Sat:
             ax.plot(_days(t)[::k], np.degrees(alpha[::k, s.index]), ls=ls, lw=0.9, color=_SAT_COLORS[s.index],
                     label=f"alpha_{int(s)} {label}")
-    if band:
-        for y in BREATHING_BAND_DEG:
+    if band and band_deg is not None:
+        mid, half = 0.5 * (band_deg[0] + band_deg[1]), 0.5 * (band_deg[1] - band_deg[0])
+        for y in band_deg:
             ax.axhline(y, color="red", lw=0.8, ls=":")
-        ax.axhspan(*BREATHING_BAND_DEG, color="red", alpha=0.04, label="60 +- 0.1 deg")
-    ax.set_xlabel("time since epoch [days, TT]")
+        ax.axhspan(*band_deg, color="red", alpha=0.04, label=f"{mid:g} +- {half:g} deg" + (f" ({band_label})"
+                                                                                         if band_label else ""))
+    ax.set_xlabel(_time_label(time_scale))
     ax.set_ylabel("breathing angle [deg]")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
     ax.set_title(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def _length_unit(length_m: float) -> tuple[float, str]:
+    """(scale [m], name) of a readable unit for lengths of about ``length_m``."""
+    return (1e9, "10$^9$ m") if length_m >= 1e9 else (1e3, "km")
+
+
+def plot_arms(t, length, rate, out_dir: Path, stem: str, title: str, nominal: tuple[float, str] | None = None,
+              band: tuple | None = None, rate_max: float | None = None, time_scale: str = "TT") -> list[Path]:
+    """Arm lengths and their rates against time (days since the epoch in
+    ``time_scale``): t (N,) [s]; length (N, 3) [m] of the arms L_12, L_23,
+    L_31; rate (N, 3) [m/s] or None.  ``nominal`` (length [m], label) draws
+    the design arm, ``band`` (min, max) [m] the allowed range, ``rate_max``
+    [m/s] the allowed |dL/dt|.  Lengths in 10^9 m for arms >= 1e9 m (LISA,
+    Taiji), else in km (TianQin); rates in m/s."""
+    plt = _pyplot()
+    t = np.asarray(t)
+    rows = 2 if rate is not None else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.4 * rows + 0.6), sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    k = _stride(t.size)
+    d = _days(t)[::k]
+    scale, unit = _length_unit(float(np.nanmean(length)))
+    names = ("L$_{12}$", "L$_{23}$", "L$_{31}$")
+    for a in range(3):
+        axes[0].plot(d, length[::k, a] / scale, color=_SAT_COLORS[a], lw=1.0, label=names[a])
+    if nominal is not None:
+        axes[0].axhline(nominal[0] / scale, color="k", lw=0.9, ls="--", label=nominal[1])
+    if band is not None:
+        for y in band:
+            axes[0].axhline(y / scale, color="red", lw=0.8, ls=":")
+    axes[0].set_ylabel(f"arm length [{unit}]")
+    axes[0].ticklabel_format(axis="y", useOffset=False)
+    if rate is not None:
+        for a in range(3):
+            axes[1].plot(d, rate[::k, a], color=_SAT_COLORS[a], lw=1.0, label=f"d{names[a]}/dt")
+        if rate_max is not None:
+            for y in (-rate_max, rate_max):
+                axes[1].axhline(y, color="red", lw=0.8, ls=":")
+            axes[1].plot([], [], color="red", lw=0.8, ls=":", label=f"+- {rate_max:g} m/s")
+        axes[1].set_ylabel("arm-length rate [m/s]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7.5, ncol=4, loc="best")
+    axes[-1].set_xlabel(_time_label(time_scale))
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, out_dir, stem)
+
+
+def plot_actuation(traj, out_dir: Path, stem: str, title: str) -> list[Path]:
+    """The actuation of a coupled run per satellite and axis against time
+    (days since the epoch in the file's time scale): left, the TM suspension
+    acceleration A_l [m/s^2] of TM 1 (solid) and TM 2 (dashed), components
+    in OA_l (x = X_OA_l, the optical axis; the TMs' sensitive axes from
+    :attr:`Trajectory.spacecraft` are named in the legend); right, the
+    drag-free acceleration G [m/s^2] of the satellite, components in its body
+    frame S (x = X_S towards the incentre, z = Z_S the constellation normal),
+    and |G|."""
+    plt = _pyplot()
+    t = _t(traj)
+    k = _stride(t.size)
+    d = _days(t)[::k]
+    A = traj["tm/a_suspension"][::k]
+    G = traj["sat/a_dragfree"][::k]
+    G_S = np.einsum("nsij,nsj->nsi", traj["sat/T_S_I"][::k], G)
+    craft = traj.spacecraft
+    sens = craft.sensitive_axes if craft is not None else np.eye(3)[[0, 0]]
+    n_sat = A.shape[1]
+    fig, axes = plt.subplots(n_sat, 2, figsize=(11, 2.6 * n_sat + 0.9), sharex=True, squeeze=False)
+    comp = ("x", "y", "z")
+    for s in range(n_sat):
+        ax = axes[s, 0]
+        for tm, ls in ((0, "-"), (1, "--")):
+            for q in range(3):
+                tag = " (sensitive)" if np.array_equal(sens[tm], np.eye(3)[q]) else ""
+                ax.plot(d, A[:, s, tm, q], ls=ls, lw=0.9, color=f"C{q}", label=f"TM{tm + 1} {comp[q]}{tag}")
+        ax.set_ylabel(f"Sat{s + 1}: A$_l$ [m/s$^2$]\nin OA$_l$")
+        ax = axes[s, 1]
+        for q, name in enumerate(("X$_S$", "Y$_S$", "Z$_S$")):
+            ax.plot(d, G_S[:, s, q], lw=0.9, color=f"C{q}", label=f"G . {name}")
+        ax.plot(d, np.linalg.norm(G[:, s], axis=-1), lw=0.8, color="k", ls=":", label="|G|")
+        ax.set_ylabel(f"Sat{s + 1}: G [m/s$^2$]\nin S")
+    for ax in axes.ravel():
+        ax.grid(True, alpha=0.3)
+    for ax in axes[0]:  # the same styles in every row: one legend per column, above it
+        ax.legend(fontsize=7, ncol=3, loc="lower center", bbox_to_anchor=(0.5, 1.02), frameon=False)
+    for ax in axes[-1]:
+        ax.set_xlabel(_time_label(_time_scale_of(traj)))
+    fig.suptitle(f"{title}\nleft: TM suspension in OA$_l$ (TM1 solid, TM2 dashed; x = X$_{{OA_l}}$, the optical axis); "
+                 "right: drag-free acceleration of the satellite in S", fontsize=9.5)
     return _save(fig, out_dir, stem)
 
 
@@ -287,10 +397,12 @@ def plot_asd(curves: Sequence[tuple[str, AsdResult, dict]], out_dir: Path, stem:
 
 def plot_deviations(series: Sequence[tuple[str, np.ndarray, np.ndarray, str, str]], out_dir: Path, stem: str,
                     title: str, ylabel: str = "|r - r$_{ref}$| [m]", log: bool = False,
-                    hline: tuple[float, str] | None = None, ymin: float | None = None) -> list[Path]:
-    """Deviation-type curves: ``series`` of (label, t [s], y (N,), color, line
-    style); ``hline`` (value, label) draws a reference level; ``ymin`` the
-    lower y limit."""
+                    hline: tuple[float, str] | None = None, ymin: float | None = None,
+                    time_scale: str = "TT") -> list[Path]:
+    """Deviation-type curves against time (days since the epoch in
+    ``time_scale``): ``series`` of (label, t [s], y (N,), color, line style);
+    ``hline`` (value, label) draws a reference level; ``ymin`` the lower y
+    limit."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.6))
     for label, t, y, color, ls in series:
@@ -300,7 +412,7 @@ def plot_deviations(series: Sequence[tuple[str, np.ndarray, np.ndarray, str, str
         ax.axhline(hline[0], color="red", lw=1.0, ls="-.", label=hline[1])
     if ymin is not None:
         ax.set_ylim(bottom=ymin)
-    ax.set_xlabel("time since epoch [days, TT]")
+    ax.set_xlabel(_time_label(time_scale))
     ax.set_ylabel(ylabel)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)

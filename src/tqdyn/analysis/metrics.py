@@ -1,11 +1,14 @@
-"""Metrics of tqdyn trajectories: breathing angles, orbit deviations, the
+"""Metrics of tqdyn trajectories: arm lengths and their rates, breathing
+angles, the design values and stability constraints of the three
+constellations (:class:`ConstellationReference`), orbit deviations, the
 secular along-track drift, the flight-axis check, range ASDs against the
-requirement and the control maxima.
+requirement, the control maxima and the actuation per axis.
 
-Conventions: SI units (m, s, m/s^2, rad), GCRS for inertial vectors, S /
-OA_l frames for control quantities as stored in the trajectory
-(:data:`tqdyn.formats.trajectory.FIELDS`), time in TT seconds since the
-scenario epoch.  Ranges are formed and differenced in double-double before
+Conventions: SI units (m, s, m/s^2, rad), the file's inertial frame (GCRS
+for geocentric, the Sun-centred BCRS for heliocentric runs) for inertial
+vectors, S / OA_l frames for control quantities as stored in the trajectory
+(:data:`tqdyn.formats.trajectory.FIELDS`), time in seconds since the
+scenario epoch in the file's time scale (TT geocentric, TDB heliocentric).  Ranges are formed and differenced in double-double before
 any float64 rounding (:mod:`tqdyn.lightpath`, :mod:`tqdyn.analysis.spectra`);
 the ASDs use the default Kaiser-window Welch estimate of the second dd
 difference (:func:`tqdyn.analysis.spectra.range_asd`) and are compared with
@@ -42,8 +45,14 @@ from . import spectra
 
 __all__ = [
     "BREATHING_BAND_DEG",
+    "LISA",
+    "TAIJI",
+    "TIANQIN",
     "AsdResult",
+    "ConstellationReference",
     "Deviation",
+    "actuation_values",
+    "arm_lengths_of",
     "breathing_angles_of",
     "flight_axis_check",
     "orbit_deviation",
@@ -55,6 +64,58 @@ __all__ = [
 BREATHING_BAND_DEG = (59.9, 60.1)
 
 _RELIABLE_BINS = 26  # lowest reliable Welch bin of the default Kaiser window (spectra module)
+
+
+@dataclass(frozen=True)
+class ConstellationReference:
+    """The design values and stability constraints a report compares a
+    constellation with.
+
+    name : "TianQin", "LISA" or "Taiji"; arm_m [m] : the nominal arm length
+    and ``arm_source`` where it comes from; arm_band_m : (min, max) [m] the
+    arms must stay in, or None; breathing_band_deg : (min, max) [deg] of the
+    breathing (corner) angles, or None; arm_rate_max : the largest |dL/dt|
+    [m/s] allowed, or None; ``constraint_source`` where the bands come from.
+    """
+
+    name: str
+    arm_m: float
+    arm_source: str
+    arm_band_m: tuple | None = None
+    breathing_band_deg: tuple | None = None
+    arm_rate_max: float | None = None
+    constraint_source: str = ""
+
+    def with_arm(self, arm_m: float, source: str) -> "ConstellationReference":
+        """The same constraints with another nominal arm length [m] (e.g. the scenario's design)."""
+        from dataclasses import replace
+
+        return replace(self, arm_m=float(arm_m), arm_source=source)
+
+
+#: TianQin: an equilateral triangle inscribed in a geocentric circular orbit of radius 1e5 km, so
+#: L = sqrt(3) x 1e5 km; the breathing-angle requirement 60 +- 0.1 deg of the TianQin paper.
+TIANQIN = ConstellationReference("TianQin", 3 ** 0.5 * 1e8, "sqrt(3) x 1e5 km: the triangle in TianQin's 1e5 km orbit",
+                                 breathing_band_deg=BREATHING_BAND_DEG, constraint_source="the TianQin paper")
+#: LISA: ESA's design arm 2.5e6 km and the stability constraints of ESA's trajectory design (Martens &
+#: Joffre 2021, "Trajectory design for the ESA LISA mission", arXiv:2101.03040): corner angles 60 +- 1.0 deg,
+#: arm-length rate <= 10 m/s, arms 2.5e6 km +- 2.5e5 km.
+LISA = ConstellationReference("LISA", 2.5e9, "ESA's LISA design, 2.5e6 km", arm_band_m=(2.25e9, 2.75e9),
+                              breathing_band_deg=(59.0, 61.0), arm_rate_max=10.0,
+                              constraint_source="ESA's LISA trajectory design (Martens & Joffre 2021)")
+#: Taiji: the design arm 3e6 km (no public stability constraints are used).
+TAIJI = ConstellationReference("Taiji", 3.0e9, "Taiji's design, 3e6 km")
+
+
+def arm_lengths_of(traj) -> tuple[np.ndarray, np.ndarray | None]:
+    """Instantaneous arm lengths L_12, L_23, L_31 (N, 3) [m] of a
+    three-satellite trajectory, from its dd satellite positions (no light
+    time), and their rates dL/dt = (v_j - v_i) . n_ij (N, 3) [m/s] (None
+    without ``sat/v``).  Any central body and frame (a length and its rate
+    do not depend on the axes); t in the file's time scale."""
+    a = geometry.arms(traj.dd("sat/r"), traj.dd("sat/v") if "sat/v" in traj else None)
+    rate = None if a.length_dot is None else a.length_dot[..., :3]
+    return a.length[..., :3], rate
 
 
 def _t(traj) -> np.ndarray:
@@ -261,3 +322,28 @@ def _control_values(tr) -> dict:
             "max_dA": float(dA.max()), "max_G_per_sat": nG.max(axis=0), "max_A_per_sat": nA.max(axis=(0, 2)),
             "max_A_day1": float(nA[day1].max()), "max_alpha_day1": float(nW[day1].max()),
             "max_G_day1": float(nG[day1].max())}
+
+
+def actuation_values(tr) -> dict:
+    """The actuation of a coupled run per axis (maxima over the run, m/s^2):
+
+    ``A_axis`` (n_sat, 2, 3): max |A_l . x|, |A_l . y|, |A_l . z| of the TM
+    suspension per satellite, TM l and axis of OA_l (x = X_OA_l the optical
+    axis); ``A_sensitive`` (n_sat, 2): max |A_l . e_l| along TM l's sensitive
+    axis e_l (from the file's spacecraft attributes, :attr:`Trajectory.spacecraft`:
+    zero to round-off when the drag-free control follows the TM there);
+    ``A_max`` (n_sat,): max |A_l| over both TMs; ``G_axis_S`` (n_sat, 3): max
+    |G . X_S|, |G . Y_S|, |G . Z_S| of the drag-free acceleration in the body
+    frame S (G stored in the inertial frame, turned with ``sat/T_S_I``);
+    ``G_mean_S`` (n_sat, 3): its mean components in S; ``G_max`` (n_sat,):
+    max |G|; ``alpha_max`` (n_sat,): max |alpha_l| [rad/s^2]."""
+    A = tr["tm/a_suspension"]
+    G = tr["sat/a_dragfree"]
+    G_S = np.einsum("nsij,nsj->nsi", tr["sat/T_S_I"], G)
+    craft = tr.spacecraft
+    e = craft.sensitive_axes if craft is not None else np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    along = np.abs(np.einsum("nslk,lk->nsl", A, e))
+    return {"A_axis": np.abs(A).max(axis=0), "A_sensitive": along.max(axis=0),
+            "A_max": np.linalg.norm(A, axis=-1).max(axis=(0, 2)), "G_axis_S": np.abs(G_S).max(axis=0),
+            "G_mean_S": G_S.mean(axis=0), "G_max": np.linalg.norm(G, axis=-1).max(axis=0),
+            "alpha_max": np.linalg.norm(tr["tm/alpha_suspension"], axis=-1).max(axis=(0, 2))}

@@ -57,9 +57,18 @@ def info():
         "constellation (coupled dynamics, [constellation] / [spacecraft] in a scenario):",
         "  pointing laws: global (instantaneous plane) | taylor1, taylor2 (light-time Taylor expansion) |"
         " iterative (light-time equation solved exactly); none = independent point masses",
-        "  control: on (drag-free G_i in the orbits, suspension A_c,l from eq. E1/E2, G from the three"
-        " conditions: tan/cot of theta/2) | off (pure-gravity orbits); free_tms: TMs as free bodies (verification)",
-        "  spacecraft: TMs +/-d_tm/2 along tm_axis of S (default y), pivots d_p; DC self-gravity per TM in"
+        "  control: on (drag-free G_i in the orbits, suspension A_c,l from the three conditions: scheme tianqin"
+        " eq. E1/E2 with tan/cot of theta/2, scheme lisa the same conditions for any independent sensitive axes) | off (pure-gravity orbits); free_tms: TMs as free bodies (verification)",
+        "  spacecraft: architecture presets tianqin (default; drag-free scheme tianqin, the paper's closed form) |"
+        " lisa, taiji (one TM per MOSA on its optical axis, MOSAs turning about Z_S through the CoM; scheme lisa);"
+        " dragfree = tianqin | lisa overrides the scheme",
+        "    tianqin only: d_tm (TMs +/-d_tm/2 along tm_axis of S, default 0.40 m along y), d_p (pivots behind the"
+        " EH centres, default 0 m); lisa/taiji only: tm_distance (EH centre from the CoM along the optical axis,"
+        " default 0.30 m)",
+        "    any architecture: housing_centers, pivots ([[x, y, z], [x, y, z]] m in S at 60 deg), sensitive_axes"
+        " (unit vectors in OA_l, default X_OA_l), envelope_radius (m, default 1.5); DC self-gravity per TM in"
         " OA_l (Table IV of the paper by default) + a common part fixed in S",
+        "  trajectory files of coupled runs record spacecraft_architecture, dragfree_scheme and the"
+        " spacecraft_* geometry (docs/trajectory-format.md)",
     ]
     click.echo("\n".join(lines))

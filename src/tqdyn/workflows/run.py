@@ -34,7 +34,7 @@ from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
-           "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning"]
+           "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning"]
 
 
 @dataclass(frozen=True)
@@ -106,9 +106,34 @@ def eop_warning(scen, model=None) -> str | None:
     return None if eop is None else long_term_warning(eop, *_run_span(scen))
 
 
+def spacecraft_attrs(scen) -> dict:
+    """The spacecraft root attributes of a coupled run of ``scen``
+    (:data:`tqdyn.formats.trajectory.schema.SPACECRAFT_ATTRS`; ``{}`` for
+    point-mass runs): the architecture, the drag-free scheme, the EH centres
+    and MOSA pivots at the nominal opening angle (m, body frame S) and the
+    TMs' sensitive axes (unit vectors, each in its OA_l) as JSON (2, 3)
+    arrays, the nominal opening angle (rad)."""
+    import json
+
+    if not scen.constellation.coupled:
+        return {}
+    craft = scen.spacecraft.craft()
+
+    def vectors(a):
+        return json.dumps([[float(x) + 0.0 for x in row] for row in a])  # + 0.0: no negative zeros
+
+    return {"spacecraft_architecture": craft.architecture, "dragfree_scheme": craft.scheme,
+            "spacecraft_housing_centers": vectors(craft.nominal_housing_centers),
+            "spacecraft_pivots": vectors(craft.pivots),
+            "spacecraft_sensitive_axes": vectors(craft.sensitive_axes_array),
+            "spacecraft_theta_nominal": float(craft.theta_nominal),
+            "spacecraft_units": io.schema.SPACECRAFT_UNITS}
+
+
 def output_attrs(scen, model=None) -> dict:
     """Root attributes of the trajectory file of ``scen`` (the EOP attributes
-    from ``model``'s table if given, see :func:`eop_attrs`)."""
+    from ``model``'s table if given, see :func:`eop_attrs`; the spacecraft
+    attributes of a coupled run, see :func:`spacecraft_attrs`)."""
     integ = scen.integrator
     c = scen.constellation
     ref = scen.reference
@@ -125,6 +150,7 @@ def output_attrs(scen, model=None) -> dict:
         "pointing": c.pointing,
         "control": c.control,
         "free_tms": int(c.free_tms),
+        **spacecraft_attrs(scen),
         **eop_attrs(scen, model),
     }
 

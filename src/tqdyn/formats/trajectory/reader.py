@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+from dataclasses import dataclass
 from typing import Any, Mapping
 
 import h5py
@@ -12,14 +13,98 @@ import numpy as np
 from ... import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
 from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, ReferenceSystem
-from .schema import (field_frame, _COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
-                     _symbolic, row_fields)
+from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
+                     _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["Trajectory", "read_trajectory"]
+__all__ = ["SpacecraftRecord", "Trajectory", "read_trajectory"]
 
-# ---------------------------------------------------------------------------
-# reading
-# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class SpacecraftRecord:
+    """The spacecraft of a coupled trajectory (:attr:`Trajectory.spacecraft`),
+    the same for the three satellites.
+
+    architecture : str
+        ``"tianqin"``, ``"lisa"`` or ``"taiji"`` (root attribute ``spacecraft_architecture``).
+    dragfree_scheme : str
+        ``"tianqin"`` or ``"lisa"`` (root attribute ``dragfree_scheme``).
+    housing_centers : ndarray (2, 3)
+        EH centres r_0,l of TM 1, TM 2 at ``theta_nominal``, m, in the body
+        frame S (origin the satellite's centre of mass).
+    pivots : ndarray (2, 3)
+        MOSA pivots (fixed in S), m, in S.
+    sensitive_axes : ndarray (2, 3)
+        Unit sensitive axis of TM l in its frame OA_l (row l - 1).
+    theta_nominal : float
+        Nominal MOSA opening angle, rad.
+    recorded : bool
+        True when the file records these values (root attributes of
+        :data:`~tqdyn.formats.trajectory.schema.SPACECRAFT_ATTRS`); False for a
+        coupled file written before them (format version 1, or 2 before the
+        spacecraft architecture became configuration): then every such run
+        used the TianQin architecture and scheme, and the values are its
+        defaults -- the line layout of the file's scenario (``[spacecraft]
+        d_tm``, ``d_p``, ``tm_axis``; 0.40 m, 0 m, ``"y"`` when absent),
+        sensitive axes X_OA_l, theta_nominal pi/3.
+    """
+
+    architecture: str
+    dragfree_scheme: str
+    housing_centers: np.ndarray
+    pivots: np.ndarray
+    sensitive_axes: np.ndarray
+    theta_nominal: float
+    recorded: bool
+
+
+def _from_scenario_text(scenario_toml: str) -> SpacecraftRecord:
+    """The spacecraft of a coupled file without spacecraft attributes
+    (:class:`SpacecraftRecord`, ``recorded`` False), from the ``[spacecraft]``
+    table of its scenario text (TOML): ``architecture`` (default
+    ``"tianqin"``), ``dragfree`` (default the architecture's: ``"tianqin"``
+    for tianqin, else ``"lisa"``), the line layout of tianqin (TM_1 at
+    +d_tm/2, TM_2 at -d_tm/2 along ``tm_axis`` of S, pivots d_p behind the EH
+    centres along the nominal X_OA_l; 0.40 m, 0 m, "y" by default) or the
+    optical-axis layout of lisa / taiji (EH centres ``tm_distance``, default
+    0.30 m, along the nominal X_OA_l, pivots at the CoM), ``housing_centers``
+    / ``pivots`` / ``sensitive_axes`` where given, theta_nominal pi/3.  The
+    scenario text of a file written before the architectures were
+    configurable names none of these keys: the TianQin defaults."""
+    import math
+    import tomllib
+
+    try:
+        sc = tomllib.loads(scenario_toml).get("spacecraft", {})
+        if not isinstance(sc, dict):
+            sc = {}
+    except (tomllib.TOMLDecodeError, TypeError):
+        sc = {}
+    theta = math.pi / 3
+    h = 0.5 * theta
+    u = np.array([[math.cos(h), math.sin(h), 0.0], [math.cos(h), -math.sin(h), 0.0]])
+    arch = str(sc.get("architecture", "tianqin"))
+    scheme = str(sc.get("dragfree", "tianqin" if arch == "tianqin" else "lisa"))
+    try:
+        if arch == "tianqin":
+            d_tm, d_p = float(sc.get("d_tm", 0.40)), float(sc.get("d_p", 0.0))
+            e = np.zeros(3)
+            e[{"x": 0, "y": 1, "z": 2}.get(str(sc.get("tm_axis", "y")), 1)] = 1.0
+            r0 = np.array([0.5 * d_tm * e, -0.5 * d_tm * e])
+            piv = r0 - d_p * u
+        else:
+            r0 = float(sc.get("tm_distance", 0.30)) * u
+            piv = np.zeros((2, 3))
+        if "housing_centers" in sc or "pivots" in sc:
+            r0 = np.array(sc.get("housing_centers", r0), dtype=np.float64)
+            piv = np.array(sc.get("pivots", r0), dtype=np.float64)
+        sens = np.array(sc.get("sensitive_axes", [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), dtype=np.float64)
+        sens = sens / np.linalg.norm(sens, axis=-1, keepdims=True)
+        if r0.shape != (2, 3) or piv.shape != (2, 3) or sens.shape != (2, 3):
+            raise ValueError("not (2, 3)")
+    except (TypeError, ValueError):  # a damaged scenario text: the TianQin defaults
+        return _from_scenario_text("")
+    # + 0.0: no negative zeros
+    return SpacecraftRecord(arch, scheme, _frozen(r0 + 0.0), _frozen(piv + 0.0), _frozen(sens + 0.0), theta, False)
 
 
 def _frozen(a) -> np.ndarray:
@@ -103,6 +188,30 @@ class Trajectory:
         return ReferenceSystem(*key, description="as recorded in the file")
 
     @property
+    def spacecraft(self) -> SpacecraftRecord | None:
+        """The spacecraft architecture and drag-free scheme of a coupled run
+        (root attribute ``pointing`` != ``"none"``): a
+        :class:`SpacecraftRecord` from the root attributes
+        ``spacecraft_architecture``, ``dragfree_scheme``,
+        ``spacecraft_housing_centers``, ``spacecraft_pivots``,
+        ``spacecraft_sensitive_axes``, ``spacecraft_theta_nominal``; for a
+        coupled file written before them (``recorded`` False) what its
+        scenario text says, the TianQin defaults when it says nothing
+        (format version 1 and early version-2 files).  None for point-mass runs (no attitude, no test masses)."""
+        import math
+
+        a = self.attrs
+        if a.get("pointing", "none") == "none":
+            return None
+        if "spacecraft_architecture" not in a:
+            return _from_scenario_text(self.scenario_toml)
+        vec = {k: _frozen(parse_vectors(a[f"spacecraft_{k}"], f"spacecraft_{k}"))
+               for k in ("housing_centers", "pivots", "sensitive_axes")}
+        return SpacecraftRecord(str(a["spacecraft_architecture"]), str(a.get("dragfree_scheme", "tianqin")),
+                                theta_nominal=float(a.get("spacecraft_theta_nominal", math.pi / 3)), recorded=True,
+                                **vec)
+
+    @property
     def epoch(self):
         """The epoch of t = 0 as a :class:`tqdyn.astro.timescales.Epoch`:
         from the root attribute ``epoch_tdb`` when present (exact), else
@@ -173,8 +282,12 @@ class Trajectory:
         ``sat_r``); a dd field gives the float64 ``hi + lo`` in ``<name>`` and
         the exact residual in ``<name>_lo`` (``<name> + <name>_lo`` == hi + lo
         exactly); the time field gives the ``time`` coordinate and ``t_lo``.
-        Variable attrs: ``units``, ``frame``, ``description``; dataset attrs:
-        the root attributes.
+        Variable attrs: ``units``, ``frame``, ``description``, and as in the
+        file ``components`` (what x, y, z are) for vectors and, for a coupled
+        run that records its spacecraft, ``dragfree_scheme`` /
+        ``sensitive_axes`` on the actuation fields
+        (:func:`~tqdyn.formats.trajectory.schema.dataset_attrs`); dataset
+        attrs: the root attributes.
         """
         import xarray as xr
 
@@ -195,8 +308,8 @@ class Trajectory:
             spec = FIELDS[f]
             dims = (("time",) if spec.time_dependent else ()) + spec.dims
             name = f.replace("/", "_")
-            attrs = {"units": spec.unit, "frame": field_frame(spec, self.reference.time_scale, self.reference.frame),
-                     "description": spec.description}
+            attrs = dataset_attrs(f, {**self.attrs, "time_scale": self.reference.time_scale,
+                                      "frame": self.reference.frame})
             arrays = self._data[f]
             if len(arrays) == 2:
                 val, res = np_two_sum(*arrays)

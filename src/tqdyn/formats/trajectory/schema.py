@@ -27,6 +27,9 @@ __all__ = [
     "FieldSpec",
     "FIELDS",
     "ROOT_ATTRS",
+    "SPACECRAFT_ATTRS",
+    "dataset_attrs",
+    "parse_vectors",
     "OutputError",
     "TrajectoryFormatError",
     "field_path",
@@ -70,6 +73,10 @@ class FieldSpec:
     dims : tuple of str
         xarray dimension names for ``shape`` (``"sat"``, ``"tm"``, ``"comp"``,
         ``"row"``, ``"col"``); the time axis (``"time"``) is not included.
+    components : str
+        What the components x, y, z of a vector field are (the axes of its
+        frame), written as the dataset attribute ``components``; ``{frame}``
+        stands for the file's frame.  ``""`` for fields that are not 3-vectors.
     """
 
     kind: str
@@ -79,14 +86,27 @@ class FieldSpec:
     description: str
     time_dependent: bool
     dims: tuple
+    components: str = ""
 
     def resolved_shape(self, n_sat: int) -> tuple[int, ...]:
         """Trailing shape (no time axis) with ``sat`` -> n_sat and ``tm`` -> 2."""
         return tuple(n_sat if a == "sat" else 2 if a == "tm" else int(a) for a in self.shape)
 
 
+#: The axes of each frame, for the ``components`` attribute of the vector fields.
+_AXES_INERTIAL = ("x, y, z: the axes of the file's frame {frame} (ICRF-aligned, non-rotating)")
+_AXES_S = ("x = X_S (the bisector of the satellite's two beams, towards the constellation's incentre), "
+           "y = Y_S = Z_S x X_S, z = Z_S (the constellation normal, n_ij x n_ik / sin(alpha_i))")
+_AXES_OA = ("x = X_OA_l (the optical axis of MOSA l: MOSA 1 faces satellite k, MOSA 2 satellite j of the even "
+            "permutation (i, j, k)), y = Y_OA_l = Z_S x X_OA_l, z = Z_OA_l = Z_S; OA_l is S turned about Z_S by "
+            "mosa/angle; tm index l = MOSA l")
+
+
 def _f(kind, shape, dims, unit, frame, description, time_dependent=True):
-    return FieldSpec(kind, tuple(shape), unit, frame, description, time_dependent, tuple(dims))
+    axes = ""
+    if shape and shape[-1] == 3 and dims[-1] == "comp":
+        axes = {"GCRS": _AXES_INERTIAL, "S": _AXES_S, "OA_l": _AXES_OA}.get(frame, "")
+    return FieldSpec(kind, tuple(shape), unit, frame, description, time_dependent, tuple(dims), axes)
 
 
 def field_frame(spec: FieldSpec, time_scale: str, frame: str) -> str:
@@ -166,6 +186,33 @@ ROOT_ATTRS: dict[str, str] = {
 }
 """Root attributes of format version 1 and their type / allowed values."""
 
+SPACECRAFT_ATTRS: dict[str, str] = {
+    "spacecraft_architecture": 'str, the spacecraft layout: "tianqin" | "lisa" | "taiji" (the preset of '
+                               "spacecraft.architecture)",
+    "dragfree_scheme": 'str, the drag-free scheme: "tianqin" (the paper\'s closed form, sensitive axes X_OA_l) | '
+                       '"lisa" (the general solution for any independent sensitive axes)',
+    "spacecraft_housing_centers": "str, JSON [[x, y, z], [x, y, z]]: the electrode-housing centres r_0,l (TM "
+                                  "nominal positions) of TM 1 and TM 2 at the nominal MOSA opening angle, m, in "
+                                  "the body frame S (origin the satellite's centre of mass)",
+    "spacecraft_pivots": "str, JSON [[x, y, z], [x, y, z]]: the pivots of MOSA 1 and MOSA 2 (fixed in S), m, in S",
+    "spacecraft_sensitive_axes": "str, JSON [[x, y, z], [x, y, z]]: the unit sensitive axis of TM 1 in OA_1 and "
+                                 "of TM 2 in OA_2 (the drag-free control keeps the suspension zero along them)",
+    "spacecraft_theta_nominal": "float, rad: the nominal MOSA opening angle at which the housing centres are given",
+    "spacecraft_units": "str, the units and frames of the spacecraft_* attributes, in words",
+}
+"""Root attributes of coupled runs (``constellation.pointing`` != "none"),
+written since the spacecraft architecture became configuration (format
+version 2, no change in any field).  A coupled file without them was
+written by the TianQin architecture: :attr:`Trajectory.spacecraft
+<tqdyn.formats.trajectory.Trajectory.spacecraft>` reports its defaults."""
+
+#: The value of ``spacecraft_units``.
+SPACECRAFT_UNITS = ("spacecraft_housing_centers, spacecraft_pivots: m, in the body frame S (origin the "
+                    "satellite's centre of mass), rows TM 1, TM 2, columns x, y, z (the same for the three "
+                    "satellites); spacecraft_sensitive_axes: unit vectors, row l in OA_l of TM l; "
+                    "spacecraft_theta_nominal: rad")
+_SPACECRAFT_VECTORS = ("spacecraft_housing_centers", "spacecraft_pivots", "spacecraft_sensitive_axes")
+
 _REQUIRED_USER_ATTRS = ("scenario", "epoch_utc", "precision", "step_s", "integrator",
                         "pointing", "control")
 _CHOICES = {
@@ -182,6 +229,53 @@ _COORDS = {
     "row": ["X_S", "Y_S", "Z_S"],
     "col": ["x", "y", "z"],
 }
+
+
+def parse_vectors(text, name: str) -> np.ndarray:
+    """The (2, 3) float64 array of a ``spacecraft_*`` vector attribute (JSON
+    text ``[[x, y, z], [x, y, z]]``); ValueError naming the attribute otherwise."""
+    import json
+
+    try:
+        a = np.array(json.loads(text), dtype=np.float64)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.shape != (2, 3) or not np.all(np.isfinite(a)):
+        raise ValueError(f"attrs[{name!r}] = {text!r}; must be JSON [[x, y, z], [x, y, z]] of finite numbers")
+    return a
+
+
+def _axis_name(v, l: int) -> str:
+    for k, name in enumerate(("X", "Y", "Z")):
+        for sign in (1.0, -1.0):
+            if np.array_equal(v, sign * np.eye(3)[k]):
+                return ("-" if sign < 0 else "") + f"{name}_OA_{l}" + (" (the optical axis)" if k == 0 else "")
+    return f"a direction in OA_{l}"
+
+
+def dataset_attrs(path: str, attrs: Mapping[str, Any]) -> dict[str, str]:
+    """The attributes of the dataset (f8 field) or group (dd field) ``path``
+    in a file with root attributes ``attrs``: ``units``, ``frame``,
+    ``description`` (:data:`FIELDS`); ``components`` (what x, y, z are) for
+    vector fields; for the actuation fields of a coupled run that records its
+    spacecraft (:data:`SPACECRAFT_ATTRS`) also ``dragfree_scheme``
+    (``sat/a_dragfree``, ``tm/a_suspension``) and ``sensitive_axes``
+    (``tm/a_suspension``: the sensitive axis of each TM in its OA_l, in words)."""
+    spec = _spec(path, "dataset_attrs")
+    frame = field_frame(spec, attrs.get("time_scale", GEOCENTRIC.time_scale), attrs.get("frame", GEOCENTRIC.frame))
+    out = {"units": spec.unit, "frame": frame, "description": spec.description}
+    if spec.components:
+        out["components"] = spec.components.format(frame=frame)
+    scheme = attrs.get("dragfree_scheme")
+    if scheme and path in ("sat/a_dragfree", "tm/a_suspension"):
+        out["dragfree_scheme"] = str(scheme)
+    axes = attrs.get("spacecraft_sensitive_axes")
+    if axes and path == "tm/a_suspension":
+        e = parse_vectors(axes, "spacecraft_sensitive_axes")
+        out["sensitive_axes"] = "; ".join(
+            f"TM {l}: [{', '.join(f'{x:.17g}' for x in e[l - 1])}] in OA_{l} = {_axis_name(e[l - 1], l)}"
+            for l in (1, 2)) + " (no suspension along it: the spacecraft follows the TM there)"
+    return out
 
 
 def field_path(row_name: str) -> str:
@@ -281,6 +375,17 @@ def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
     except ValueError:
         raise ValueError(f"attrs['epoch_utc'] = {out['epoch_utc']!r} is not an ISO 8601 "
                          "date-time (e.g. 2034-01-01T00:00:00)") from None
+    for key in ("spacecraft_architecture", "dragfree_scheme", "spacecraft_units", *_SPACECRAFT_VECTORS):
+        if key in out and not (isinstance(out[key], str) and out[key]):
+            raise ValueError(f"attrs[{key!r}]: must be a non-empty str, got {out[key]!r}")
+    for key in _SPACECRAFT_VECTORS:
+        if key in out:
+            parse_vectors(out[key], key)
+    if "spacecraft_theta_nominal" in out:
+        th = out["spacecraft_theta_nominal"]
+        if isinstance(th, str) or not 0 < th < math.pi:
+            raise ValueError(f"attrs['spacecraft_theta_nominal'] = {th!r}; must be an angle in (0, pi) rad")
+        out["spacecraft_theta_nominal"] = float(th)
     step = out["step_s"]
     if isinstance(step, str) or not math.isfinite(step):
         raise ValueError(f"attrs['step_s'] = {step!r}; must be a finite number of seconds")

@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 from ._h5safe import _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
-from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, field_frame
+from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, dataset_attrs
 
 __all__ = ["check_writable", "TrajectoryWriter"]
 
@@ -144,7 +144,12 @@ class TrajectoryWriter:
         none), ``control`` (on | off).  ``format``, ``format_version``,
         ``tqdyn_version``, ``origin`` ("earth"), ``frame`` ("GCRS") and ``time_scale`` ("TT") are
         filled in (a given ``tqdyn_version`` is kept; the others must match).
-        Extra str/int/float attributes are stored as given.
+        Extra str/int/float attributes are stored as given; the spacecraft
+        attributes of a coupled run (:data:`SPACECRAFT_ATTRS
+        <tqdyn.formats.trajectory.schema.SPACECRAFT_ATTRS>`) are checked
+        (JSON (2, 3) vectors, theta in (0, pi) rad) and also state the
+        drag-free scheme and the TMs' sensitive axes on the actuation datasets
+        (:func:`~tqdyn.formats.trajectory.schema.dataset_attrs`).
     fields : sequence of str
         Paths from :data:`FIELDS` this file will contain; must include ``"t"``
         if any other time-dependent field is listed.  Static fields listed here
@@ -195,8 +200,7 @@ class TrajectoryWriter:
         self._expected = int(expected_rows) if expected_rows is not None else 0
         self._chunk_rows = max(1, min(_DEFAULT_CHUNK_ROWS, self._expected or _DEFAULT_CHUNK_ROWS))
         full_attrs = _check_attrs(attrs)
-        self._time_scale = full_attrs["time_scale"]
-        self._frame = full_attrs["frame"]
+        self._attrs = full_attrs
 
         self._rows = 0  # rows appended (on disk + buffered)
         self._rows_on_disk = 0
@@ -222,11 +226,11 @@ class TrajectoryWriter:
                           compression=compression, fletcher32=True)
                 if spec.kind == "dd":
                     g = h5.create_group(f)
-                    self._field_attrs(g, spec)
+                    self._field_attrs(g, f)
                     self._dsets[f] = (g.create_dataset("hi", **kw), g.create_dataset("lo", **kw))
                 else:
                     ds = h5.create_dataset(f, **kw)
-                    self._field_attrs(ds, spec)
+                    self._field_attrs(ds, f)
                     self._dsets[f] = (ds,)
         except BaseException as exc:
             self.abort()
@@ -250,12 +254,11 @@ class TrajectoryWriter:
             return tmp
         raise OutputError(f"cannot create a unique temporary file for {str(self._path)!r}")  # pragma: no cover
 
-    def _field_attrs(self, obj, spec: FieldSpec) -> None:
-        obj.attrs["units"] = spec.unit
-        # the time field's "frame" is the file's time scale (FIELDS says "time_scale"), the
-        # vectors' is the file's frame (FIELDS says "GCRS", the geocentric one)
-        obj.attrs["frame"] = field_frame(spec, self._time_scale, self._frame)
-        obj.attrs["description"] = spec.description
+    def _field_attrs(self, obj, path: str) -> None:
+        # units, frame (the time field's is the file's time scale, the vectors' the file's frame),
+        # description, components and, for the actuation fields, the drag-free scheme and sensitive axes
+        for key, value in dataset_attrs(path, self._attrs).items():
+            obj.attrs[key] = value
 
     def _require_open(self, what: str) -> h5py.File:
         if self._status != "open":
@@ -397,12 +400,12 @@ class TrajectoryWriter:
                 del h5[path]
             if spec.kind == "dd":
                 g = h5.create_group(path)
-                self._field_attrs(g, spec)
+                self._field_attrs(g, path)
                 g.create_dataset("hi", data=arrays[0], fletcher32=True)
                 g.create_dataset("lo", data=arrays[1], fletcher32=True)
             else:
                 ds = h5.create_dataset(path, data=arrays[0], fletcher32=True)
-                self._field_attrs(ds, spec)
+                self._field_attrs(ds, path)
         except (OSError, RuntimeError) as exc:
             raise self._io_failed(exc) from None
         except BaseException:
@@ -533,10 +536,8 @@ class TrajectoryWriter:
         return self
 
     def _reopen_datasets(self, h5, partial, rows: int) -> None:
-        ts = h5.attrs.get("time_scale", "TT")
-        self._time_scale = ts.decode() if isinstance(ts, bytes) else str(ts)
-        fr = h5.attrs.get("frame", "GCRS")
-        self._frame = fr.decode() if isinstance(fr, bytes) else str(fr)
+        self._attrs = {k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
+                       for k, v in h5.attrs.items()}
         self._fields = tuple(f for f in FIELDS if f in h5)
         self._tfields = tuple(f for f in self._fields if FIELDS[f].time_dependent)
         self._static_pending = set()

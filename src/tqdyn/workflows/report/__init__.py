@@ -3,20 +3,26 @@
 Two entry points, both writing PNG + PDF figures and ``summary.md`` into an
 output directory and returning a :class:`Report`:
 
-* :func:`report_runs` -- whatever the given trajectory files contain: per run
-  the electrostatic / drag-free control (coupled runs), the breathing angles,
-  the range ASD of the six light paths (uniform grids) and the pointing-law
-  comparison (runs on the 50 s integrator grid); across runs that share an
-  epoch, the orbit deviation from a reference run (the first pure-gravity
-  run, else the first run).
+* :func:`report_runs` -- whatever the given trajectory files contain, for
+  TianQin, LISA and Taiji alike: per run the reference system and (coupled
+  runs) the spacecraft architecture and drag-free scheme the file records,
+  the electrostatic / drag-free control and the actuation per TM and axis,
+  the arm lengths and their rates, the breathing angles against the
+  constellation's design and constraints, the range ASD of the six light
+  paths (uniform grids reaching the band) and the pointing-law comparison
+  (runs on the integrator grid); across runs that share an epoch, the orbit
+  deviation from a reference run (the first pure-gravity run, else the
+  first run).
 * :func:`report_studies` -- the paper's section V from the study runs of
   :mod:`tqdyn.workflows.studies` (Figs. 5-11, the drag-free and common self-gravity
   deviations) with a table "quantity | paper | tqdyn | agreement / notes".
 
 Conventions: SI units (m, s, m/s^2, rad; angles in the figures and table in
-deg where marked), GCRS for inertial vectors, S / OA_l frames for control
+deg where marked), the file's inertial frame for inertial vectors (GCRS
+geocentric, the Sun-centred BCRS heliocentric), S / OA_l frames for control
 quantities as stored in the trajectory (:data:`tqdyn.formats.trajectory.FIELDS`), time in
-TT seconds (days in the figures) since the scenario epoch.  Ranges are
+seconds (days in the figures) since the scenario epoch in the file's time
+scale (TT geocentric, TDB heliocentric).  Ranges are
 formed and differenced in double-double before any float64 rounding
 (:mod:`tqdyn.lightpath`, :mod:`tqdyn.analysis.spectra`); the ASDs use the
 default Kaiser-window Welch estimate of the second dd difference
