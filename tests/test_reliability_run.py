@@ -221,11 +221,17 @@ def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     _resume_matches_uninterrupted(tmp_path, args, out, ref)
 
 
-def test_kill_9_after_a_checkpoint_resumes(tmp_path):
+@pytest.mark.parametrize("options", [
+    ["--duration", "12d", "--checkpoint-every", "500"],
+    # --checkpoint-interval alone: a checkpoint at the first chunk boundary (4096 steps) after the wall-clock
+    # interval; where it falls does not change the steps
+    ["--duration", "40d", "--checkpoint-every", "0", "--checkpoint-interval", "0.001"],
+], ids=["every-500-steps", "wall-clock-interval"])
+def test_kill_9_after_a_checkpoint_resumes(tmp_path, options):
     """kill -9 (no handler can run): the last checkpoint and its partial file
     are what is left, nothing at the output path; `--resume` finishes to the
     data of an uninterrupted run."""
-    args = KEPLER + ["--duration", "12d", "--checkpoint-every", "500"]
+    args = KEPLER + options
     ref, out = tmp_path / "ref.h5", tmp_path / "out.h5"
     p = _child(args + ["-o", str(out)])
     _wait_for(tmp_path / "out.h5.checkpoint", p)
@@ -234,21 +240,6 @@ def test_kill_9_after_a_checkpoint_resumes(tmp_path):
     assert code == -signal.SIGKILL
     left = _listing(tmp_path)
     assert "out.h5" not in left and "out.h5.checkpoint" in left
-    _resume_matches_uninterrupted(tmp_path, args, out, ref)
-
-
-def test_wall_clock_checkpoint_resumes(tmp_path):
-    """`--checkpoint-interval`: a checkpoint at the first chunk boundary (4096 steps) after the wall-clock
-    interval, with step-count checkpoints off; kill -9 after it and `--resume` finishes to the data of an
-    uninterrupted run (where a checkpoint falls does not change the steps)."""
-    args = KEPLER + ["--duration", "40d", "--checkpoint-every", "0", "--checkpoint-interval", "0.001"]
-    ref, out = tmp_path / "ref.h5", tmp_path / "out.h5"
-    p = _child(args + ["-o", str(out)])
-    _wait_for(tmp_path / "out.h5.checkpoint", p)
-    p.send_signal(signal.SIGKILL)
-    code, _, _ = _finish(p)
-    assert code == -signal.SIGKILL
-    assert "out.h5.checkpoint" in _listing(tmp_path)
     _resume_matches_uninterrupted(tmp_path, args, out, ref)
 
 
