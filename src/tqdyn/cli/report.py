@@ -5,10 +5,13 @@ composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
 
 * ``tqdyn report RUN.h5 [...] [--out DIR]``: figures (PNG and PDF) of what
   the runs contain and ``DIR/summary.md``;
-* ``tqdyn report --studies [--runs-dir DIR] [--out DIR] [--quick |
-  --duration-scale X] [--study NAME ...] [--set KEY=VALUE ...] [--workers N]``:
-  runs (or reuses) the study runs of the paper's section V and regenerates
-  its figures and the summary table (paper value vs tqdyn value).
+* ``tqdyn report --studies [--mission tianqin|lisa] [--runs-dir DIR] [--out DIR]
+  [--quick | --duration-scale X] [--study NAME ...] [--set KEY=VALUE ...]
+  [--workers N]``: runs (or reuses) the study runs of the paper's section V
+  and regenerates its figures and the summary table (paper value vs tqdyn
+  value); with ``--mission lisa`` the same studies on LISA and Taiji
+  (:mod:`tqdyn.workflows.studies_lisa`, :mod:`tqdyn.workflows.report.lisa`:
+  one-year runs, reference = first-order estimates and ESA's files).
 
 Bad input (a missing file, a file that is not a tqdyn trajectory, an unknown
 study, bad overrides, conflicting options) exits with status 2 and one line
@@ -37,10 +40,14 @@ __all__ = ["report"]
                    "tqdyn-studies).")
 @click.option("--studies", is_flag=True,
               help="Run (or reuse) the study runs of the paper's section V and regenerate its figures and table.")
+@click.option("--mission", type=click.Choice(["tianqin", "lisa"]), default=None,
+              help="With --studies: the study set, tianqin (the paper's section V, default) or lisa (the same "
+                   "studies on LISA and Taiji, one-year runs).")
 @click.option("--runs-dir", metavar="DIR", help="With --studies: directory of the study runs (default: OUT/runs).")
-@click.option("--quick", is_flag=True, help="With --studies: durations scaled by 1/90 (90 d -> 1 d, 30 d -> 8 h).")
+@click.option("--quick", is_flag=True, help="With --studies: durations scaled by 1/90 (90 d -> 1 d, 30 d -> 8 h; "
+                                            "lisa: 365 d -> 4 d).")
 @click.option("--duration-scale", type=float, metavar="X",
-              help="With --studies: factor on the paper's spans (default 1: 90 d and 30 d).")
+              help="With --studies: factor on the paper's spans (default 1: 90 d and 30 d; lisa: 365 d).")
 @click.option("--study", "only", multiple=True, metavar="NAME",
               help="With --studies: only this study (repeatable); default all.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
@@ -48,11 +55,13 @@ __all__ = ["report"]
 @click.option("--workers", type=int, metavar="N",
               help="With --studies: worker processes for the runs (default: the CPU cores; 1 = in this process).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress on stderr.")
-def report(runs, out, studies, runs_dir, quick, duration_scale, only, sets, workers, quiet):
+def report(runs, out, studies, mission, runs_dir, quick, duration_scale, only, sets, workers, quiet):
     """Figures and a summary table of trajectory files RUN.h5, or (--studies)
     of the paper's section V: pointing laws (Fig. 5), range ASDs (Figs. 6,
     10, 11), electrostatic control (Figs. 7, 8), drag-free and self-gravity
-    orbit deviations and breathing angles (Fig. 9)."""
+    orbit deviations and breathing angles (Fig. 9); with --mission lisa the
+    same studies on LISA and Taiji (one year) against first-order estimates
+    and ESA's orbit files."""
     def say(msg):
         if not quiet:
             click.echo(msg, err=True)
@@ -60,9 +69,10 @@ def report(runs, out, studies, runs_dir, quick, duration_scale, only, sets, work
     if studies:
         if runs:
             _fail(f"RUN.h5: {runs[0]!r} given with --studies; allowed: either trajectory files or --studies")
-        _run_studies(out or "tqdyn-studies", runs_dir, quick, duration_scale, only, sets, workers, quiet, say)
+        _run_studies(out or "tqdyn-studies", runs_dir, quick, duration_scale, only, sets, workers, quiet, say,
+                     mission or "tianqin")
         return
-    for name, given in (("--runs-dir", runs_dir is not None), ("--quick", quick),
+    for name, given in (("--mission", mission is not None), ("--runs-dir", runs_dir is not None), ("--quick", quick),
                         ("--duration-scale", duration_scale is not None), ("--study", bool(only)),
                         ("--set", bool(sets)), ("--workers", workers is not None)):
         if given:
@@ -88,7 +98,7 @@ def _print_report(rep) -> None:
     click.echo(f"summary: {rep.summary_path}")
 
 
-def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quiet, say):
+def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quiet, say, mission="tianqin"):
     from pathlib import Path
 
     from tqdm import tqdm
@@ -101,13 +111,22 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         _fail("--quick: conflicts with --duration-scale; allowed: one of them")
     if workers is not None and workers < 1:
         _fail(f"--workers: {workers} is not a number of workers; allowed: an integer >= 1")
-    scale = st.QUICK_SCALE if quick else (1.0 if duration_scale is None else duration_scale)
+    if mission == "lisa":
+        from ..workflows import studies_lisa as sl
+        from ..workflows.report.lisa import report_lisa_studies
+
+        catalogue = {"catalogue": sl.STUDIES, "runs": sl.RUNS}
+        quick_scale = sl.QUICK_SCALE
+    else:
+        catalogue = {}
+        quick_scale = st.QUICK_SCALE
+    scale = quick_scale if quick else (1.0 if duration_scale is None else duration_scale)
     runs_dir = runs_dir or str(Path(out) / "runs")
     names = tuple(only) or None
     try:
         if duration_scale is not None:
             st.scaled_duration_s(1.0, duration_scale, 50.0)  # validates the scale
-        plan = st.plan_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets)
+        plan = st.plan_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets, **catalogue)
         rp.check_out_dir(out)
     except (ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
@@ -130,7 +149,7 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
 
     try:
         result = st.run_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets,
-                                workers=workers, progress=progress, plan=plan)
+                                workers=workers, progress=progress, plan=plan, **catalogue)
     except KeyboardInterrupt:
         bar.close()
         _fail("interrupted; finished runs are kept and reused next time", _EXIT_INTERRUPTED)
@@ -139,9 +158,14 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         _fail(str(exc))
     bar.close()
     paths = {name: result.path(name) for name in result.outcomes}
-    title = "tqdyn: the paper's section V reproduced" + ("" if scale == 1.0 else f" (durations x {scale:.4g})")
+    scaled = "" if scale == 1.0 else f" (durations x {scale:.4g})"
     try:
-        rep = rp.report_studies(paths, out, studies=names, progress=say, title=title)
+        if mission == "lisa":
+            rep = report_lisa_studies(paths, out, studies=names, progress=say,
+                                      title="tqdyn: the paper's studies on LISA and Taiji" + scaled)
+        else:
+            rep = rp.report_studies(paths, out, studies=names, progress=say,
+                                    title="tqdyn: the paper's section V reproduced" + scaled)
     except ImportError as exc:  # matplotlib missing: the runs are kept
         _fail(str(exc))
     except KeyboardInterrupt:

@@ -230,10 +230,31 @@ def oem_common_span(paths, eme2000: str = "frame-bias") -> tuple[str, str]:
 def _heliocentric_oem(path: str, eme2000: str = "frame-bias"):
     """An OEM file's single segment as Sun-centred ICRF/TDB states
     (:func:`tqdyn.readers.oem.to_heliocentric`; ``eme2000``: see
-    :class:`InitialConfig`); ValueError naming the file."""
+    :class:`InitialConfig`); ValueError naming the file.  Cached per file
+    (absolute path, size, modification time) and reading: resolving one
+    scenario reads its OEM files several times (epoch, span, states), a
+    study plan dozens of times.  The result is shared: do not modify it."""
+    import os
+
+    try:
+        st = os.stat(path)
+    except OSError:
+        key = None
+    else:
+        key = (os.path.abspath(path), st.st_size, st.st_mtime_ns, eme2000)
+    if key is not None and key in _OEM_CACHE:
+        return _OEM_CACHE[key]
     from ..readers.oem import read_oem, to_heliocentric
 
-    return to_heliocentric(read_oem(path), eme2000_frame_bias=eme2000 == "frame-bias")
+    traj = to_heliocentric(read_oem(path), eme2000_frame_bias=eme2000 == "frame-bias")
+    if key is not None:
+        if len(_OEM_CACHE) >= 16:
+            _OEM_CACHE.pop(next(iter(_OEM_CACHE)))
+        _OEM_CACHE[key] = traj
+    return traj
+
+
+_OEM_CACHE: dict = {}
 
 
 def _tdb_text(jd) -> str:

@@ -47,7 +47,7 @@ import hashlib
 import math
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -271,38 +271,45 @@ def run_complete(path, canonical_toml: str) -> bool:
     return abs(t_end - float(scen.run.duration_s)) <= 1e-6 * float(scen.integrator.step_s)
 
 
-def _check_names(studies) -> tuple[str, ...]:
+def _check_names(studies, catalogue=None) -> tuple[str, ...]:
+    catalogue = STUDIES if catalogue is None else catalogue
     if studies is None:
-        return tuple(STUDIES)
+        return tuple(catalogue)
     if isinstance(studies, str):
         studies = (studies,)
     for s in studies:
-        if s not in STUDIES:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(STUDIES)}")
+        if s not in catalogue:
+            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(catalogue)}")
     return tuple(studies)
 
 
 def plan_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scale: float = 1.0,
-                 extra_overrides: Sequence[str] = (), check_data: bool = True) -> tuple[PlannedRun, ...]:
+                 extra_overrides: Sequence[str] = (), check_data: bool = True,
+                 catalogue: Mapping[str, Study] | None = None,
+                 runs: Mapping[str, RunSpec] | None = None) -> tuple[PlannedRun, ...]:
     """Resolve the runs of ``studies`` (default: all of :data:`STUDIES`) for ``runs_dir``.
 
     Every scenario is validated (and, with ``check_data``, its force model's
     data limits checked) before anything runs: bad input raises ValueError /
     FileNotFoundError.  Runs shared by several studies appear once; longest
-    first.  Nothing is written.
+    first.  Nothing is written.  ``catalogue`` / ``runs``: another study set
+    and its runs (default :data:`STUDIES` / :data:`RUNS`; e.g. the LISA set
+    of :mod:`tqdyn.workflows.studies_lisa`).
     """
     from .. import dynamics
 
-    names = _check_names(studies)
+    catalogue = STUDIES if catalogue is None else catalogue
+    runs = RUNS if runs is None else runs
+    names = _check_names(studies, catalogue)
     runs_dir = Path(os.path.abspath(os.path.expanduser(os.fspath(runs_dir))))
     wanted: list[str] = []
     for s in names:
-        for r in STUDIES[s].runs:
+        for r in catalogue[s].runs:
             if r not in wanted:
                 wanted.append(r)
     planned = []
     for r in wanted:
-        spec = RUNS[r]
+        spec = runs[r]
         scen = spec.scenario_for(duration_scale=duration_scale, extra=extra_overrides)
         canonical = scen.to_toml()
         digest = hashlib.sha256(canonical.encode("utf-8")).hexdigest()[:_DIGEST_CHARS]
@@ -368,7 +375,9 @@ def _run_one(scenario_toml: str) -> dict:
 def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scale: float = 1.0,
                 extra_overrides: Sequence[str] = (), workers: int | None = None,
                 progress: Callable[[RunOutcome], None] | None = None,
-                plan: Sequence[PlannedRun] | None = None) -> StudyRuns:
+                plan: Sequence[PlannedRun] | None = None,
+                catalogue: Mapping[str, Study] | None = None,
+                runs: Mapping[str, RunSpec] | None = None) -> StudyRuns:
     """Run (or reuse) every run the ``studies`` need, in ``runs_dir``.
 
     studies : names in :data:`STUDIES` (default all); duration_scale : factor
@@ -378,7 +387,8 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
     cluster (default: the usable CPU cores; 1 = run in this process);
     progress : called with each :class:`RunOutcome` (reused ones first).
     plan : the result of :func:`plan_studies` for the same arguments, if
-    already computed (skips planning again).
+    already computed (skips planning again).  catalogue / runs : another
+    study set (as for :func:`plan_studies`).
 
     Bad input raises ValueError / FileNotFoundError before anything runs; a
     run that fails does not stop the others (see :attr:`StudyRuns.failures`).
@@ -389,9 +399,10 @@ def run_studies(runs_dir, *, studies: Sequence[str] | None = None, duration_scal
     t0 = time.perf_counter()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers: {workers!r} is not allowed; allowed: an integer >= 1")
-    names = _check_names(studies)
+    names = _check_names(studies, catalogue)
     if plan is None:
-        plan = plan_studies(runs_dir, studies=names, duration_scale=duration_scale, extra_overrides=extra_overrides)
+        plan = plan_studies(runs_dir, studies=names, duration_scale=duration_scale, extra_overrides=extra_overrides,
+                            catalogue=catalogue, runs=runs)
     runs_dir = Path(os.path.abspath(os.path.expanduser(os.fspath(runs_dir))))
     try:
         runs_dir.mkdir(parents=True, exist_ok=True)
