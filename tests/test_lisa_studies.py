@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pytest
 
-from tqdyn import cli
+from cli_support import run_cli
 from tqdyn.analysis import lisa_estimates as le
 from tqdyn.analysis.metrics import orbit_deviation
 from tqdyn.formats.trajectory import read_trajectory
@@ -422,19 +422,10 @@ def test_lisa_catalogue():
                            check_data=False)[0].spec.scenario in ("tianqin-gravity", "tianqin-extreme")
 
 
-def _cli(args, capsys):
-    try:
-        status = cli.main(args)
-    except SystemExit as exc:
-        status = exc.code
-    out = capsys.readouterr()
-    return status, out.out, out.err
-
-
 def test_cli_lisa_quick(tmp_path, capsys):
     # all seven studies at durations x 1/90 (365 d -> 4 d, 3926.5 d -> 43.6 d): ~15 s with a warm JIT cache
     out = tmp_path / "s"
-    status, stdout, err = _cli(["report", "--studies", "--mission", "lisa", "--quick", "--workers", "1", "-q",
+    status, stdout, err = run_cli(["report", "--studies", "--mission", "lisa", "--quick", "--workers", "1", "-q",
                                 "--out", str(out)], capsys)
     assert status == 0, err
     summary = (out / "summary.md").read_text()
@@ -458,7 +449,7 @@ def test_cli_lisa_quick(tmp_path, capsys):
 ])
 def test_cli_lisa_bad_input(args, match, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    status, _, err = _cli(args, capsys)
+    status, _, err = run_cli(args, capsys)
     assert status == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("tqdyn: error: ") and match in lines[0], err

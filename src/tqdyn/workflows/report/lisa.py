@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
 
@@ -33,37 +32,14 @@ from ...analysis.metrics import _common_rows, _control_values, _t, orbit_deviati
 from ...analysis.pointing_study import pointing_study_of
 from ...constellation import geometry
 from ...constellation.indices import Sat
-from ...formats import trajectory as io
 from ..studies_lisa import SG_DIRECTIONS, STUDIES
-from .summary import Report, SummaryRow, _e, _per_sat, _span_days, check_out_dir, format_summary
+from .summary import Report, SummaryRow, evaluate_studies, _e, _per_sat, _span_days, format_summary
 
 __all__ = ["report_lisa_studies"]
 
 _C = 299792458.0
 _YEAR_S = 365.25 * 86400.0
 _PERM = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
-
-
-class _Runs:
-    """Trajectories of the study runs, read lazily and cached."""
-
-    def __init__(self, paths: Mapping[str, Path | None]):
-        self.paths = dict(paths)
-        self._cache: dict = {}
-
-    def get(self, name):
-        p = self.paths.get(name)
-        if p is None:
-            raise KeyError(name)
-        if name not in self._cache:
-            self._cache[name] = io.read_trajectory(p)
-        return self._cache[name]
-
-    def has(self, *names) -> bool:
-        return all(self.paths.get(n) is not None for n in names)
-
-    def drop(self, name):
-        self._cache.pop(name, None)
 
 
 def report_lisa_studies(run_paths: Mapping[str, str | os.PathLike | None], out_dir: str | os.PathLike, *,
@@ -81,23 +57,7 @@ def report_lisa_studies(run_paths: Mapping[str, str | os.PathLike | None], out_d
     ``out_dir``.  Returns :class:`~tqdyn.workflows.report.summary.Report`
     (``values``: the measured and reference numbers by key, SI units).
     """
-    say = progress or (lambda msg: None)
-    names = tuple(STUDIES) if studies is None else tuple(studies)
-    for s in names:
-        if s not in STUDIES:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(STUDIES)}")
-    out = check_out_dir(out_dir)
-    rep = Report(out_dir=out)
-    runs = _Runs({k: (Path(v) if v is not None else None) for k, v in run_paths.items()})
-    for s in names:
-        st = STUDIES[s]
-        missing = [r for r in st.runs if not runs.has(r)]
-        if missing:
-            rep.notes.append(f"study {s} skipped: run(s) {', '.join(missing)} not available")
-            continue
-        say(f"study {s}: {st.title}")
-        _STUDY_FUNCS[s](rep, runs)
-    used = sorted({r for s in names for r in STUDIES[s].runs if runs.has(r)})
+    rep, runs, used = evaluate_studies(STUDIES, _STUDY_FUNCS, run_paths, out_dir, studies, progress)
     notes = ["reference: a first-order analytic estimate (docs/lisa-coupled.md, tqdyn.analysis.lisa_estimates), "
              "ESA's orbit files or a first-order bound, as each row says; spans are the runs' own"]
     notes += list(rep.notes) + [f"run {r}: {runs.paths[r]}" for r in used]

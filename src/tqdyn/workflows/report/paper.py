@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
 
@@ -42,37 +41,14 @@ from ...analysis.metrics import (
 from ...analysis.pointing_study import pointing_study_of
 from ...astro.constants import GM_EARTH_EGM2008
 from ...constellation.indices import Link, Sat
-from ...formats import trajectory as io
 from ...lightpath import instantaneous_ranges, light_travel_times_of
 from ..studies import FLIGHT_DIRECTION_S, SG_DIRECTIONS, STUDIES
-from .summary import Report, SummaryRow, _asd_verdict, _e, _finish, _order_ok, _per_sat, _span_days, check_out_dir
+from .summary import Report, SummaryRow, evaluate_studies, _asd_verdict, _e, _finish, _order_ok, _per_sat, _span_days
 
 __all__ = ["PAPER_LINK", "report_studies"]
 
 #: The link of Figs. 10 and 11: received on Sat1 from Sat3.
 PAPER_LINK = Link.L13
-
-
-class _Runs:
-    """Trajectories of the study runs, read lazily and cached."""
-
-    def __init__(self, paths: Mapping[str, Path | None]):
-        self.paths = dict(paths)
-        self._cache: dict = {}
-
-    def get(self, name):
-        p = self.paths.get(name)
-        if p is None:
-            raise KeyError(name)
-        if name not in self._cache:
-            self._cache[name] = io.read_trajectory(p)
-        return self._cache[name]
-
-    def has(self, *names) -> bool:
-        return all(self.paths.get(n) is not None for n in names)
-
-    def drop(self, name):
-        self._cache.pop(name, None)
 
 
 def report_studies(run_paths: Mapping[str, str | os.PathLike | None], out_dir: str | os.PathLike, *,
@@ -89,23 +65,8 @@ def report_studies(run_paths: Mapping[str, str | os.PathLike | None], out_dir: s
     ``fig10-lightpath-vs-instantaneous``, ``fig11-sat-vs-tm``; .png and
     .pdf) and ``summary.md`` into ``out_dir``.  Returns :class:`Report`.
     """
-    say = progress or (lambda msg: None)
-    names = tuple(STUDIES) if studies is None else tuple(studies)
-    for s in names:
-        if s not in STUDIES:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(STUDIES)}")
-    out = check_out_dir(out_dir)
-    rep = Report(out_dir=out)
-    runs = _Runs({k: (Path(v) if v is not None else None) for k, v in run_paths.items()})
-    for s in names:
-        st = STUDIES[s]
-        missing = [r for r in st.runs if not runs.has(r)]
-        if missing:
-            rep.notes.append(f"study {s} ({st.paper}) skipped: run(s) {', '.join(missing)} not available")
-            continue
-        say(f"study {s} ({st.paper}): {st.title}")
-        _STUDY_FUNCS[s](rep, runs)
-    used = sorted({r for s in names for r in STUDIES[s].runs if runs.has(r)})
+    rep, runs, used = evaluate_studies(STUDIES, _STUDY_FUNCS, run_paths, out_dir, studies, progress,
+                                       label=lambda name, st: f"{name} ({st.paper})")
     _finish(rep, title, [f"{r}: {runs.paths[r]}" for r in used])
     return rep
 

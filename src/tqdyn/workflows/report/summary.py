@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from ...analysis.metrics import _t
+from ...formats import trajectory as io
 
-__all__ = ["Report", "SummaryRow", "check_out_dir", "format_summary"]
+__all__ = ["Report", "RunFiles", "evaluate_studies", "SummaryRow", "check_out_dir", "format_summary"]
 
 
 @dataclass(frozen=True)
@@ -114,3 +115,55 @@ def _label_of(path: Path, used: set) -> str:
         label, k = f"{base}-{k}", k + 1
     used.add(label)
     return label
+
+
+class RunFiles:
+    """Trajectories of the study runs (run name -> file, None if missing),
+    read lazily and cached: :meth:`get` (KeyError if missing), :meth:`has`,
+    :meth:`drop` (free a cached trajectory)."""
+
+    def __init__(self, paths):
+        self.paths = dict(paths)
+        self._cache: dict = {}
+
+    def get(self, name):
+        p = self.paths.get(name)
+        if p is None:
+            raise KeyError(name)
+        if name not in self._cache:
+            self._cache[name] = io.read_trajectory(p)
+        return self._cache[name]
+
+    def has(self, *names) -> bool:
+        return all(self.paths.get(n) is not None for n in names)
+
+    def drop(self, name):
+        self._cache.pop(name, None)
+
+
+def evaluate_studies(catalogue, funcs, run_paths, out_dir, studies=None, progress=None, label=None):
+    """Evaluate the studies ``studies`` (names in ``catalogue``, default all)
+    from their runs: checks the names (ValueError naming the study and the
+    allowed ones), the output directory, reads the run files lazily
+    (:class:`RunFiles`), skips a study whose runs are missing with a note,
+    and calls ``funcs[name](report, runs)`` for the others.  ``label(name,
+    study)``: its name in progress messages and notes.  Returns (report,
+    runs, the names of the runs used)."""
+    say = progress or (lambda msg: None)
+    label = label or (lambda name, st: name)
+    names = tuple(catalogue) if studies is None else tuple(studies)
+    for s in names:
+        if s not in catalogue:
+            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(catalogue)}")
+    rep = Report(out_dir=check_out_dir(out_dir))
+    runs = RunFiles({k: (Path(v) if v is not None else None) for k, v in run_paths.items()})
+    for s in names:
+        st = catalogue[s]
+        missing = [r for r in st.runs if not runs.has(r)]
+        if missing:
+            rep.notes.append(f"study {label(s, st)} skipped: run(s) {', '.join(missing)} not available")
+            continue
+        say(f"study {label(s, st)}: {st.title}")
+        funcs[s](rep, runs)
+    used = sorted({r for s in names for r in catalogue[s].runs if runs.has(r)})
+    return rep, runs, used
