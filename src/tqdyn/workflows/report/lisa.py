@@ -465,7 +465,8 @@ def _study_pointing(rep, runs):
     st = pointing_study_of(tr)
     span = float(st.t[-1] - st.t[0]) / 86400 if st.t.size > 1 else 0.0
     rep.figures += plot_pointing(st, rep.out_dir, "lisa-pointing",
-                                 f"LISA: pointing laws vs iterative (light time ~8.3 s), drag-free orbit, {span:.4g} d")
+                                 f"LISA: pointing laws vs iterative (light time ~8.3 s), drag-free orbit, {span:.4g} d",
+                                 time_scale=str(tr.attrs.get("time_scale", "TDB")))
     r = _r(tr)
     v = float(np.linalg.norm(tr["sat/v"], axis=-1).max())
     L = float(max(np.linalg.norm(r[:, j] - r[:, i], axis=-1).max() for i, j, _ in _PERM))
