@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
-           "SCHEME_CODES", "SYSTEM_TDAT_BODIES", "N_SYSTEM_TDAT", "JERK_BODIES_MAX", "make_cpar", "workspace",
+           "SCHEME_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "make_cpar", "workspace",
            "aux_views"]
 
 #: Arithmetic of a propagation: double-double states (trailing axis 2) or plain float64.
@@ -54,7 +54,6 @@ SCHEME_CODES = {"tianqin": 0, "lisa": 1}
 #: jerk bodies of the geocentric coupled system (time-only inputs appended
 #: to the force model's: GCRS position [m] and velocity [m/s] of each)
 SYSTEM_TDAT_BODIES = ("moon", "sun")
-N_SYSTEM_TDAT = 12
 
 # aux layout per satellite (float64), AX_SAT values each
 AX_T, AX_W, AX_WD, AX_ALPHA, AX_THETA, AX_G, AX_AGRAV = 0, 9, 12, 15, 16, 17, 20
