@@ -19,6 +19,7 @@ from tqdyn import dynamics
 from tqdyn.numerics.dd import mp_from_dd
 from tqdyn.scenario import load_scenario, loads_scenario
 from cli_support import run_cli as _run
+from cli_support import run_cli_interrupted
 
 
 
@@ -273,22 +274,10 @@ def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch, extra):
     assert not (tmp_path / "ref.h5.checkpoint").exists()
 
     out = tmp_path / "run.h5"
-    real = dynamics.propagate
-    calls = {"n": 0}
-
-    def interrupted(scen, sink=None, **kw):
-        def sink_then_stop(rows):
-            sink(rows)
-            calls["n"] += 1
-            if calls["n"] == 3:  # after the checkpoints at steps 500 and 1000
-                raise KeyboardInterrupt
-        return real(scen, sink=sink_then_stop, **kw)
-
-    monkeypatch.setattr(dynamics, "propagate", interrupted)
-    status, _, err = _run(args + ["-o", str(out)], capsys)
+    # Ctrl-C after the third chunk of rows, i.e. after the checkpoints at steps 500 and 1000
+    status, _, err = run_cli_interrupted(args + ["-o", str(out)], capsys, monkeypatch)
     assert status == 130 and "--resume" in err
     assert not out.exists() and (tmp_path / "run.h5.checkpoint").exists()
-    monkeypatch.setattr(dynamics, "propagate", real)
     status, _, err = _run(args + ["-o", str(out)], capsys)  # without --resume: refused, nothing lost
     assert status == 2 and "--resume" in err
     status, _, err = _run(args + ["-o", str(out), "--resume"], capsys)

@@ -25,10 +25,10 @@ import h5py
 import numpy as np
 import pytest
 
-from tqdyn import dynamics
 from tqdyn.astro.ephemeris import default_ephemeris_path
 from tqdyn.formats import trajectory as io
 from cli_support import run_cli as _run
+from cli_support import run_cli_interrupted
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 KEPLER = ["run", "tianqin-kepler", "-q"]
@@ -268,20 +268,7 @@ def interrupted_run(tmp_path, capsys, monkeypatch):
     """An interrupted run (Ctrl-C after its checkpoints): (args, output path, checkpoint path)."""
     args = KEPLER + ["--duration", "1d", "--checkpoint-every", "200"]
     out = tmp_path / "run.h5"
-    real = dynamics.propagate
-    calls = {"n": 0}
-
-    def interrupted(scen, sink=None, **kw):
-        def sink_then_stop(rows):
-            sink(rows)
-            calls["n"] += 1
-            if calls["n"] == 3:
-                raise KeyboardInterrupt
-        return real(scen, sink=sink_then_stop, **kw)
-
-    monkeypatch.setattr(dynamics, "propagate", interrupted)
-    status, _, err = _run(args + ["-o", str(out)], capsys)
-    monkeypatch.setattr(dynamics, "propagate", real)
+    status, _, err = run_cli_interrupted(args + ["-o", str(out)], capsys, monkeypatch)
     assert status == 130, err
     ckpt = tmp_path / "run.h5.checkpoint"
     assert ckpt.exists()
