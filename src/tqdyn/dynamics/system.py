@@ -130,15 +130,13 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     else:
         bodies = tuple(b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies) if law else ()
     eph = _ephemeris(f.ephemeris) if bodies else None
-    gms = planetary_gm() if bodies else {}
-    if law and model is None:
+    gms = planetary_gm()
+    ramp = scenario.self_gravity_centre_ramp()
+    if model is None and (law or ramp is not None):
         model = build_force_model(f, ref)
     earth = next((t for t in model.terms if isinstance(t, EarthField)), None) if law else None
     j2k = earth.j2_jerk_coefficient() if earth is not None else 0.0
-    gm = float(gms.get("sun", planetary_gm()["sun"])) if ref.origin == "sun" else float(f.gm_earth)
-    ramp = scenario.self_gravity_centre_ramp()
-    if ramp is not None and model is None:
-        model = build_force_model(f, ref)
+    gm = float(gms["sun"]) if ref.origin == "sun" else float(f.gm_earth)
     centre = model.n_tdat + (6 * len(bodies) if eph is not None else 0) if ramp is not None else -1
     cpar = _lay.make_cpar(mode, law=law, control=c.control == "on", gm=gm, c=C_LIGHT,
                           scheme=_lay.SCHEME_CODES[craft.scheme], theta_nom=craft.theta_nominal,
