@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .attitude import T_OA_S_of
 from .indices import MOSA_SIGN
 
 __all__ = [
@@ -106,14 +107,6 @@ class ArchitectureError(ValueError):
 
 def _bad(field_name: str, value, allowed: str) -> ValueError:
     return ArchitectureError(field_name, value, allowed)
-
-
-def _rot_z(ang) -> np.ndarray:
-    """R_z(ang) for ang of shape (...): (..., 3, 3) (active rotation about Z_S)."""
-    c, s = np.cos(ang), np.sin(ang)
-    out = np.zeros(np.shape(ang) + (3, 3))
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1], out[..., 2, 2] = c, -s, s, c, 1.0
-    return out
 
 
 def _vectors(value, name: str, unit: bool = False) -> np.ndarray:
@@ -304,8 +297,8 @@ class Spacecraft:
         """e_1 . (e_2 x Z_S) of the sensitive axes e_l (in S) at MOSA angle
         ``theta`` [rad]; ``sensitive_axes_oa`` (2, 3) in OA_l.  Zero when the
         drag-free conditions do not determine G."""
-        e = np.array([_rot_z(sg * 0.5 * theta) @ np.asarray(sensitive_axes_oa[l], dtype=np.float64)
-                      for l, sg in enumerate(MOSA_SIGN)])
+        e = np.einsum("lji,lj->li", T_OA_S_of(0.5 * theta * MOSA_SIGN),
+                      np.asarray(sensitive_axes_oa, dtype=np.float64))
         return float(np.dot(e[0], np.cross(e[1], [0.0, 0.0, 1.0])))
 
     @property
@@ -351,5 +344,5 @@ class Spacecraft:
         rho_nom = self._r0 - self._piv
         out = np.zeros(theta.shape + (2, 3))
         for l, s in enumerate(MOSA_SIGN):
-            out[..., l, :] = np.einsum("...ij,j->...i", _rot_z(s * d), rho_nom[l])
+            out[..., l, :] = np.einsum("...ji,j->...i", T_OA_S_of(s * d), rho_nom[l])  # R_z(s d) rho
         return out
