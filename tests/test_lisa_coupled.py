@@ -123,6 +123,8 @@ def test_lisa_preset_geometry():
     # Taiji, one year, full Newtonian model + the Sun's Schwarzschild term: measured 4.6e-14 m (3.0e-11 m
     # without the Schwarzschild jerk in the attitude model)
     ("taiji", [], "365d", 2e-13),
+    # the same with the full model evaluated at each EH centre and TM ("direct"): measured 4.5e-14 m
+    ("taiji", ['constellation.tm_gravity="direct"'], "365d", 2e-13),
 ])
 def test_free_tms_stay_at_their_housing_centres(scenario, overrides, duration, bound):
     """Free-TM mode: the six TMs as free bodies under gravity + self-gravity + the scheme's suspension stay

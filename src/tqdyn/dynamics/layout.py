@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
-           "SCHEME_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "make_cpar", "workspace",
+           "SCHEME_CODES", "TM_GRAVITY_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "make_cpar", "workspace",
            "aux_views"]
 
 #: Arithmetic of a propagation: double-double states (trailing axis 2) or plain float64.
@@ -48,7 +48,13 @@ CP_NJB = 55        # number of jerk bodies (their states in tdat from CP_TD, 6 v
 CP_JGM = 56        # (JERK_BODIES_MAX,) their GMs [m^3/s^2]
 JERK_BODIES_MAX = 10
 CP_GMREL = CP_JGM + JERK_BODIES_MAX   # GM [m^3/s^2] of the central body's Schwarzschild jerk, 0 = off
-CP_LEN = CP_GMREL + 1
+CP_TMG = CP_GMREL + 1  # TM differential gravity: TMG_DIFFERENTIAL or TMG_DIRECT (:data:`TM_GRAVITY_CODES`)
+CP_LEN = CP_TMG + 1
+#: codes of cpar[CP_TMG] (names: ``constellation.tm_gravity``): the test masses'
+#: differential gravity from :mod:`tqdyn.forces.differential` or from a second
+#: full evaluation of the force model at each EH centre
+TMG_DIFFERENTIAL, TMG_DIRECT = 0, 1
+TM_GRAVITY_CODES = {"differential": TMG_DIFFERENTIAL, "direct": TMG_DIRECT}
 #: drag-free scheme codes of cpar[CP_SCHEME] (names: spacecraft.DRAGFREE_SCHEMES)
 SCHEME_CODES = {"tianqin": 0, "lisa": 1}
 #: jerk bodies of the geocentric coupled system (time-only inputs appended
@@ -67,12 +73,13 @@ AUX_LEN = 3 * AX_SAT
 _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), ("T", (3, 3, 3)),
               ("om", (3, 3)), ("omd", (3, 3)), ("th", (3, 3)), ("r0", (3, 2, 3)), ("rho", (3, 2, 3)),
               ("vel", (3, 2, 3)), ("dgI", (3, 2, 3)), ("dgS", (3, 2, 3)), ("sgS", (3, 2, 3)), ("g", (3, 2, 3)),
-              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)))
+              ("A", (3, 2, 3)), ("GS", (3, 3)), ("alp", (3, 2, 3)), ("GI", (3, 3)), ("jp", (3, 3)),
+              ("e_sat", (3, 3)), ("s_sat", (3, 3)))
 
 
 def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta_nom=np.pi / 3,
               r0_nom=None, pivots=None, sensitive_axes=None, sg_oa=None, sg_s=None, jerk_gms=(), j2k=0.0,
-              tdat_offset=-1, centre_column=-1, gm_relativity=0.0) -> np.ndarray:
+              tdat_offset=-1, centre_column=-1, gm_relativity=0.0, tm_gravity="differential") -> np.ndarray:
     """Pack the constellation parameters for :func:`system_rhs`.
 
     mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
@@ -92,7 +99,9 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta
     in the jerk model (0 = off; heliocentric runs with relativity);
     tdat_offset : column of the system's time-only inputs in tdat, -1 if none;
     centre_column : column in tdat of the magnitude [m/s^2] of the
-    self-gravity toward the constellation centre (positive toward it), -1 if off.
+    self-gravity toward the constellation centre (positive toward it), -1 if off;
+    tm_gravity : "differential" | "direct", how the TMs' differential gravity is formed
+    (:data:`TM_GRAVITY_CODES`).
     """
     p = np.zeros(CP_LEN)
     p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
@@ -113,6 +122,7 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta
     p[CP_JGM:CP_JGM + len(gms)] = gms
     p[CP_J2K], p[CP_TD], p[CP_GMREL] = j2k, tdat_offset, gm_relativity
     p[CP_SGC] = centre_column
+    p[CP_TMG] = TM_GRAVITY_CODES[tm_gravity]
     return p
 
 

@@ -23,11 +23,17 @@ Two systems share one compiled entry point, :func:`system_rhs`, selected by
      positions, velocities and accelerations (and, for the local laws, their
      jerks: monopole + Moon and Sun tidal terms + J2, :func:`_jerk_perturbation`,
      so that omega_dot is the derivative of omega to ~1e-22 rad/s^2);
-  3. the EH centers r_i + T_I_S r_0,l (dd) and gravity there (dd); the
-     differential gravity a(TM) - a(sat) is the difference of two dd
-     accelerations, rounded to float64 only afterwards, so it has no
-     cancellation (its error is ~1e-32 * 0.04 m/s^2 for the dd terms and
-     ~1e-16 of the differential float64 perturbations, ~1e-23 m/s^2);
+  3. the EH centers r_i + T_I_S r_0,l (dd) and the differential gravity
+     a(EH) - a(sat) there (float64), by ``constellation.tm_gravity``:
+     "differential" (default) forms it term by term without cancellation
+     (:mod:`tqdyn.forces.differential`: exact point-mass differences, the
+     midpoint Jacobian of the Earth's degree 2, float64 differences of the
+     small terms; error ~4e-25 m/s^2, the float64 round-off of the Earth's
+     degrees >= 3 and the planets); "direct" evaluates the whole model again
+     at each EH centre (dd) and subtracts, which costs six more full
+     evaluations and has the same error geocentric (its float64 terms at a
+     float64-rounded position) but ~1e-22 m/s^2 heliocentric, where the
+     planets are float64 and a position rounds to 3e-5 m;
   4. g_l, A_c,l and G_i (:mod:`._control_jit`);
   5. G feedback: omega_dot and theta_ddot depend on the satellites'
      accelerations, which contain G.  Steps 2 and 4 are repeated once with
@@ -43,7 +49,11 @@ Two systems share one compiled entry point, :func:`system_rhs`, selected by
   are the six TMs (body 3 + 2 i + l), propagated as free bodies under
   gravity + self-gravity + the suspension acceleration A_c,l computed for
   the nominal TM positions (the EH centers); how far they drift from the EH
-  centers verifies the control derivation and the integration.
+  centers verifies the control derivation and the integration.  Their
+  gravity is formed like the EH centres': the satellite's plus the
+  differential gravity at the TM's offset ("differential"; the method
+  itself is checked against mpmath in tests/test_differential_gravity.py),
+  or the full model at the TM ("direct").
 
 Per-evaluation diagnostics (attitude, control, TM states) are written into
 ``aux`` (float64, layout constants ``AX_*`` below) -- the driver keeps the
@@ -59,14 +69,15 @@ from ..constellation._control_jit import housing_geometry, satellite_control
 from ..constellation._kinematics_jit import sat_kinematics
 from ..constellation.indices import MOSA_SIGN
 from ..forces.earth import j2_jerk_gcrs_z
-from ..forces.model import ForceModel, gravity
+from ..forces.differential import differential_gravity, direct_terms
+from ..forces.model import ForceModel, gravity, gravity_split
 from ..forces.relativity import schwarzschild_jerk
 from ..forces.third_body import third_body_jerk
 from ..numerics.dd import add, ld, lo_part, st, sub, to_f64
 from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX_TMLEN, AX_W, AX_WD, CP_CONTROL,
                      CP_C, CP_GM, CP_GMREL, CP_J2K, CP_JGM, CP_LAW, CP_MODE, CP_NJB, CP_PIV, CP_R0, CP_SCHEME, CP_SENS,
-                     CP_SG_OA, CP_SG_S, CP_SGC, CP_TD, CP_THNOM, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
-                     TM_SUSP, TM_VHI, TM_VLO, make_cpar, workspace)
+                     CP_SG_OA, CP_SG_S, CP_SGC, CP_TD, CP_THNOM, CP_TMG, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
+                     TM_SUSP, TM_VHI, TM_VLO, TMG_DIRECT, make_cpar, workspace)
 
 __all__ = ["system_rhs", "point_masses", "evaluate_rhs", "toward_centre"]
 
@@ -216,22 +227,31 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
     free = cpar[CP_MODE] == MODE_FREE_TM
     control_on = cpar[CP_CONTROL] != 0.0
     r_hi, r_lo, v, a, T, om, omd, th, r0, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], fw[8], fw[10]
-    dgI, sgS, A, alp, GI = fw[11], fw[13], fw[15], fw[17], fw[18]
-    # 1. gravity at the satellites
+    dgI, sgS, A, alp, GI, e_sat, s_sat = fw[11], fw[13], fw[15], fw[17], fw[18], fw[20], fw[21]
+    direct = cpar[CP_TMG] == TMG_DIRECT
+    # 1. gravity at the satellites (and, for the differential gravity, the
+    # float64 parts it shares with the EH centres)
     for i in range(3):
-        _gravity_into(gw, i, ld(y, i, 0), ld(y, i, 1), ld(y, i, 2), ld(y, i, 3), ld(y, i, 4), ld(y, i, 5),
-                      tdat, params, layout)
+        gx, gy, gz, e_sat[i, 0], e_sat[i, 1], e_sat[i, 2] = gravity_split(
+            ld(y, i, 0), ld(y, i, 1), ld(y, i, 2), ld(y, i, 3), ld(y, i, 4), ld(y, i, 5), tdat, params, layout)
+        st(gw, gx, i, 0)
+        st(gw, gy, i, 1)
+        st(gw, gz, i, 2)
         for q in range(3):
             x = ld(y, i, q)
             r_hi[i, q] = to_f64(x)
             r_lo[i, q] = lo_part(x)
             v[i, q] = to_f64(ld(y, i, q + 3))
             a[i, q] = to_f64(ld(gw, i, q))
+        if not direct:
+            s_sat[i, 0], s_sat[i, 1], s_sat[i, 2] = direct_terms(r_hi[i, 0], r_hi[i, 1], r_hi[i, 2], v[i, 0],
+                                                                 v[i, 1], v[i, 2], tdat, params, layout)
     # 2. attitude and EH geometry
     if cpar[CP_LAW] != 0:
         _jerk_perturbation(cpar, tdat, fw)
     _control_pass(cpar, fw)
-    # 3. gravity at the EH centers, differential gravity in dd
+    # 3. differential gravity at the EH centers: term by term
+    # (:mod:`tqdyn.forces.differential`) or, "direct", the full model there (dd)
     for i in range(3):
         for l in range(2):
             ox = T[i, 0, 0] * r0[i, l, 0] + T[i, 1, 0] * r0[i, l, 1] + T[i, 2, 0] * r0[i, l, 2]
@@ -242,10 +262,16 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
             uz = T[i, 0, 2] * vel[i, l, 0] + T[i, 1, 2] * vel[i, l, 1] + T[i, 2, 2] * vel[i, l, 2]
             hx, hy, hz = add(ld(y, i, 0), ox), add(ld(y, i, 1), oy), add(ld(y, i, 2), oz)
             hvx, hvy, hvz = add(ld(y, i, 3), ux), add(ld(y, i, 4), uy), add(ld(y, i, 5), uz)
-            row = 3 + 2 * i + l
-            _gravity_into(gw, row, hx, hy, hz, hvx, hvy, hvz, tdat, params, layout)
-            for q in range(3):
-                dgI[i, l, q] = to_f64(sub(ld(gw, row, q), ld(gw, i, q)))
+            if direct:
+                row = 3 + 2 * i + l
+                _gravity_into(gw, row, hx, hy, hz, hvx, hvy, hvz, tdat, params, layout)
+                for q in range(3):
+                    dgI[i, l, q] = to_f64(sub(ld(gw, row, q), ld(gw, i, q)))
+            else:
+                dgI[i, l, 0], dgI[i, l, 1], dgI[i, l, 2] = differential_gravity(
+                    r_hi[i, 0], r_hi[i, 1], r_hi[i, 2], v[i, 0], v[i, 1], v[i, 2], ox, oy, oz, ux, uy, uz,
+                    e_sat[i, 0], e_sat[i, 1], e_sat[i, 2], s_sat[i, 0], s_sat[i, 1], s_sat[i, 2],
+                    tdat, params, layout)
             b = AX_SAT * i + AX_TM + AX_TMLEN * l
             aux[b + TM_RHI], aux[b + TM_RHI + 1], aux[b + TM_RHI + 2] = to_f64(hx), to_f64(hy), to_f64(hz)
             aux[b + TM_RLO], aux[b + TM_RLO + 1], aux[b + TM_RLO + 2] = lo_part(hx), lo_part(hy), lo_part(hz)
@@ -302,16 +328,32 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
             if free:
                 tb = 3 + 2 * i + l
                 trow = 9 + 2 * i + l
-                _gravity_into(gw, trow, ld(y, tb, 0), ld(y, tb, 1), ld(y, tb, 2), ld(y, tb, 3), ld(y, tb, 4),
-                              ld(y, tb, 5), tdat, params, layout)
-                tx, ty, tz = add(ld(gw, trow, 0), gx), add(ld(gw, trow, 1), gy), add(ld(gw, trow, 2), gz)
+                if direct:  # the full model at the TM
+                    _gravity_into(gw, trow, ld(y, tb, 0), ld(y, tb, 1), ld(y, tb, 2), ld(y, tb, 3), ld(y, tb, 4),
+                                  ld(y, tb, 5), tdat, params, layout)
+                    tx, ty, tz = add(ld(gw, trow, 0), gx), add(ld(gw, trow, 1), gy), add(ld(gw, trow, 2), gz)
+                else:  # the satellite's gravity plus the differential gravity at the TM's offset
+                    fx, fy, fz = differential_gravity(
+                        r_hi[i, 0], r_hi[i, 1], r_hi[i, 2], v[i, 0], v[i, 1], v[i, 2],
+                        to_f64(sub(ld(y, tb, 0), ld(y, i, 0))), to_f64(sub(ld(y, tb, 1), ld(y, i, 1))),
+                        to_f64(sub(ld(y, tb, 2), ld(y, i, 2))), to_f64(sub(ld(y, tb, 3), ld(y, i, 3))),
+                        to_f64(sub(ld(y, tb, 4), ld(y, i, 4))), to_f64(sub(ld(y, tb, 5), ld(y, i, 5))),
+                        e_sat[i, 0], e_sat[i, 1], e_sat[i, 2], s_sat[i, 0], s_sat[i, 1], s_sat[i, 2],
+                        tdat, params, layout)
+                    tx = add(ld(gw, i, 0), gx + fx)
+                    ty = add(ld(gw, i, 1), gy + fy)
+                    tz = add(ld(gw, i, 2), gz + fz)
                 for q in range(3):
                     st(k, ld(y, tb, q + 3), tb, q)
                 st(k, tx, tb, 3)
                 st(k, ty, tb, 4)
                 st(k, tz, tb, 5)
-            else:
+            elif direct:
                 tx, ty, tz = add(ld(gw, hrow, 0), gx), add(ld(gw, hrow, 1), gy), add(ld(gw, hrow, 2), gz)
+            else:  # the EH centre's gravity as the satellite's plus the differential gravity
+                tx = add(ld(gw, i, 0), gx + dgI[i, l, 0])
+                ty = add(ld(gw, i, 1), gy + dgI[i, l, 1])
+                tz = add(ld(gw, i, 2), gz + dgI[i, l, 2])
             aux[b + TM_A], aux[b + TM_A + 1], aux[b + TM_A + 2] = to_f64(tx), to_f64(ty), to_f64(tz)
 
 

@@ -144,6 +144,7 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
                           sensitive_axes=craft.sensitive_axes_array, sg_oa=craft.self_gravity_array, sg_s=common,
                           jerk_gms=[gms[b] for b in bodies], j2k=j2k,
                           gm_relativity=gm if (law and ref.origin == "sun" and f.relativity) else 0.0,
-                          tdat_offset=model.n_tdat if eph is not None else -1, centre_column=centre)
+                          tdat_offset=model.n_tdat if eph is not None else -1, centre_column=centre,
+                          tm_gravity=c.tm_gravity)
     return System(cpar, True, c.free_tms, eph, centre_ramp=ramp, jerk_bodies=bodies, reference=ref,
                   spacecraft=craft)

@@ -54,6 +54,8 @@ __all__ = [
     "earth_field_static_accel",
     "earth_tides_accel",
     "earth_field_accel_batch",
+    "degree2_matrix",
+    "degree2_accel_ext",
     "j2_jerk_gcrs_z",
     "PARAM_HEADER",
     "N_ROT",
@@ -296,27 +298,18 @@ def _earth_field(rx, ry, rz, tdat, params, static, tides):
 
 
 @njit(cache=True)
-def degree2_accel_ext(rx, ry, rz, tdat, params):
-    """Degree-2 part of the Earth field (static + tidal corrections) in the
-    number type of r (generic: dd tuples or float64), GCRS [m/s^2].
-
-    Closed form: with the unnormalised C20u = sqrt(5) C20, C21u =
-    sqrt(5/3) C21, C22u = sqrt(5/12) C22 (same for S), the degree-2
-    potential is V2 = GM R^2 Q / r^5 with the traceless quadratic form
-    Q = x^T M x, M = [[-C20u/2 + 3 C22u, 3 S22u, 3/2 C21u],
-    [3 S22u, -C20u/2 - 3 C22u, 3/2 S21u], [3/2 C21u, 3/2 S21u, C20u]]
-    (ITRS), so a = GM R^2 (2 M x / r^5 - 5 Q x / r^7).  Used by the model
-    when ``extended_degree2`` is set (J2 is ~5e-7 m/s^2 at 1e5 km: its
-    float64 round-off would move the orbit by ~5e-14 m per day).
-    """
+def degree2_matrix(tdat, params, one):
+    """(GM R^2, M_xx, M_yy, M_zz, M_xy, M_xz, M_yz) of the degree-2 field
+    (static + tidal corrections; see :func:`degree2_accel_ext`), ITRS, in
+    the number type of ``one`` (1.0 as a dd tuple or a float64): GM R^2 in
+    m^5/s^2, M dimensionless.  tdat, params: the Earth field's."""
     gm, radius = params[0], params[1]
     ld = int(params[2]) + 1
     L = ld * ld
     nt = int(params[4])
     c20, c21, c22 = params[PARAM_HEADER + 2 * ld], params[PARAM_HEADER + 2 * ld + 1], params[PARAM_HEADER + 2 * ld + 2]
     s21, s22 = params[PARAM_HEADER + L + 2 * ld + 1], params[PARAM_HEADER + L + 2 * ld + 2]
-    # static coefficients plus the tidal corrections, summed in the number type of r
-    one = const(1.0, 0.0, rx)
+    # static coefficients plus the tidal corrections, summed in the number type of one
     c20, c21, s21, c22, s22 = mul(one, c20), mul(one, c21), mul(one, s21), mul(one, c22), mul(one, s22)
     if nt >= 2:  # packed corrections: dC_nm at n (n+1)/2 + m
         lt = (nt + 1) * (nt + 2) // 2
@@ -336,6 +329,26 @@ def degree2_accel_ext(rx, ry, rz, tdat, params):
     m_xy = mul(v22, 3.0)
     m_xz = mul(u21, 1.5)
     m_yz = mul(v21, 1.5)
+    gmr2 = mul(mul(mul(one, gm), radius), radius)
+    return gmr2, m_xx, m_yy, m_zz, m_xy, m_xz, m_yz
+
+
+@njit(cache=True)
+def degree2_accel_ext(rx, ry, rz, tdat, params):
+    """Degree-2 part of the Earth field (static + tidal corrections) in the
+    number type of r (generic: dd tuples or float64), GCRS [m/s^2].
+
+    Closed form: with the unnormalised C20u = sqrt(5) C20, C21u =
+    sqrt(5/3) C21, C22u = sqrt(5/12) C22 (same for S), the degree-2
+    potential is V2 = GM R^2 Q / r^5 with the traceless quadratic form
+    Q = x^T M x, M = [[-C20u/2 + 3 C22u, 3 S22u, 3/2 C21u],
+    [3 S22u, -C20u/2 - 3 C22u, 3/2 S21u], [3/2 C21u, 3/2 S21u, C20u]]
+    (ITRS, :func:`degree2_matrix`), so a = GM R^2 (2 M x / r^5 - 5 Q x / r^7).
+    Used by the model when ``extended_degree2`` is set (J2 is ~5e-7 m/s^2 at
+    1e5 km: its float64 round-off would move the orbit by ~5e-14 m per day).
+    """
+    one = const(1.0, 0.0, rx)
+    gmr2, m_xx, m_yy, m_zz, m_xy, m_xz, m_yz = degree2_matrix(tdat, params, one)
     # r_ITRS = T r (T float64, r generic)
     x = add(add(mul(rx, tdat[0]), mul(ry, tdat[1])), mul(rz, tdat[2]))
     y = add(add(mul(rx, tdat[3]), mul(ry, tdat[4])), mul(rz, tdat[5]))
@@ -346,7 +359,6 @@ def degree2_accel_ext(rx, ry, rz, tdat, params):
     q = add(add(mul(x, mx), mul(y, my)), mul(z, mz))
     r2 = add(add(mul(x, x), mul(y, y)), mul(z, z))
     r5 = mul(mul(r2, r2), sqrt(r2))
-    gmr2 = mul(mul(mul(one, gm), radius), radius)
     # a = (2 GM R^2 / r^5) M x - (5 GM R^2 Q / r^7) x
     s1 = div(mul(gmr2, 2.0), r5)
     s2 = div(mul(mul(gmr2, 5.0), q), mul(r5, r2))

@@ -39,7 +39,7 @@ from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
 
-__all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "gravity_split", "SLOTS"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -250,11 +250,25 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
 def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
     and velocity (vx, vy, vz) [m/s] relative to the central body, in the
+    force model's reference system (see :func:`gravity_split`, whose first
+    three values this returns).  Returns (ax, ay, az) in the number type of x.
+    """
+    ax, ay, az, _, _, _ = gravity_split(x, y, z, vx, vy, vz, tdat, params, layout)
+    return ax, ay, az
+
+
+@njit(cache=True)
+def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
+    """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
+    and velocity (vx, vy, vz) [m/s] relative to the central body, in the
     force model's reference system (geocentric GCRS or heliocentric BCRS) (generic dd / float64; the
     velocity enters the relativistic terms only), from the enabled terms.
 
     tdat: (n_tdat,) float64 time-only inputs at this instant; params, layout:
-    from :class:`ForceModel`.  Returns (ax, ay, az) in the number type of x.
+    from :class:`ForceModel`.  Returns (ax, ay, az, ex, ey, ez): the total
+    in the number type of x and, float64, the part of it from the Earth
+    field's float64 kernel (zero without that term), which the differential
+    gravity of the test masses reuses (:mod:`tqdyn.forces.differential`).
     """
     zero = mul(x, 0.0)
     ax, ay, az = zero, zero, zero
@@ -282,14 +296,15 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     rx, ry, rz = to_f64(x), to_f64(y), to_f64(z)
     ux, uy, uz = to_f64(vx), to_f64(vy), to_f64(vz)
     px, py, pz = 0.0, 0.0, 0.0
+    ex, ey, ez = 0.0, 0.0, 0.0
     if layout[SLOT_THIRD_BODY, 0]:
         o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
         gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if layout[SLOT_EARTH_FIELD, 0]:
         o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
-        gx, gy, gz = earth_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
-        px, py, pz = px + gx, py + gy, pz + gz
+        ex, ey, ez = earth_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        px, py, pz = px + ex, py + ey, pz + ez
     if layout[SLOT_EARTH_FIELD_INDIRECT, 0]:
         o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
         gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
@@ -310,4 +325,4 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
         o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
         gx, gy, gz = central_j2_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    return add(ax, px), add(ay, py), add(az, pz)
+    return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez

@@ -47,6 +47,7 @@ from .spherical_harmonics import sh_accel
 __all__ = [
     "MoonField",
     "moon_field_accel",
+    "moon_field_direct",
 ]
 
 
@@ -55,12 +56,13 @@ __all__ = [
 
 
 @njit(cache=True)
-def _field_gcrs(px, py, pz, tdat, params):
+def _field_gcrs(px, py, pz, tdat, params, ntrunc=-1):
     """Field acceleration [m/s^2, GCRS] at the Moon-centred GCRS position
-    (px, py, pz) [m]: rotate into PA with tdat[3:12], sh_accel, rotate back."""
+    (px, py, pz) [m]: rotate into PA with tdat[3:12], sh_accel, rotate back;
+    degrees 2 .. min(N, ntrunc) (ntrunc < 0: all N of params)."""
     gm, radius = params[0], params[1]
-    nmax = int(params[2])
-    n1 = nmax + 1
+    n1 = int(params[2]) + 1
+    nmax = n1 - 1 if ntrunc < 0 or ntrunc > n1 - 1 else ntrunc
     k = n1 * n1
     cnm = params[3:3 + k].reshape((n1, n1))
     snm = params[3 + k:3 + 2 * k].reshape((n1, n1))
@@ -90,6 +92,16 @@ def moon_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """
     ax, ay, az = _field_gcrs(rx - tdat[0], ry - tdat[1], rz - tdat[2], tdat, params)
     return ax - tdat[12], ay - tdat[13], az - tdat[14]
+
+
+@njit(cache=True)
+def moon_field_direct(rx, ry, rz, tdat, params, nmax):
+    """The Moon's field on a satellite at (rx, ry, rz) [m, GCRS] alone (no
+    term on the Earth), degrees 2 .. min(nmax, N) [m/s^2, GCRS]; tdat and
+    params as :func:`moon_field_accel`.  For differences between nearby
+    points (:mod:`tqdyn.forces.differential`), where the Earth's term drops
+    out.  float64 scalars."""
+    return _field_gcrs(rx - tdat[0], ry - tdat[1], rz - tdat[2], tdat, params, nmax)
 
 
 @njit(cache=True)

@@ -30,7 +30,8 @@ TOML layout (every section and key optional except at least one
                     tableau ("corrected" | "published"), rtol
     [forces]        earth_monopole, gm_earth [m^3/s^2]
     [constellation] pointing ("none" | "global" | "taylor1" | "taylor2" |
-                    "iterative"), control ("on" | "off"), free_tms (bool)
+                    "iterative"), control ("on" | "off"), free_tms (bool),
+                    tm_gravity ("differential" | "direct")
     [spacecraft]    d_tm [m], d_p [m], tm_axis ("x" | "y" | "z"),
                     self_gravity ("table-iv" | "off" | array (2, 3) or
                     (3, 2, 3) [m/s^2] in OA_l), self_gravity_common (array

@@ -108,7 +108,7 @@ _SCHEMA: dict[str, dict[str, str]] = {
                    "sensitive_axes": _ANY, "envelope_radius": _NUM},
     "initial": {"axes": _STR, "design": _STR, "arm_length": _NUM, "displacement_deg": _NUM, "rotation": _STR,
                 "semi_major_axis": _NUM, "oem": _STRLIST, "oem_eme2000": _STR},
-    "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL},
+    "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL, "tm_gravity": _STR},
 }
 _SAT_SCHEMA: dict[str, str] = {
     "name": _STR, "a_km": _NUM, "e": _NUM, "i_deg": _NUM, "raan_deg": _NUM, "argp_deg": _NUM, "nu_deg": _NUM,
