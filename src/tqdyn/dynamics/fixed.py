@@ -1,12 +1,16 @@
 """Fixed-step propagation: the compiled DP87 loop, chunk by chunk.
 
-The loop runs entirely in compiled code, one chunk of steps at a time.
-Before each chunk the time-only inputs of the force model are computed for
-every stage time of the chunk (t_n + c_i h, known in advance) and handed to
+The loop runs entirely in compiled code, one block of steps at a time.
+Before each block the time-only inputs of the force model are computed for
+every stage time of the block (t_n + c_i h, known in advance) and handed to
 the loop as one array, so no Python runs per step; the inputs of the next
-chunk are computed in a second thread while the compiled loop (nogil) runs.
-Time is an integer step count times the exact step (a dd pair), never a
-large bare float64.
+block are computed in a second thread while the compiled loop (nogil) runs.
+A chunk (the unit of output rows, progress and checkpoints) is split into
+blocks of at most :data:`INPUT_BLOCK` steps, which bounds the memory of the
+time-only inputs (~2.6 MB per 128 steps for the coupled TianQin model, plus
+the temporaries of their evaluation) whatever the chunk.  Time is an
+integer step count times the exact step (a dd pair), never a large bare
+float64.
 """
 
 from __future__ import annotations
@@ -24,9 +28,10 @@ from . import layout as _lay
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
-__all__ = ["DEFAULT_CHUNK", "propagate_fixed", "warm_up"]
+__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "propagate_fixed", "warm_up"]
 
-DEFAULT_CHUNK = 4096  # steps per compiled call: ~1 s of work, bounds memory of time-only inputs
+DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints (~2 s of work)
+INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
 
 
 def _as_precision(y_dd: np.ndarray, precision: str) -> np.ndarray:
@@ -169,28 +174,60 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         plan.append((n_plan, m))
         n_plan += m
 
-    def inputs(n0, m):
-        t_out = np.empty((m, 2))
-        t_nodes = np.empty((m if model.time_dependent else 0, 13, 2))
-        _grid_times(n0, m, h, coef.c, t_out, t_nodes)
-        tdat = (model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1]) if model.time_dependent
-                else np.zeros((m, 13, 0)))
-        return t_out, tdat
+    def inputs(n0, m, span):
+        """Time-only inputs (m, 13, n_tdat) of the steps n0 .. n0 + m - 1 of
+        the chunk span = (first step, steps).  A block shorter than its chunk
+        is evaluated together with one more pseudo-step holding the chunk's
+        first and last instants, whose rows are dropped: the inputs of a
+        step are the same whatever block holds it (terms that evaluate slow
+        quantities on nodes spanning the requested instants, the CIP of the
+        relativity term, see the chunk's span as in one evaluation; the
+        others are instant by instant, with the 13 stages of a step in one
+        row).  The stages stay (m, 13) even where two are the same instant
+        (c = 1 twice, and c = 1 is the next step's c = 0): the ocean tides'
+        matrix product (BLAS, one 13-row product per step) gives the 13th row
+        other last bits than the 12th, so evaluating each instant once would
+        change the trajectory's last bits."""
+        if not model.time_dependent:
+            return np.zeros((m, 13, 0))
+        c0, cm = span
+        extra = 0 if (n0, m) == (c0, cm) else 1
+        t_nodes = np.empty((m + extra, 13, 2))
+        _grid_times(n0, m, h, coef.c, np.empty((m, 2)), t_nodes[:m])
+        if extra:
+            _grid_times(c0 + cm - 1, 1, h, coef.c, np.empty((1, 2)), t_nodes[m:])
+            first = np.empty((1, 13, 2))
+            _grid_times(c0, 1, h, coef.c, np.empty((1, 2)), first)
+            t_nodes[m, 0] = first[0, 0]
+        tdat = model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1])
+        return tdat[:m] if extra else tdat
 
+    blocks = [(b0, min(INPUT_BLOCK, n0 + m - b0), (n0, m)) for n0, m in plan
+              for b0 in range(n0, n0 + m, INPUT_BLOCK)]
     with ThreadPoolExecutor(max_workers=1) as pool:
-        pending = pool.submit(inputs, *plan[0]) if plan else None
-        for idx, (n0, m) in enumerate(plan):
-            t_out, tdat = pending.result()
-            pending = pool.submit(inputs, *plan[idx + 1]) if idx + 1 < len(plan) else None
+        pending = pool.submit(inputs, *blocks[0]) if blocks else None
+        ib = 0
+        for n0, m in plan:
+            t_out = np.empty((m, 2))
+            _grid_times(n0, m, h, coef.c, t_out, np.empty((0, 13, 2)))
             out_y = np.empty((m,) + y.shape)
             out_a = np.empty((m,) + acc_shape)
             out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
-            _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
-                         coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, m, out_y, out_a, out_aux)
+            while ib < len(blocks) and blocks[ib][2] == (n0, m):
+                b0, mb, _ = blocks[ib]
+                tdat = pending.result()
+                ib += 1
+                pending = pool.submit(inputs, *blocks[ib]) if ib < len(blocks) else None
+                o, e = b0 - n0, b0 - n0 + mb
+                _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                             coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, mb, out_y[o:e],
+                             out_a[o:e], out_aux[o:e])
+                del tdat
             if sink is not None:
                 sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
             if n_aux:
                 update_extremes(extremes, out_aux, system)
+            del out_y, out_a, out_aux
             n = n0 + m
             if progress is not None:
                 progress(m)
