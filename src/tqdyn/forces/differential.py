@@ -17,9 +17,10 @@ cancellation and at a fraction of the cost:
   geocentric form and the heliocentric one alike: the indirect term is the
   same at both points and drops out): the exact difference of GM D/|D|^3
   between two points D and D + e (:func:`pm_difference`), written so that
-  nothing cancels -- relative error ~1e-16 of the ~1e-10 m/s^2 result, and
-  exact to all orders in |e| / |D| (the monopole's second-order term is
-  ~5e-19 m/s^2 at TianQin, the Moon's ~1e-22);
+  nothing cancels -- relative error <= ~1e-15 of the result (1e-25 m/s^2
+  for the monopole's 8e-11 at TianQin, measured against mpmath), and exact
+  to all orders in |e| / |D| (the monopole's second-order term is ~5e-19
+  m/s^2 at TianQin, the Moon's ~1e-22);
 * **the Earth's degree 2** (static + tides), when the model evaluates it in
   extended precision: the Jacobian of the quadrupole field at the midpoint
   r + d/2 applied to d (:func:`quadrupole_jacobian_product`).  The midpoint
@@ -39,12 +40,17 @@ cancellation and at a fraction of the cost:
 * the Earth-field indirect term (the geocentre's acceleration) is the same
   at both points and is left out exactly.
 
-Overall dg is exact to ~1e-25 m/s^2 -- the level of today's float64
-perturbations at a float64-rounded position, which bounds the direct
-difference too (tests/test_differential_gravity.py compares the two and
-mpmath).  Everything is float64; positions r are the satellite's float64
-position (its 1.5e-8 m rounding moves dg by |d^3 a| |d| 1.5e-8 m ~ 4e-26
-m/s^2).
+Overall dg is exact to ~4e-25 m/s^2 geocentric: the float64 round-off of
+the Earth's degrees >= 3 (2.7e-10 m/s^2 at TianQin) and of the planets,
+which the direct difference (the whole model again at r + d) carries too;
+both agree to 4.2e-25 m/s^2 (tests/test_differential_gravity.py, which
+also checks each part against mpmath or double-double).  The float64 terms
+are evaluated at r and at fl(r + d): the rounding of r + d (<= 7.5e-9 m at
+1e8 m) moves their difference by <= |grad a_{>=3}| 7.5e-9 m ~ 1e-25 m/s^2,
+as in the direct difference.  Heliocentric the direct difference is the
+worse one (~1e-22 m/s^2: float64 planets at positions rounded to 3e-5 m),
+while the exact point-mass differences here agree with mpmath to 1e-29.
+Everything is float64.
 """
 
 from __future__ import annotations
