@@ -186,6 +186,21 @@ def _factors(j, k):
     return a, b, fz, fm, fp
 
 
+@njit(cache=True, inline="always")
+def _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp):
+    """One step (j - 1, k) -> (j, k) of the column recursion for j >= k + 2
+    (ib: the table index of (j, k)): (f_z, f_-, f_+) of (j, k) and the new
+    (Vbar, Wbar) of degrees j - 1 and j.  Inlined into the kernel's loops."""
+    if j <= _JT:
+        u = np.uint64(ib)
+        fa, fb, fz, fm, fp = ta[u], tb[u], tz[u], tm[u], tp[u]
+    else:
+        fa, fb, fz, fm, fp = _factors(j, k)
+    a = fa * zr
+    b = fb * rr
+    return fz, fm, fp, v, w, a * v - b * v1, a * w - b * w1
+
+
 @njit(cache=True)
 def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, nmin):
     """Acceleration [m/s^2] of a fully-normalised spherical-harmonic field,
@@ -324,14 +339,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
         j1 = nmin + 1 if nmin + 1 < jmax + 1 else jmax + 1
         for j in range(j0, j1):
             ib += j
-            if j <= _JT:
-                u = np.uint64(ib)
-                fa, fb, fz, fm, fp = ta[u], tb[u], tz[u], tm[u], tp[u]
-            else:
-                fa, fb, fz, fm, fp = _factors(j, k)
-            a = fa * zr
-            b = fb * rr
-            v1, w1, v, w = v, w, a * v - b * v1, a * w - b * w1
+            fz, fm, fp, v1, w1, v, w = _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp)
         j0 = j1 if j1 > j0 else j0
         # (2) static + correction: n <= min(ns, nt)
         j1 = (ns if ns < nt else nt) + 2
@@ -339,14 +347,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
             j1 = jmax + 1
         for j in range(j0, j1):
             ib += j
-            if j <= _JT:
-                u = np.uint64(ib)
-                fa, fb, fz, fm, fp = ta[u], tb[u], tz[u], tm[u], tp[u]
-            else:
-                fa, fb, fz, fm, fp = _factors(j, k)
-            a = fa * zr
-            b = fb * rr
-            v1, w1, v, w = v, w, a * v - b * v1, a * w - b * w1
+            fz, fm, fp, v1, w1, v, w = _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp)
             n = j - 1
             o = n * ldc + k
             to = (n * ldt if ldt > 0 else (n * (n + 1)) // 2) + k
@@ -363,14 +364,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
         if ns > nt:
             for j in range(j0, jmax + 1):
                 ib += j
-                if j <= _JT:
-                    u = np.uint64(ib)
-                    fa, fb, fz, fm, fp = ta[u], tb[u], tz[u], tm[u], tp[u]
-                else:
-                    fa, fb, fz, fm, fp = _factors(j, k)
-                a = fa * zr
-                b = fb * rr
-                v1, w1, v, w = v, w, a * v - b * v1, a * w - b * w1
+                fz, fm, fp, v1, w1, v, w = _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp)
                 o = (j - 1) * ldc + k
                 cm, sm = C[np.uint64(o - 1)], S[np.uint64(o - 1)]
                 c0, s0 = C[np.uint64(o)], S[np.uint64(o)]
@@ -383,14 +377,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
         else:
             for j in range(j0, jmax + 1):
                 ib += j
-                if j <= _JT:
-                    u = np.uint64(ib)
-                    fa, fb, fz, fm, fp = ta[u], tb[u], tz[u], tm[u], tp[u]
-                else:
-                    fa, fb, fz, fm, fp = _factors(j, k)
-                a = fa * zr
-                b = fb * rr
-                v1, w1, v, w = v, w, a * v - b * v1, a * w - b * w1
+                fz, fm, fp, v1, w1, v, w = _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp)
                 n = j - 1
                 to = (n * ldt if ldt > 0 else (n * (n + 1)) // 2) + k
                 cm, sm = dC[np.uint64(to - 1)], dS[np.uint64(to - 1)]
