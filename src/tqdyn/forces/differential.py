@@ -60,7 +60,7 @@ import math
 from numba import njit
 
 from .earth import PARAM_HEADER as _EF_HEADER
-from .earth import degree2_matrix, earth_field_accel
+from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
 from .heliocentric import central_j2_accel
 from .model import (SLOT_CENTRAL_J2, SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_MOON_FIELD, SLOT_RELATIVITY,
                     SLOT_SUN_J2, SLOT_THIRD_BODY)
@@ -186,16 +186,10 @@ def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey,
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 is not in the float64 field: midpoint Jacobian
             t = tdat[c:]
             k, mxx, myy, mzz, mxy, mxz, myz = degree2_matrix(t, params[o:], 1.0)
-            mx, my, mz = rx + 0.5 * dx, ry + 0.5 * dy, rz + 0.5 * dz
-            x = t[0] * mx + t[1] * my + t[2] * mz
-            y = t[3] * mx + t[4] * my + t[5] * mz
-            z = t[6] * mx + t[7] * my + t[8] * mz
-            qx = t[0] * dx + t[1] * dy + t[2] * dz
-            qy = t[3] * dx + t[4] * dy + t[5] * dz
-            qz = t[6] * dx + t[7] * dy + t[8] * dz
+            x, y, z = itrs_from_gcrs(t, rx + 0.5 * dx, ry + 0.5 * dy, rz + 0.5 * dz)  # the midpoint
+            qx, qy, qz = itrs_from_gcrs(t, dx, dy, dz)
             jx, jy, jz = quadrupole_jacobian_product(k, mxx, myy, mzz, mxy, mxz, myz, x, y, z, qx, qy, qz)
-            gx += t[0] * jx + t[3] * jy + t[6] * jz
-            gy += t[1] * jx + t[4] * jy + t[7] * jz
-            gz += t[2] * jx + t[5] * jy + t[8] * jz
+            jx, jy, jz = gcrs_from_itrs(t, jx, jy, jz)
+            gx, gy, gz = gx + jx, gy + jy, gz + jz
     fx, fy, fz = direct_terms(hx, hy, hz, wx, wy, wz, tdat, params, layout)
     return gx + (fx - sx), gy + (fy - sy), gz + (fz - sz)

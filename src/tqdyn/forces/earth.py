@@ -55,6 +55,8 @@ __all__ = [
     "earth_tides_accel",
     "earth_field_accel_batch",
     "degree2_matrix",
+    "itrs_from_gcrs",
+    "gcrs_from_itrs",
     "degree2_accel_ext",
     "j2_jerk_gcrs_z",
     "PARAM_HEADER",
@@ -286,15 +288,27 @@ def _earth_field(rx, ry, rz, tdat, params, static, tides):
         nt = -1
     # degree 2 evaluated elsewhere (in extended precision, degree2_accel_ext)?
     nmin = 3 if params[PARAM_HEADER + 2 * L] != 0.0 else 2
-    # r_ITRS = T r
-    x = tdat[0] * rx + tdat[1] * ry + tdat[2] * rz
-    y = tdat[3] * rx + tdat[4] * ry + tdat[5] * rz
-    z = tdat[6] * rx + tdat[7] * ry + tdat[8] * rz
+    x, y, z = itrs_from_gcrs(tdat, rx, ry, rz)
     ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, 0, nt, nmin)
-    # a_GCRS = T^T a_ITRS
-    return (tdat[0] * ax + tdat[3] * ay + tdat[6] * az,
-            tdat[1] * ax + tdat[4] * ay + tdat[7] * az,
-            tdat[2] * ax + tdat[5] * ay + tdat[8] * az)
+    return gcrs_from_itrs(tdat, ax, ay, az)
+
+
+@njit(cache=True, inline="always")
+def itrs_from_gcrs(tdat, x, y, z):
+    """T_ITRS_GCRS (x, y, z): a GCRS vector in the ITRS, with the rotation
+    from the Earth term's time-only inputs (tdat[0:9], row-major).  float64."""
+    return (tdat[0] * x + tdat[1] * y + tdat[2] * z,
+            tdat[3] * x + tdat[4] * y + tdat[5] * z,
+            tdat[6] * x + tdat[7] * y + tdat[8] * z)
+
+
+@njit(cache=True, inline="always")
+def gcrs_from_itrs(tdat, x, y, z):
+    """T_ITRS_GCRS^T (x, y, z): an ITRS vector in the GCRS (see
+    :func:`itrs_from_gcrs`).  float64."""
+    return (tdat[0] * x + tdat[3] * y + tdat[6] * z,
+            tdat[1] * x + tdat[4] * y + tdat[7] * z,
+            tdat[2] * x + tdat[5] * y + tdat[8] * z)
 
 
 @njit(cache=True)

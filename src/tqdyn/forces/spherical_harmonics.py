@@ -201,6 +201,19 @@ def _advance(j, k, ib, zr, rr, v1, w1, v, w, ta, tb, tz, tm, tp):
     return fz, fm, fp, v, w, a * v - b * v1, a * w - b * w1
 
 
+@njit(cache=True, inline="always")
+def _accumulate(ax, ay, az, fz, fm, fp, v, w, cm, sm, c0, s0, cp, sp):
+    """Add harmonic (j, k)'s contribution through the coefficients (n, k - 1)
+    (cm, sm), (n, k) (c0, s0), (n, k + 1) (cp, sp), n = j - 1, with factors
+    f_-, f_z, f_+ (the rows of the branch-free loops, where all three orders exist)."""
+    az -= fz * (c0 * v + s0 * w)
+    ax -= fm * (cm * v + sm * w)
+    ay -= fm * (cm * w - sm * v)
+    ax += fp * (cp * v + sp * w)
+    ay += fp * (sp * v - cp * w)
+    return ax, ay, az
+
+
 @njit(cache=True)
 def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, nmin):
     """Acceleration [m/s^2] of a fully-normalised spherical-harmonic field,
@@ -354,11 +367,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
             cm, sm = C[np.uint64(o - 1)] + dC[np.uint64(to - 1)], (S[np.uint64(o - 1)] + dS[np.uint64(to - 1)])
             c0, s0 = C[np.uint64(o)] + dC[np.uint64(to)], S[np.uint64(o)] + dS[np.uint64(to)]
             cp, sp = C[np.uint64(o + 1)] + dC[np.uint64(to + 1)], S[np.uint64(o + 1)] + dS[np.uint64(to + 1)]
-            az -= fz * (c0 * v + s0 * w)
-            ax -= fm * (cm * v + sm * w)
-            ay -= fm * (cm * w - sm * v)
-            ax += fp * (cp * v + sp * w)
-            ay += fp * (sp * v - cp * w)
+            ax, ay, az = _accumulate(ax, ay, az, fz, fm, fp, v, w, cm, sm, c0, s0, cp, sp)
         j0 = j1 if j1 > j0 else j0
         # (3) the rest up to jmax: static only (ns > nt) or correction only
         if ns > nt:
@@ -369,11 +378,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
                 cm, sm = C[np.uint64(o - 1)], S[np.uint64(o - 1)]
                 c0, s0 = C[np.uint64(o)], S[np.uint64(o)]
                 cp, sp = C[np.uint64(o + 1)], S[np.uint64(o + 1)]
-                az -= fz * (c0 * v + s0 * w)
-                ax -= fm * (cm * v + sm * w)
-                ay -= fm * (cm * w - sm * v)
-                ax += fp * (cp * v + sp * w)
-                ay += fp * (sp * v - cp * w)
+                ax, ay, az = _accumulate(ax, ay, az, fz, fm, fp, v, w, cm, sm, c0, s0, cp, sp)
         else:
             for j in range(j0, jmax + 1):
                 ib += j
@@ -383,11 +388,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
                 cm, sm = dC[np.uint64(to - 1)], dS[np.uint64(to - 1)]
                 c0, s0 = dC[np.uint64(to)], dS[np.uint64(to)]
                 cp, sp = dC[np.uint64(to + 1)], dS[np.uint64(to + 1)]
-                az -= fz * (c0 * v + s0 * w)
-                ax -= fm * (cm * v + sm * w)
-                ay -= fm * (cm * w - sm * v)
-                ax += fp * (cp * v + sp * w)
-                ay += fp * (sp * v - cp * w)
+                ax, ay, az = _accumulate(ax, ay, az, fz, fm, fp, v, w, cm, sm, c0, s0, cp, sp)
     scale = gm / (radius * radius)
     return scale * ax, scale * ay, scale * az
 
