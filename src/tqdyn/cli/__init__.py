@@ -12,6 +12,7 @@ from __future__ import annotations
 import click
 
 from .. import __version__
+from ..workflows.heap import bound_heap_retention
 from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 from .bench import bench as _bench_command
 from .export import export as _export_command
@@ -41,7 +42,9 @@ cli.add_command(_report_command)
 
 
 def main(argv=None):
-    """Entry point: click in non-standalone mode so usage errors are one line."""
+    """Entry point: click in non-standalone mode so usage errors are one line.
+    Large freed blocks go back to the system (:mod:`tqdyn.workflows.heap`)."""
+    bound_heap_retention()
     try:
         cli.main(args=argv, prog_name="tqdyn", standalone_mode=False)
     except click.exceptions.Abort:

@@ -190,6 +190,13 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         change the trajectory's last bits."""
         if not model.time_dependent:
             return np.zeros((m, 13, 0))
+        t_cpu = _time.thread_time()
+        try:
+            return _inputs(n0, m, span)
+        finally:
+            cpu["inputs"] += _time.thread_time() - t_cpu
+
+    def _inputs(n0, m, span):
         c0, cm = span
         extra = 0 if (n0, m) == (c0, cm) else 1
         t_nodes = np.empty((m + extra, 13, 2))
@@ -202,6 +209,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         tdat = model.precompute(epoch, t_nodes[..., 0], t_nodes[..., 1])
         return tdat[:m] if extra else tdat
 
+    cpu = {"inputs": 0.0, "loop": 0.0}
     blocks = [(b0, min(INPUT_BLOCK, n0 + m - b0), (n0, m)) for n0, m in plan
               for b0 in range(n0, n0 + m, INPUT_BLOCK)]
     with ThreadPoolExecutor(max_workers=1) as pool:
@@ -219,9 +227,11 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
                 ib += 1
                 pending = pool.submit(inputs, *blocks[ib]) if ib < len(blocks) else None
                 o, e = b0 - n0, b0 - n0 + mb
+                t_cpu = _time.thread_time()
                 _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
                              coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, mb, out_y[o:e],
                              out_a[o:e], out_aux[o:e])
+                cpu["loop"] += _time.thread_time() - t_cpu
                 del tdat
             if sink is not None:
                 sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
@@ -249,4 +259,5 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         sink(select_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
     return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,
                      y_final=to_dd(y, 2), n_steps=n_total, n_rejected=0,
-                     n_rhs=13 * n_total + 1, wall_s=wall, extra=format_extremes(extremes))
+                     n_rhs=13 * n_total + 1, wall_s=wall, extra=format_extremes(extremes),
+                     cpu_inputs_s=cpu["inputs"], cpu_loop_s=cpu["loop"])

@@ -160,7 +160,10 @@ class RunResult:
     energy_rel_drift: (n_sat,) relative change of the two-body energy
     v^2/2 - GM/r (only for a pure monopole model, else None);
     reference: the :class:`~tqdyn.astro.reference.ReferenceSystem` of the
-    states and times (the force model's).
+    states and times (the force model's); cpu_inputs_s, cpu_loop_s: CPU
+    time [s] of the time-only inputs (their thread) and of the compiled loop
+    (fixed mode; 0 otherwise) -- on two cores the wall time cannot be below
+    half their sum.
     """
 
     precision: str
@@ -175,6 +178,8 @@ class RunResult:
     energy_rel_drift: np.ndarray | None = None
     extra: dict = field(default_factory=dict)
     reference: object = None
+    cpu_inputs_s: float = 0.0
+    cpu_loop_s: float = 0.0
 
 
 def update_extremes(ext: dict, out_aux: np.ndarray, system) -> None:

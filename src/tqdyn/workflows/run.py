@@ -32,6 +32,7 @@ from ..formats import trajectory as io
 from .. import dynamics
 from ..dynamics import Checkpoint, RunResult, row_names
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
+from .heap import bound_heap_retention
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
            "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning"]
@@ -202,6 +203,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         resolved scenario and precision).
     """
     out_path = io.check_writable(scen.run.output)
+    bound_heap_retention()
     if model is None:
         model = dynamics.check_inputs(scen)
     fixed = scen.integrator.mode == "fixed"

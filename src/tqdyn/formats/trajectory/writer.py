@@ -25,7 +25,11 @@ from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs,
 
 __all__ = ["check_writable", "TrajectoryWriter"]
 
-_DEFAULT_CHUNK_ROWS = 4096
+_DEFAULT_CHUNK_ROWS = 1024  # rows per chunk: also the rows buffered in memory (~2 MB for a coupled run)
+# The rows are buffered here and written a whole chunk at a time, so HDF5's
+# chunk cache would only keep written chunks resident (up to 1 MB per
+# dataset, ~20 MB for a coupled run, growing with the run): no chunk cache.
+_RDCC_NBYTES = 0
 
 # ---------------------------------------------------------------------------
 # small helpers
@@ -212,7 +216,7 @@ class TrajectoryWriter:
         self._state["tmp"] = tmp
         self._finalizer = weakref.finalize(self, _cleanup, self._state)
         try:
-            h5 = h5py.File(tmp, "w")
+            h5 = h5py.File(tmp, "w", rdcc_nbytes=_RDCC_NBYTES)
             self._state["h5"] = h5
             self._state["fd"] = _vfd(h5)
             for k, v in full_attrs.items():
@@ -516,7 +520,7 @@ class TrajectoryWriter:
         self._state = {"tmp": str(partial)}
         self._finalizer = weakref.finalize(self, _cleanup, self._state)
         try:
-            h5 = h5py.File(partial, "r+")
+            h5 = h5py.File(partial, "r+", rdcc_nbytes=_RDCC_NBYTES)
         except OSError as exc:
             self._finalizer.detach()
             raise OutputError(f"cannot reopen partial trajectory {str(partial)!r}: {exc}") from None
