@@ -9,8 +9,8 @@ with the run.  :func:`bound_heap_retention` fixes the threshold at
 :data:`MMAP_THRESHOLD_BYTES` (which also stops the adjustment), so that
 every block of that size or more is mapped on allocation and unmapped on
 free, while the smaller temporaries, the same sizes block after block,
-reuse the heap.  Results do not depend on it.  Elsewhere than glibc (macOS, musl) it
-does nothing.
+reuse the heap.  Results do not depend on it.  Elsewhere than glibc
+(macOS, musl) it does nothing.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import sys
 __all__ = ["MMAP_THRESHOLD_BYTES", "bound_heap_retention"]
 
 #: Blocks of this many bytes or more are mapped: the inputs array of a block
-#: (~10 MB for the coupled TianQin model) and the rows of a chunk.  Lower
+#: (~10 MB for the coupled TianQin model).  Lower
 #: thresholds cost CPU in page faults: at 256 KiB the time-only inputs took
 #: ~10 % more CPU (the (6656, 3, 3)-sized temporaries of a block mapped and
 #: zeroed anew each time); at 4 MiB they cost the same as glibc's default.
