@@ -20,7 +20,7 @@ import sys
 
 import click
 
-from .. import __version__
+from .._version import __version__
 from ._common import (EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, EXIT_SIGHUP, EXIT_SIGTERM,
                       _overrides, fail as _fail)
 

@@ -17,7 +17,7 @@ Two tableaux are available:
   use them.
 
 The compiled functions here are generic over the number type (see
-:mod:`tqdyn.precision`): coefficient and state arrays with a trailing dd axis
+:mod:`tqdyn.numerics.dd`): coefficient and state arrays with a trailing dd axis
 give double-double arithmetic, plain float64 arrays give float64.  They work
 on a state array ``y`` of shape (n_body, 6) -- rows (x, y, z, vx, vy, vz) in
 m and m/s -- and stage derivatives ``K`` of shape (13, n_body, 6); the

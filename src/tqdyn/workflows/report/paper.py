@@ -154,8 +154,8 @@ def _study_control_no_sg(rep, runs):
                    "same order" if _order_ok(v["max_G"], 1e-13) else "differs"),
         SummaryRow("Flight direction in S (sets the sign of the +flight runs)", "-",
                    f"Y_S . v/|v| in [{yv.min():.6f}, {yv.max():.6f}]",
-                   "flight = -Y_S, as tqdyn.studies assumes" if yv.max() < -0.99 else
-                   "NOT -Y_S: the +flight runs of tqdyn.studies are mislabelled"),
+                   "flight = -Y_S, as tqdyn.workflows.studies assumes" if yv.max() < -0.99 else
+                   "NOT -Y_S: the +flight runs of tqdyn.workflows.studies are mislabelled"),
     ]
 
 
