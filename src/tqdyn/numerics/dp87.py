@@ -37,7 +37,7 @@ from .dd import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
 
 __all__ = [
-    "TABLEAUX", "Tableau", "load_tableau", "StepCoefficients",
+    "CORRECTED_TABLEAU_PROVENANCE", "TABLEAUX", "Tableau", "load_tableau", "StepCoefficients",
     "stage_state", "combine", "error_norm", "ORDER", "ERROR_ORDER",
 ]
 
@@ -45,6 +45,8 @@ __all__ = [
 ORDER = 8
 ERROR_ORDER = 7
 TABLEAUX = ("corrected", "published")
+#: Where the corrected tableau comes from (the first line of its generated module's docstring).
+CORRECTED_TABLEAU_PROVENANCE = _tab.__doc__.splitlines()[0].strip()
 _N = _tab.STAGES
 
 
