@@ -64,3 +64,17 @@ def test_light_paths_and_range_asd():
     np.testing.assert_allclose(tqdyn.requirement_asd(np.array([7e-3])), 0.3e-12 * np.sqrt(2), rtol=1e-15)
     with pytest.raises(ValueError, match="link: '14' is not a link; allowed: 12, 23, 31, 13, 32, 21"):
         tqdyn.range_asd(lt, "14")
+
+
+@pytest.mark.parametrize("old, new", [("tqdyn.io", "tqdyn.formats.trajectory"), ("tqdyn.sweep", "tqdyn.workflows.sweep")])
+def test_version_01_import_paths_warn_and_reexport(old, new):
+    """The 0.1 shims still give the same objects, and importing them warns."""
+    import importlib
+    import sys
+
+    sys.modules.pop(old, None)
+    with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
+        shim = importlib.import_module(old)
+    target = importlib.import_module(new)
+    assert shim.__all__ == list(target.__all__)
+    assert all(getattr(shim, n) is getattr(target, n) for n in target.__all__)

@@ -20,8 +20,10 @@ import tqdyn
 PACKAGE = pathlib.Path(tqdyn.__file__).resolve().parent
 
 #: Layers from the bottom up (docs/design.md).  ``readers`` may also import
-#: ``astro.constants``, the one dependency-free module of ``astro``.
-LAYERS = ("numerics", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
+#: ``astro.constants``, the one dependency-free module of ``astro``.  ``_version``
+#: is the version string alone (so that no layer imports the package root,
+#: whose lazy attributes import the front door).
+LAYERS = ("_version", "numerics", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
           "formats", "analysis", "workflows", "cli", "<front>")
 #: Top-level modules outside the layer packages: the front door and the
 #: version-0.1 import paths kept for users' scripts (they re-export).
@@ -115,8 +117,6 @@ def test_dependencies_point_down(name):
     own = LAYERS.index(_layer(name))
     bad = []
     for target, line in _imports(name):
-        if target == "tqdyn":
-            continue  # the package itself (its version string)
         layer = _layer(target)
         if layer == "astro" and target == "tqdyn.astro.constants" and _layer(name) == "readers":
             continue
@@ -160,3 +160,91 @@ def test_modules_are_small():
     long = {m: sum(1 for _ in MODULES[m][0].open(encoding="utf-8")) for m in MODULES}
     too_long = {m: n for m, n in long.items() if n > MAX_LINES and m not in LONG_MODULES}
     assert not too_long, f"modules over {MAX_LINES} lines: {too_long}"
+
+
+def _private_imports(name: str) -> list[str]:
+    """Private names (``_x``, not dunders) that module ``name`` takes from a
+    module of another layer: ``from tqdyn.a.b import _x``, ``from tqdyn.a
+    import _module``, or ``m._x`` on a module ``m`` imported from another layer."""
+    path, is_pkg = MODULES[name]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    base = name if is_pkg else name.rsplit(".", 1)[0]
+    own = _layer(name)
+    foreign_modules = {}   # local name -> imported module of another layer
+    bad = []
+
+    def private(n: str) -> bool:
+        return n.startswith("_") and not (n.startswith("__") and n.endswith("__"))
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = base.split(".")
+                parts = parts[: len(parts) - (node.level - 1)]
+                target = ".".join(parts + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if not target.startswith("tqdyn") or _layer(target) == own:
+                continue
+            for a in node.names:
+                sub = f"{target}.{a.name}"
+                if private(a.name):
+                    bad.append(f"line {node.lineno}: {sub}")
+                elif sub in MODULES:
+                    foreign_modules[a.asname or a.name] = sub
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.startswith("tqdyn.") and _layer(a.name) != own:
+                    if any(private(p) for p in a.name.split(".")):
+                        bad.append(f"line {node.lineno}: {a.name}")
+                    if a.asname:
+                        foreign_modules[a.asname] = a.name
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                and node.value.id in foreign_modules and private(node.attr)):
+            bad.append(f"line {node.lineno}: {foreign_modules[node.value.id]}.{node.attr}")
+    return sorted(set(bad))
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_private_names_across_layers(name):
+    """What one layer uses of another is public (listed in ``__all__`` or at
+    least not ``_``-prefixed); private names stay inside their layer."""
+    bad = _private_imports(name)
+    assert not bad, f"{name} uses private names of other layers: " + "; ".join(bad)
+
+
+def test_no_layer_imports_the_package_root():
+    """``from tqdyn import x`` inside a layer would run the front door's lazy
+    imports (an import loop the cycle test cannot see): the version comes from
+    ``tqdyn._version``."""
+    bad = [f"{m} line {line}" for m in MODULES if _layer(m) != "<front>"
+           for target, line in _imports(m) if target == "tqdyn"]
+    assert not bad, "; ".join(bad)
+
+
+def test_every_dotted_tqdyn_name_in_the_source_exists():
+    """Docstrings, comments and messages name modules and objects as
+    ``tqdyn.a.b.c``; every such name resolves (a module, then attributes), so
+    that no text points at a module that moved (e.g. version 0.1's flat
+    ``tqdyn.frames``)."""
+    import importlib
+    import inspect
+    import re
+
+    bad = []
+    pattern = re.compile(r"\btqdyn(?:\.[A-Za-z_][A-Za-z0-9_]*)+")
+    for name, (path, _) in MODULES.items():
+        for lineno, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            for dotted in pattern.findall(line):
+                parts = dotted.split(".")
+                k = max(i for i in range(1, len(parts) + 1) if ".".join(parts[:i]) in MODULES or i == 1)
+                obj = importlib.import_module(".".join(parts[:k]))
+                for attr in parts[k:]:
+                    if isinstance(obj, type) and f"self.{attr} =" in inspect.getsource(obj):
+                        break  # an instance attribute set by the class
+                    if not hasattr(obj, attr):
+                        bad.append(f"{path.relative_to(PACKAGE)}:{lineno}: {dotted}")
+                        break
+                    obj = getattr(obj, attr)
+    assert not bad, "names that do not exist: " + "; ".join(bad)

@@ -326,7 +326,7 @@ def test_earth_field_errors():
 
 
 def test_default_rotation_is_frames():
-    """Without a rotation provider the term uses tqdyn.frames.earth_orientation.
+    """Without a rotation provider the term uses tqdyn.astro.earth_orientation.earth_orientation.
     Against erfa.c2t06a with the EOP of the epoch day held constant: < 1e-8
     at the epoch (dX, dY ~ 1e-9 rad are the difference); 5 days later the
     held UT1-UTC is off by ~1.2 ms of LOD (~9e-8 rad), bound 3e-7."""

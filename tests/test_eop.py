@@ -1,4 +1,4 @@
-"""Tests for tqdyn.eop (IERS 14 C04 / 20 C04 / finals2000A readers, interpolation, sub-daily EOP terms).
+"""Tests for tqdyn.astro.eop (IERS 14 C04 / 20 C04 / finals2000A readers, interpolation, sub-daily EOP terms).
 
 Independent references used here:
 * The parse check of ``src/tqdyn/data/SOURCES.md`` (2004-06-06, MJD 53162:

@@ -1,4 +1,4 @@
-"""JPL ephemeris access (tqdyn.ephemeris) and the ephemeris-driven third-body
+"""JPL ephemeris access (tqdyn.astro.ephemeris) and the ephemeris-driven third-body
 term (tqdyn.forces.third_body_ephemeris).
 
 References, each independent of tqdyn's Chebyshev code:

@@ -1,4 +1,4 @@
-"""Tests for tqdyn.frames (GCRS -> ITRS, IAU 2006/2000A CIO based, IERS EOP).
+"""Tests for tqdyn.astro.earth_orientation (GCRS -> ITRS, IAU 2006/2000A CIO based, IERS EOP).
 
 Independent references used here:
 * pyerfa's composite routines evaluated directly at every instant:

@@ -291,7 +291,7 @@ def test_propagator_dense_output_vs_direct_propagation():
 
 
 class _FakeTrajectory:
-    """Duck-typed stand-in for tqdyn.io.Trajectory (dict of arrays)."""
+    """Duck-typed stand-in for tqdyn.formats.trajectory.Trajectory (dict of arrays)."""
 
     def __init__(self, fields):
         self._f = fields

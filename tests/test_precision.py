@@ -1,4 +1,4 @@
-"""The arithmetic core (tqdyn.precision) against exact references.
+"""The arithmetic core (tqdyn.numerics.dd) against exact references.
 
 References: exact rational arithmetic (fractions.Fraction) for the
 error-free transformations; mpmath at 60 significant digits (~200 bits,

@@ -144,7 +144,7 @@ def test_range_asd_white_noise_level():
 
 
 def test_flight_direction_is_minus_y_s(runs):
-    # the +flight self-gravity of tqdyn.studies is [0, -1e-9, 0] in S: check the sign on a run
+    # the +flight self-gravity of tqdyn.workflows.studies is [0, -1e-9, 0] in S: check the sign on a run
     y = metrics.flight_axis_check(io.read_trajectory(runs["dragfree"]))
     assert np.max(y) < -0.9999
     assert studies.FLIGHT_DIRECTION_S == (0.0, -1.0, 0.0)

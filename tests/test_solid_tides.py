@@ -366,7 +366,7 @@ def test_precompute_speed_53000_instants():
     t = np.linspace(0.0, 4096 * 50.0, n)
     eo = standin_orientation(EPOCH, t, cheap=True)
     tdb = tdb_jd(EPOCH, t)
-    prov = SolidTides(gm_moon=GM_MOON, gm_sun=GM_SUN)  # tqdyn.ephemeris default DE421
+    prov = SolidTides(gm_moon=GM_MOON, gm_sun=GM_SUN)  # tqdyn.astro.ephemeris default DE421
     prov.evaluate(eo, tdb)  # warm-up (numba kernels, file open)
     pos = np.random.default_rng(0).normal(size=(n, 2, 3)) * 1e9
     beta = doodson_arguments(eo.gmst, delaunay_arguments(*eo.tt))

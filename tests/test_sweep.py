@@ -1,4 +1,4 @@
-"""Parameter sweeps on Dask: tqdyn.sweep and the `tqdyn sweep` command.
+"""Parameter sweeps on Dask: tqdyn.workflows.sweep and the `tqdyn sweep` command.
 
 Reference values, independent of the sweep code:
 * the analytic effect of a constant common self-gravity a = 1e-9 m/s^2 on a
@@ -11,7 +11,7 @@ Reference values, independent of the sweep code:
 * a circular orbit (e = 0) starts at |r| = a: the a_km values typed in the
   sweep files below (Table I: Sat1 a = 100000 km);
 * the member files read with h5py directly (hi + lo), not through
-  tqdyn.io, for the gathered values;
+  tqdyn.formats.trajectory, for the gathered values;
 * TOML itself (tomllib) for the override text of the swept values.
 Members run the built-in "tianqin" scenario (coupled: attitude + drag-free
 control) with a cheap force model (Earth monopole, Moon at most) for 1 h at
@@ -80,7 +80,7 @@ def _write(tmp_path, text, name="sweep.toml"):
 
 
 def _h5_value(path, field):
-    """hi + lo of a dd field of a trajectory file, read with h5py (not tqdyn.io)."""
+    """hi + lo of a dd field of a trajectory file, read with h5py (not tqdyn.formats.trajectory)."""
     with h5py.File(path, "r") as h5:
         return h5[field]["hi"][()] + h5[field]["lo"][()]
 

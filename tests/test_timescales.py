@@ -1,4 +1,4 @@
-"""Tests for tqdyn.timescales (UTC -> TAI -> TT -> TDB at the geocenter).
+"""Tests for tqdyn.astro.timescales (UTC -> TAI -> TT -> TDB at the geocenter).
 
 References used here, independent of the code under test:
 * JD of a calendar date from Python's proleptic Gregorian ``datetime.date``

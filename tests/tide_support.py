@@ -4,10 +4,10 @@
   pyerfa (IAU 2006/2000A ``c2t06a``) and constant EOP values of 2004-06-06
   (EOP 14 C04, MJD 53162, the parse check of src/tqdyn/data/SOURCES.md):
   x_p = -0.074487", y_p = 0.475665", UT1-UTC = -0.4704721 s, TAI-UTC = 32 s.
-  It stands in for ``tqdyn.frames.earth_orientation`` (same field names).
+  It stands in for ``tqdyn.astro.earth_orientation.earth_orientation`` (same field names).
 * :class:`DirectDE421`: Sun and Moon geocentric GCRS positions read with
   jplephem from the DE421 file of ``skyfield-data`` -- independent of
-  ``tqdyn.ephemeris``.
+  ``tqdyn.astro.ephemeris``.
 * :func:`max_accel`: the largest acceleration [m/s^2] of a set of Stokes
   corrections over a sphere of radius r, from central finite differences of
   the potential V = GM/r sum (R/r)^n Pbar_nm(sin phi) (dC cos m lon + dS sin

@@ -15,7 +15,7 @@ classes :class:`Scenario`, :class:`Trajectory`, :class:`LightTravelTimes`.
 They are imported on first use, so ``import tqdyn`` stays cheap.
 """
 
-__version__ = "0.2.0.dev0"
+from ._version import __version__
 
 __all__ = ["__version__", "LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory",
            "breathing_angles", "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory",

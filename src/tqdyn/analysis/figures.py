@@ -21,11 +21,12 @@ import numpy as np
 
 from ..constellation.indices import Sat
 from . import spectra
-from .metrics import BREATHING_BAND_DEG, AsdResult, _common_rows, _t
+from .metrics import BREATHING_BAND_DEG, AsdResult, common_rows, times_s
 from .pointing_study import PointingStudy
 
 __all__ = [
     "FIGURE_FORMATS",
+    "SAT_COLORS",
     "check_figure_path",
     "figure_extensions",
     "plot_actuation",
@@ -190,7 +191,8 @@ def _time_scale_of(traj) -> str:
     return ref.time_scale if ref is not None else str(traj.attrs.get("time_scale", "TT"))
 
 
-_SAT_COLORS = ("tab:blue", "tab:orange", "tab:green")
+#: Line colour of Sat1, Sat2, Sat3 in every figure (matplotlib names).
+SAT_COLORS = ("tab:blue", "tab:orange", "tab:green")
 
 
 def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str, time_scale: str = "TT") -> list[Path]:
@@ -205,7 +207,7 @@ def plot_pointing(study: PointingStudy, out_dir: Path, stem: str, title: str, ti
         c = study.laws[law]
         for s in Sat:
             for m, what in ((0, f"<-{int(s.k)}"), (1, f"<-{int(s.j)}")):
-                ax.semilogy(d, np.maximum(c.per_beam[::k, s.index, m], 1e-30), lw=0.7, color=_SAT_COLORS[s.index],
+                ax.semilogy(d, np.maximum(c.per_beam[::k, s.index, m], 1e-30), lw=0.7, color=SAT_COLORS[s.index],
                             ls="-" if m == 0 else "--", label=f"beam Sat{int(s)} {what}")
         ax.semilogy(d, np.maximum(c.x_s[::k].max(axis=1), 1e-30), color="k", lw=0.9, ls=":", label="X_S (max over sats)")
         ax.semilogy(d, np.maximum(c.theta[::k].max(axis=1), 1e-30), color="0.45", lw=0.9, ls="-.",
@@ -225,7 +227,7 @@ def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) 
     [rad/s^2] (components in OA_l) of both TMs of ``sat``, and |A|, |G| of
     every satellite, against time (days since the epoch in the file's time scale)."""
     plt = _pyplot()
-    t = _t(traj)
+    t = times_s(traj)
     k = _stride(t.size)
     d = _days(t)[::k]
     A = traj["tm/a_suspension"][::k]
@@ -240,9 +242,9 @@ def plot_control(traj, out_dir: Path, stem: str, title: str, sat: Sat = Sat.S1) 
     axes[0].set_ylabel(f"Sat{int(sat)} suspension\nacceleration [m/s$^2$], OA$_l$")
     axes[1].set_ylabel(f"Sat{int(sat)} TM angular\nacceleration [rad/s$^2$], OA$_l$")
     for s in Sat:
-        axes[2].semilogy(d, np.linalg.norm(A[:, s.index], axis=-1).max(axis=-1), color=_SAT_COLORS[s.index], lw=0.8,
+        axes[2].semilogy(d, np.linalg.norm(A[:, s.index], axis=-1).max(axis=-1), color=SAT_COLORS[s.index], lw=0.8,
                          label=f"max$_l$ |A| Sat{int(s)}")
-        axes[2].semilogy(d, G[:, s.index], color=_SAT_COLORS[s.index], lw=0.8, ls="--", label=f"|G| Sat{int(s)}")
+        axes[2].semilogy(d, G[:, s.index], color=SAT_COLORS[s.index], lw=0.8, ls="--", label=f"|G| Sat{int(s)}")
     axes[2].set_ylabel("[m/s$^2$]")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
@@ -264,7 +266,7 @@ def plot_breathing(series: Sequence[tuple[str, np.ndarray, np.ndarray, str]], ou
     for label, t, alpha, ls in series:
         k = _stride(t.size)
         for s in Sat:
-            ax.plot(_days(t)[::k], np.degrees(alpha[::k, s.index]), ls=ls, lw=0.9, color=_SAT_COLORS[s.index],
+            ax.plot(_days(t)[::k], np.degrees(alpha[::k, s.index]), ls=ls, lw=0.9, color=SAT_COLORS[s.index],
                     label=f"alpha_{int(s)} {label}")
     if band and band_deg is not None:
         mid, half = 0.5 * (band_deg[0] + band_deg[1]), 0.5 * (band_deg[1] - band_deg[0])
@@ -303,7 +305,7 @@ def plot_arms(t, length, rate, out_dir: Path, stem: str, title: str, nominal: tu
     scale, unit = _length_unit(float(np.nanmean(length)))
     names = ("L$_{12}$", "L$_{23}$", "L$_{31}$")
     for a in range(3):
-        axes[0].plot(d, length[::k, a] / scale, color=_SAT_COLORS[a], lw=1.0, label=names[a])
+        axes[0].plot(d, length[::k, a] / scale, color=SAT_COLORS[a], lw=1.0, label=names[a])
     if nominal is not None:
         axes[0].axhline(nominal[0] / scale, color="k", lw=0.9, ls="--", label=nominal[1])
     if band is not None:
@@ -313,7 +315,7 @@ def plot_arms(t, length, rate, out_dir: Path, stem: str, title: str, nominal: tu
     axes[0].ticklabel_format(axis="y", useOffset=False)
     if rate is not None:
         for a in range(3):
-            axes[1].plot(d, rate[::k, a], color=_SAT_COLORS[a], lw=1.0, label=f"d{names[a]}/dt")
+            axes[1].plot(d, rate[::k, a], color=SAT_COLORS[a], lw=1.0, label=f"d{names[a]}/dt")
         if rate_max is not None:
             for y in (-rate_max, rate_max):
                 axes[1].axhline(y, color="red", lw=0.8, ls=":")
@@ -337,7 +339,7 @@ def plot_actuation(traj, out_dir: Path, stem: str, title: str) -> list[Path]:
     frame S (x = X_S towards the incentre, z = Z_S the constellation normal),
     and |G|."""
     plt = _pyplot()
-    t = _t(traj)
+    t = times_s(traj)
     k = _stride(t.size)
     d = _days(t)[::k]
     A = traj["tm/a_suspension"][::k]
@@ -450,10 +452,10 @@ def plot_extreme(te, ae, tg, ag, out_dir):
     vs the 60 +- 0.1 deg band, and their difference [deg]."""
     plt = _pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
-    _, ia, ib = _common_rows(te, tg)
+    _, ia, ib = common_rows(te, tg)
     k = _stride(te.size)
     for s in Sat:
-        c = _SAT_COLORS[s.index]
+        c = SAT_COLORS[s.index]
         axes[0].plot(_days(te)[::k], np.degrees(ae[::k, s.index]), color=c, lw=0.9, label=f"alpha_{int(s)} extreme")
         axes[0].plot(_days(tg)[::k], np.degrees(ag[::k, s.index]), color=c, lw=0.7, ls=":",
                      label=f"alpha_{int(s)} gravity orbit")

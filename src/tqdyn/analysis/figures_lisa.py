@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..constellation.indices import Sat
-from .figures import _SAT_COLORS, _days, _pyplot, _save, _stride
+from .figures import SAT_COLORS, _days, _pyplot, _save, _stride
 
 __all__ = ["plot_arm_response", "plot_deviation", "plot_esa_ramp", "plot_estimate"]
 
@@ -38,7 +38,7 @@ def plot_estimate(panels: Sequence[tuple], out_dir: Path, stem: str, title: str)
         d = _days(t)[::k]
         for col, (ax, meas, est, what) in enumerate(((row[0], G, Ge, "|G|"), (row[1], A, Ae, "max |A| comp."))):
             for s in Sat:
-                c = _SAT_COLORS[s.index]
+                c = SAT_COLORS[s.index]
                 ax.plot(d, meas[::k, s.index], color=c, lw=0.9, label=f"Sat{int(s)} run")
                 if est is not None:
                     ax.plot(d, est[::k, s.index], color=c, lw=0.9, ls="--", label=f"Sat{int(s)} formula")
@@ -118,7 +118,7 @@ def plot_esa_ramp(t, along, along_pred, angle_deg, angle_est_deg, vs_files: Sequ
     k = _stride(t.size)
     d = _days(t)[::k]
     for s in Sat:
-        c = _SAT_COLORS[s.index]
+        c = SAT_COLORS[s.index]
         axes[0].plot(d, along[::k, s.index] / 1e3, color=c, lw=1.2, label=f"Sat{int(s)} coupled - point mass")
         axes[0].plot(d, along_pred[::k, s.index] / 1e3, color=c, lw=1.0, ls="--", label=f"Sat{int(s)} CW prediction")
         axes[1].plot(d, angle_deg[::k, s.index], color=c, lw=1.2, label=f"Sat{int(s)} X_S vs centroid")
@@ -127,7 +127,7 @@ def plot_esa_ramp(t, along, along_pred, angle_deg, angle_est_deg, vs_files: Sequ
     for label, tf, dr, ls in vs_files:
         kk = _stride(tf.size)
         for s in Sat:
-            axes[2].semilogy(_days(tf)[::kk], np.maximum(dr[::kk, s.index], 1e-3), color=_SAT_COLORS[s.index], ls=ls,
+            axes[2].semilogy(_days(tf)[::kk], np.maximum(dr[::kk, s.index], 1e-3), color=SAT_COLORS[s.index], ls=ls,
                              lw=1.0, label=f"Sat{int(s)} {label}")
     axes[0].set_ylabel("along-track difference [km]")
     axes[1].set_ylabel("angle X_S to centroid [deg]")

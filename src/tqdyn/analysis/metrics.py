@@ -54,10 +54,17 @@ __all__ = [
     "actuation_values",
     "arm_lengths_of",
     "breathing_angles_of",
+    "common_rows",
+    "control_values",
+    "dd_difference",
     "flight_axis_check",
+    "is_uniform_grid",
+    "link_of",
     "orbit_deviation",
     "range_asd_in_band",
+    "sat_light_travel_times",
     "secular_along_track_drift",
+    "times_s",
 ]
 
 #: Constellation-stability requirement on the breathing angles [deg]: 60 +- 0.1.
@@ -118,7 +125,10 @@ def arm_lengths_of(traj) -> tuple[np.ndarray, np.ndarray | None]:
     return a.length[..., :3], rate
 
 
-def _t(traj) -> np.ndarray:
+def times_s(traj) -> np.ndarray:
+    """Row times (N,) [s since the file's epoch, in its time scale] of a
+    trajectory, rounded to float64 (hi + lo): for plotting and for matching
+    rows, never for differences that need the dd time."""
     hi, lo = traj.dd("t")
     return hi + lo
 
@@ -135,7 +145,9 @@ def breathing_angles_of(traj) -> np.ndarray:
     return alpha
 
 
-def _common_rows(t_a, t_b):
+def common_rows(t_a, t_b):
+    """(t, ia, ib): the times [s] two row grids share (matched to 1 us) and
+    their row indices in each."""
     common, ia, ib = np.intersect1d(np.round(t_a, 6), np.round(t_b, 6), return_indices=True)
     return common, ia, ib
 
@@ -162,7 +174,7 @@ def orbit_deviation(run, ref) -> Deviation | None:
     no time row or no satellite count."""
     if run.n_sat != ref.n_sat:
         return None
-    t, ia, ib = _common_rows(_t(run), _t(ref))
+    t, ia, ib = common_rows(times_s(run), times_s(ref))
     if t.size == 0:
         return None
     ah, al = run.dd("sat/r")
@@ -280,30 +292,34 @@ def _sat_acceleration(traj) -> np.ndarray:
     return acc
 
 
-def _sat_light_path(traj):
+def sat_light_travel_times(traj):
     """Light paths between satellite centres (c tau, six links)."""
     return light_travel_times(traj.dd("t"), traj.dd("sat/r"), traj.dd("sat/v"), _sat_acceleration(traj),
                               note="satellite centre of mass to satellite centre of mass")
 
 
-def _uniform(t) -> bool:
+def is_uniform_grid(t) -> bool:
+    """True if the times ``t`` (N,) [s] are increasing with a constant step
+    (to 1e-6 of the median step) and there are at least three."""
     if t.size < 3:
         return False
     d = np.diff(t)
     return bool(np.all(d > 0) and np.max(np.abs(d - np.median(d))) <= 1e-6 * np.median(d))
 
 
-def _link_dd(pair, link: Link):
+def link_of(pair, link: Link):
+    """The (hi, lo) series (N,) of ``link`` from a dd pair of per-link arrays (N, 6)."""
     return pair[0][:, link.index], pair[1][:, link.index]
 
 
-def _diff_dd(a, b):
+def dd_difference(a, b):
+    """a - b of two dd pairs (hi, lo), in dd."""
     from ..numerics.dd import np_dd_add
 
     return np_dd_add(a[0], a[1], -b[0], -b[1])
 
 
-def _control_values(tr) -> dict:
+def control_values(tr) -> dict:
     """Maxima of the control magnitudes of a coupled run: |A| (TM suspension,
     m/s^2), |alpha| (rad/s^2), |G| (m/s^2), |A_1 - A_2| (the two TMs' actuation
     compared in S) over the run and over its first day (``*_day1``)."""
@@ -316,7 +332,7 @@ def _control_values(tr) -> dict:
     A_S = np.stack([A[..., 0] * c - A[..., 1] * s, A[..., 0] * s + A[..., 1] * c, A[..., 2]], -1)
     dA = np.linalg.norm(A_S[:, :, 0] - A_S[:, :, 1], axis=-1)
     nA, nW, nG = (np.linalg.norm(x, axis=-1) for x in (A, W, G))
-    t = _t(tr)
+    t = times_s(tr)
     day1 = t - t[0] <= 86400.0
     return {"max_A": float(nA.max()), "max_alpha": float(nW.max()), "max_G": float(nG.max()),
             "max_dA": float(dA.max()), "max_G_per_sat": nG.max(axis=0), "max_A_per_sat": nA.max(axis=(0, 2)),

@@ -170,7 +170,7 @@ def pointing_study_of(trajectory, *, laws=APPROXIMATE_LAWS, stride: int = 1, max
                       tol: float = 1e-20) -> PointingStudy:
     """:func:`compare_pointing_laws` on a trajectory object.
 
-    ``trajectory`` is duck-typed like :class:`tqdyn.io.Trajectory`
+    ``trajectory`` is duck-typed like :class:`tqdyn.formats.trajectory.Trajectory`
     (``trajectory.dd(name)``, ``trajectory[name]``, ``name in trajectory``,
     ``trajectory.attrs``).  Uses ``t``, ``sat/r``, ``sat/v`` and the total
     acceleration ``sat/a_gravity`` (+ ``sat/a_dragfree`` when the root

@@ -14,7 +14,7 @@ with, in TN36's notation,
   a = 1/(1 + sqrt(1 - X^2 - Y^2)) (TN36 eq. 5.10);
 * R = R3(-ERA): Earth rotation angle of UT1 (IAU 2000, ``erfa.era00``);
 * W = R3(-s') R2(x_p) R1(y_p): polar motion (C04 x_p, y_p plus, by default,
-  the IERS sub-daily ocean-tide and libration terms, see :mod:`tqdyn.eop`)
+  the IERS sub-daily ocean-tide and libration terms, see :mod:`tqdyn.astro.eop`)
   and the TIO locator s' = -47 uas t (TN36 eq. 5.13, as ``erfa.sp00``).
 
 R1, R2, R3 are the usual frame rotations (R3(a) = [[cos a, sin a, 0],
@@ -279,7 +279,7 @@ def earth_orientation(epoch: Epoch, t_hi, t_lo=0.0, eop: EOP | None = None, *, u
 
     Parameters
     ----------
-    epoch : :class:`tqdyn.timescales.Epoch` -- the scenario epoch.
+    epoch : :class:`tqdyn.astro.timescales.Epoch` -- the scenario epoch.
     t_hi, t_lo : float or array_like [s] -- TT seconds since the epoch as a
         double-double (broadcast together; ``t_lo`` may be 0).
     eop : :class:`tqdyn.astro.eop.EOP` or None -- EOP table (default: the

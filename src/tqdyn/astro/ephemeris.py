@@ -54,7 +54,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..readers.pck import _shipped_gm
+from ..readers.pck import shipped_gm
 from .constants import DAY_S, J2000_JD
 
 __all__ = [
@@ -64,6 +64,7 @@ __all__ = [
     "Ephemeris",
     "default_ephemeris",
     "default_ephemeris_path",
+    "ephemeris_named",
     "planetary_gm",
 ]
 
@@ -547,13 +548,20 @@ def default_ephemeris() -> Ephemeris:
     return eph
 
 
+def ephemeris_named(name_or_path: str) -> Ephemeris:
+    """The JPL ephemeris a scenario names (``forces.ephemeris``): ``"de421"``
+    (any case) is the shipped one (:func:`default_ephemeris`), anything else
+    the path of a .bsp file."""
+    return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
+
+
 # --------------------------------------------------------------------------
 # GMs
 
 
 @functools.lru_cache(maxsize=1)
 def _planetary_gm() -> tuple[tuple[str, float], ...]:
-    gm = _shipped_gm()
+    gm = shipped_gm()
     return tuple((name, gm[naif]) for name, naif in NAIF_ID.items())
 
 

@@ -59,6 +59,7 @@ from .constants import ARCSEC_RAD, J2000_JD
 
 __all__ = [
     "ARCSEC_RAD",
+    "LIBRATIONS",
     "T_PA_ME_DE421",
     "lunar_iau_rotation",
     "lunar_pa_euler_angles",
@@ -70,7 +71,9 @@ __all__ = [
 #: Days per Julian century.
 _CENTURY_D = 36525.0
 
-_LIBRATIONS = ("de421", "iau")
+#: The lunar orientation models (``libration`` of :func:`lunar_pa_rotation`):
+#: the DE421 librations (binary PCK) or the IAU rotation elements.
+LIBRATIONS = ("de421", "iau")
 
 
 def _r1(a):
@@ -253,4 +256,4 @@ def lunar_pa_rotation(jd1, jd2, libration: str = "de421", kernel=None) -> np.nda
         return _pa_angles_and_matrix(jd1, jd2, kernel)[1]
     if libration == "iau":
         return _iau_matrix(jd1, jd2, None, T_PA_ME_DE421)
-    raise ValueError(f"lunar orientation: libration {libration!r} is not one of {_LIBRATIONS}")
+    raise ValueError(f"lunar orientation: libration {libration!r} is not one of {LIBRATIONS}")

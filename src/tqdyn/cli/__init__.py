@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import click
 
-from .. import __version__
+from .._version import __version__
 from ..workflows.heap import bound_heap_retention
 from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 from .bench import bench as _bench_command

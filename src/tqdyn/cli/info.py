@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import click
 
-from .. import __version__
+from .._version import __version__
 
 __all__ = ["info"]
 
@@ -23,7 +23,7 @@ def info():
     from ..astro.eop_sources import describe_sources
     from ..astro.reference import REFERENCE_SYSTEMS
     from ..forces.model import describe_terms
-    from ..numerics import _dp87_tableau
+    from ..numerics.dp87 import CORRECTED_TABLEAU_PROVENANCE
     from ..scenario import builtin_scenarios
 
     def version(mod):
@@ -42,7 +42,7 @@ def info():
              "precision: dd (compiled double-double, ~32 digits, FMA two-product) | float64",
              "integrator: Prince-Dormand RK8(7)13M, fixed step or adaptive (embedded 7th order), "
              "Hermite dense output",
-             f"  tableaux: corrected (default; {_dp87_tableau.__doc__.splitlines()[0].strip()}) | published "
+             f"  tableaux: corrected (default; {CORRECTED_TABLEAU_PROVENANCE}) | published "
              "(GSL rk8pd.c / GMAT rationals, order conditions hold to ~6.5e-18)",
              "force models:"]
     for name, description, source in describe_terms():

@@ -20,7 +20,7 @@ import sys
 
 import click
 
-from .. import __version__
+from .._version import __version__
 from ._common import (EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, EXIT_SIGHUP, EXIT_SIGTERM,
                       _overrides, fail as _fail)
 
@@ -75,9 +75,9 @@ def _check_stop(pending: dict) -> None:
 def _fail_io(message: str):
     """One line, exit status 3; if HDF5 could not close a file, end without
     the interpreter's exit handlers (HDF5 would crash in them)."""
-    from ..formats.trajectory import _h5safe
+    from ..formats.trajectory import hdf5_poisoned
 
-    if _h5safe.HDF5_POISONED:  # pragma: no cover - the writer avoids it
+    if hdf5_poisoned():  # pragma: no cover - the writer avoids it
         click.echo(f"tqdyn: error: {message}", err=True)
         sys.stdout.flush()
         sys.stderr.flush()

@@ -17,7 +17,7 @@ import sys
 
 import click
 
-from .. import __version__
+from .._version import __version__
 from ._common import EXIT_FAILED as _EXIT_MEMBER_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
 from ._common import fail as _fail
 

@@ -405,7 +405,7 @@ def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: n
 
     cpar: the system's parameters (:attr:`System.cpar`; default: point
     masses).  With ``with_aux`` returns (k, aux), aux the (AUX_LEN,)
-    diagnostics of the coupled modes (see :func:`tqdyn.dynamics.aux_views`).
+    diagnostics of the coupled modes (see :func:`tqdyn.dynamics.layout.aux_views`).
     """
     k = np.zeros_like(y)
     cpar = make_cpar(MODE_POINT_MASS) if cpar is None else cpar

@@ -21,7 +21,8 @@ from ..astro.ephemeris import planetary_gm
 from ..constellation._kinematics_jit import LAW_CODES
 from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
 from ..forces.earth import EarthField
-from ..forces.model import ForceModel, _ephemeris, build_force_model
+from ..astro.ephemeris import ephemeris_named
+from ..forces.model import ForceModel, build_force_model
 from . import layout as _lay
 
 __all__ = ["System", "build_system", "centre_ramp", "self_gravity_oa"]
@@ -129,7 +130,7 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
         bodies = tuple(f.third_bodies) if law else ()
     else:
         bodies = tuple(b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies) if law else ()
-    eph = _ephemeris(f.ephemeris) if bodies else None
+    eph = ephemeris_named(f.ephemeris) if bodies else None
     gms = planetary_gm()
     ramp = scenario.self_gravity_centre_ramp()
     if model is None and (law or ramp is not None):

@@ -11,7 +11,7 @@ degree 1 vanishes (geocentric ITRS origin).
 
 Time-only inputs (:meth:`EarthField.precompute`, once per chunk of
 instants): the rotation matrix T_ITRS_GCRS (9 values, row-major), by default
-from ``tqdyn.frames.earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS``
+from ``tqdyn.astro.earth_orientation.earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS``
 (IAU 2006/2000A + EOP), and the sum of the coefficient corrections dC, dS
 of the tide providers in ``tides`` (solid, ocean, pole, atmospheric tides),
 each a callable (epoch, t_hi, t_lo) -> (dC, dS) of shape (..., k+1, k+1)
@@ -24,7 +24,7 @@ Permanent tide: the default static field is EGM2008 **tide-free**, which is
 consistent with an IERS 2010 solid-tide model that keeps the permanent
 (time-average) part of its dC20 (TN36 sec. 6.2 step 1 as computed).  With a
 zero-tide field the solid-tide model must remove it (TN36 eq. 6.14).  See
-:mod:`tqdyn.forces.gravity_models`.  A tide provider may declare
+:mod:`tqdyn.readers.gravity_fields`.  A tide provider may declare
 ``permanent_tide = "included"`` or ``"removed"``; :class:`EarthField`
 rejects a combination that counts the permanent deformation zero or two
 times.
@@ -70,11 +70,11 @@ N_ROT = 9
 
 
 def _frames_rotation(epoch, t_hi, t_lo):
-    """T_ITRS_GCRS (..., 3, 3) from :func:`tqdyn.frames.earth_orientation`."""
+    """T_ITRS_GCRS (..., 3, 3) from :func:`tqdyn.astro.earth_orientation.earth_orientation`."""
     try:
         from ..astro.earth_orientation import earth_orientation
     except ImportError as exc:
-        raise ImportError("EarthField: tqdyn.frames.earth_orientation is not available; "
+        raise ImportError("EarthField: tqdyn.astro.earth_orientation.earth_orientation is not available; "
                           "pass a rotation provider (rotation=...)") from exc
     return earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS
 
@@ -131,7 +131,7 @@ class EarthField:
     rotation : callable, optional
         (epoch, t_hi, t_lo) -> T_ITRS_GCRS (*shape(t_hi), 3, 3) float64
         (maps GCRS vectors into ITRS).  Default:
-        ``tqdyn.frames.earth_orientation(...).T_ITRS_GCRS``.
+        ``tqdyn.astro.earth_orientation.earth_orientation(...).T_ITRS_GCRS``.
     tide_degree : int, optional
         Degree nt of the summed corrections (default: the largest degree of
         the providers; -1 if there are none).

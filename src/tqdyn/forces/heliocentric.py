@@ -51,9 +51,9 @@ __all__ = ["CentralJ2", "HeliocentricPositions", "SunMonopole", "central_j2_acce
 def _gm_sun_decimal() -> str:
     """GM of the Sun [m^3/s^2] as the exact decimal of the shipped GM file (DE430/DE431:
     BODY10_GM = 1.3271244004193938E+11 km^3/s^2), for the dd monopole."""
-    from ..readers.pck import _shipped_gm
+    from ..readers.pck import shipped_gm
 
-    return str(_shipped_gm(exact=True)[10])
+    return str(shipped_gm(exact=True)[10])
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
 from .central import EarthMonopole, monopole
@@ -126,13 +127,6 @@ def describe_terms() -> list[tuple[str, str, str]]:
     return [(cls.name, cls.description, cls.source) for cls in classes]
 
 
-def _ephemeris(name_or_path: str):
-    """The JPL ephemeris of a scenario: "de421" (shipped) or a .bsp path."""
-    from ..astro.ephemeris import Ephemeris, default_ephemeris
-
-    return default_ephemeris() if name_or_path.lower() == "de421" else Ephemeris(name_or_path)
-
-
 class _Orientation:
     """Earth orientation with one EOP table (None: no EOP), as a picklable
     callable (epoch, t_hi, t_lo) -> EarthOrientation; ``.rotation`` gives
@@ -194,7 +188,7 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
         terms.append(EarthMonopole(gm=forces.gm_earth))
     needs_ephemeris = (forces.third_bodies or forces.relativity or forces.moon_degree or forces.sun_j2
                        or forces.solid_tides or forces.earth_field_indirect)
-    eph = _ephemeris(forces.ephemeris) if needs_ephemeris else None
+    eph = ephemeris_named(forces.ephemeris) if needs_ephemeris else None
     if eop is _FROM_CONFIG:
         from ..astro.eop_sources import eop_table
 
@@ -236,7 +230,7 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     terms = []
     if forces.sun_monopole:
         terms.append(SunMonopole())
-    eph = _ephemeris(forces.ephemeris) if forces.third_bodies else None
+    eph = ephemeris_named(forces.ephemeris) if forces.third_bodies else None
     if forces.third_bodies:
         terms.append(heliocentric_third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended))
     if forces.sun_j2:

@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
-from ..astro.lunar_orientation import _LIBRATIONS, lunar_pa_rotation
+from ..astro.lunar_orientation import LIBRATIONS, lunar_pa_rotation
 from ..astro.timescales import tdb_jd
 from .spherical_harmonics import sh_accel
 
@@ -185,8 +185,8 @@ class MoonField:
             raise ValueError(f"MoonField: degree must be an integer, got {self.degree!r}")
         if self.degree < 2:
             raise ValueError(f"MoonField: degree {self.degree} < 2 (the monopole is the third-body term)")
-        if self.libration not in _LIBRATIONS:
-            raise ValueError(f"MoonField: libration {self.libration!r} is not one of {_LIBRATIONS}")
+        if self.libration not in LIBRATIONS:
+            raise ValueError(f"MoonField: libration {self.libration!r} is not one of {LIBRATIONS}")
         self.model()  # ValueError now if the degree exceeds the coefficient file's
 
     def model(self):

@@ -139,7 +139,7 @@ class SolidPoleTide(_PoleTide):
     ``provider(epoch, t_hi, t_lo)`` -> (dC, dS), float64 S + (3, 3) [n, m],
     dimensionless, fully normalised, ITRS; only [2, 1] is non-zero.
     orientation: callable (epoch, t_hi, t_lo) -> object with xp, yp [rad]
-    and tt (jd1, jd2); None -> :func:`tqdyn.frames.earth_orientation`.
+    and tt (jd1, jd2); None -> :func:`tqdyn.astro.earth_orientation.earth_orientation`.
     """
 
     name: str = field(default="solid_pole_tide", init=False)

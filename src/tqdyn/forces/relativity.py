@@ -219,7 +219,7 @@ class Relativity:
         Switch each of the three terms.
     ephemeris : Ephemeris or None
         Source of the Sun's geocentric state for de Sitter (``None``: the
-        shipped DE421, :func:`tqdyn.ephemeris.default_ephemeris`).
+        shipped DE421, :func:`tqdyn.astro.ephemeris.default_ephemeris`).
     j_axis : str
         Direction of J: ``"cip"`` (rotation axis, default) or ``"gcrs_z"``.
     gm_earth : float
@@ -229,7 +229,7 @@ class Relativity:
     beta, gamma : float
         PPN parameters, 1 in general relativity.
 
-    GM_S comes from :func:`tqdyn.ephemeris.planetary_gm` (DE430/431), c is
+    GM_S comes from :func:`tqdyn.astro.ephemeris.planetary_gm` (DE430/431), c is
     exact (299792458 m/s).
     """
 

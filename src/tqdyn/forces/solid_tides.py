@@ -232,7 +232,7 @@ def _resolve_orientation(orientation):
     try:
         from ..astro.earth_orientation import earth_orientation
     except ImportError as exc:
-        raise ImportError("tides: tqdyn.frames.earth_orientation is not available "
+        raise ImportError("tides: tqdyn.astro.earth_orientation.earth_orientation is not available "
                           f"({exc}); pass orientation=callable(epoch, t_hi, t_lo)") from None
     return earth_orientation
 

@@ -137,7 +137,7 @@ class ThirdBodies:
     names: tuple[str, ...]
     gms: tuple[float, ...]
     position: Callable
-    source: str = "JPL DE ephemeris via tqdyn.ephemeris (or user-supplied positions)"
+    source: str = "JPL DE ephemeris via tqdyn.astro.ephemeris (or user-supplied positions)"
     extended: tuple[str, ...] = ()
     name: str = field(default="third_body", init=False)
     description: str = field(default="point-mass third bodies, direct + indirect term (Battin)", init=False)

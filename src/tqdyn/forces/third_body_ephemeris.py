@@ -80,8 +80,8 @@ _GRID_S = 3600.0
 
 def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=(), gcrs: bool = True) -> ThirdBodies:
     """Third-body term for ``names`` (default: all of
-    :data:`tqdyn.ephemeris.BODIES`) with positions from ``ephemeris``
-    (``None``: the shipped DE421, :func:`tqdyn.ephemeris.default_ephemeris`)
+    :data:`tqdyn.astro.ephemeris.BODIES`) with positions from ``ephemeris``
+    (``None``: the shipped DE421, :func:`tqdyn.astro.ephemeris.default_ephemeris`)
     and GMs [m^3/s^2] from ``data/gm_de431.tpc``; the bodies named in
     ``extended`` (and in ``names``) are evaluated in extended precision.
     ``gcrs``: positions and GMs in the TT-compatible GCRS (the GMs times

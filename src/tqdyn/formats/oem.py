@@ -46,7 +46,7 @@ from collections.abc import Sequence
 import erfa
 import numpy as np
 
-import tqdyn
+from .._version import __version__
 
 from ..readers.oem import GEOCENTRIC, HELIOCENTRIC, INTERPOLATIONS, REF_FRAMES, TIME_SYSTEMS
 from . import trajectory as _io
@@ -227,7 +227,7 @@ def _kvn(parts: list[dict], originator: str, creation_date: str, comments: list[
 
 
 def _default_comments(parts: list[dict]) -> list[str]:
-    lines = [f"written by tqdyn {tqdyn.__version__}",
+    lines = [f"written by tqdyn {__version__}",
              "units: positions km, velocities km/s" + (", accelerations km/s**2" if any(
                  p["values"].shape[1] == 9 for p in parts) else "")]
     systems = {(p["meta"]["CENTER_NAME"], p["meta"]["REF_FRAME"], p["meta"]["TIME_SYSTEM"]) for p in parts}

@@ -17,7 +17,7 @@ Two tableaux are available:
   use them.
 
 The compiled functions here are generic over the number type (see
-:mod:`tqdyn.precision`): coefficient and state arrays with a trailing dd axis
+:mod:`tqdyn.numerics.dd`): coefficient and state arrays with a trailing dd axis
 give double-double arithmetic, plain float64 arrays give float64.  They work
 on a state array ``y`` of shape (n_body, 6) -- rows (x, y, z, vx, vy, vz) in
 m and m/s -- and stage derivatives ``K`` of shape (13, n_body, 6); the
@@ -37,7 +37,7 @@ from .dd import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
 
 __all__ = [
-    "TABLEAUX", "Tableau", "load_tableau", "StepCoefficients",
+    "CORRECTED_TABLEAU_PROVENANCE", "TABLEAUX", "Tableau", "load_tableau", "StepCoefficients",
     "stage_state", "combine", "error_norm", "ORDER", "ERROR_ORDER",
 ]
 
@@ -45,6 +45,8 @@ __all__ = [
 ORDER = 8
 ERROR_ORDER = 7
 TABLEAUX = ("corrected", "published")
+#: Where the corrected tableau comes from (the first line of its generated module's docstring).
+CORRECTED_TABLEAU_PROVENANCE = _tab.__doc__.splitlines()[0].strip()
 _N = _tab.STAGES
 
 

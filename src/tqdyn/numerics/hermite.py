@@ -11,7 +11,7 @@ propagation to the same instant.
 
 The polynomial is built in Newton form from confluent divided differences
 on the scaled time s = (t - t_0) / h (nodes at integers), in the number type
-of the data (generic dd / float64, see :mod:`tqdyn.precision`): the large
+of the data (generic dd / float64, see :mod:`tqdyn.numerics.dd`): the large
 position enters only through the first coefficient, so dd positions keep
 their ~1e-24 m resolution.  Velocity is the derivative of the same
 polynomial (one order less accurate).

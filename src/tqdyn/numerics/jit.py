@@ -9,6 +9,13 @@ lives in ``$TQDYN_CACHE_DIR`` (default ``~/.cache/tqdyn``); if it cannot be
 created, numba falls back to its usual locations.  Compilation happens once
 per machine and package version instead of once per process.
 
+Every source version gets its own folder ``<cache>/numba/<stamp>``, so
+folders of versions that are no longer installed pile up (tens of MB each).
+:func:`prune_stale_caches` removes the folders of other versions that have
+not been used for :data:`STALE_AFTER_DAYS` days (each process touches its own
+folder's ``last-used`` file once); it runs at most once a day per machine
+(the ``last-prune`` file), when the locator is installed.
+
 The locator plugs into numba's caching internals; if those change in a
 future numba, tqdyn keeps working and numba's default locators are used.
 """
@@ -19,12 +26,22 @@ import functools
 import hashlib
 import os
 import pathlib
+import shutil
+import time
 
 import numba
 
-__all__ = ["cache_dir", "install_cache_locator"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "install_cache_locator", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
+
+#: A version's kernel folder unused for this many days is removed by
+#: :func:`prune_stale_caches` (long enough that two installs used side by side,
+#: e.g. a release and a development checkout, never delete each other's kernels).
+STALE_AFTER_DAYS = 30.0
+#: Seconds between two prunes on one machine (one directory listing per day).
+_PRUNE_EVERY_S = 86400.0
+_STAMP_CHARS = 16
 
 
 def cache_dir() -> pathlib.Path:
@@ -66,7 +83,7 @@ def install_cache_locator() -> bool:
             # install of the same sources shares it, old versions' folders are
             # simply never read again
             sub = pathlib.Path(py_file).resolve().parent.relative_to(_PACKAGE)
-            self._cache_path = str(cache_dir() / _package_stamp()[:16] / sub)
+            self._cache_path = str(cache_dir() / _package_stamp()[:_STAMP_CHARS] / sub)
 
         def get_cache_path(self):
             return self._cache_path
@@ -91,7 +108,51 @@ def install_cache_locator() -> bool:
             return self
 
     classes.insert(0, TqdynCacheLocator)
+    try:
+        prune_stale_caches()
+    except OSError:
+        pass  # a read-only or vanished cache folder: nothing to clean
     return True
+
+
+def _touch(path: pathlib.Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.touch()
+
+
+def prune_stale_caches(now: float | None = None, stale_after_days: float = STALE_AFTER_DAYS,
+                       force: bool = False) -> list[pathlib.Path]:
+    """Remove the kernel folders of other package versions unused for
+    ``stale_after_days`` days; returns the removed folders.
+
+    The current version's folder is marked as used (its ``last-used`` file
+    is touched) and never removed; a folder without a ``last-used`` file
+    counts by its own modification time.  Unless ``force``, nothing is done
+    if the last prune on this machine was less than a day ago (``now``: a
+    POSIX time [s], default the current time).  A folder that another process
+    removes at the same time is skipped.
+    """
+    root = cache_dir()
+    now = time.time() if now is None else now
+    current = root / _package_stamp()[:_STAMP_CHARS]
+    _touch(current / "last-used")
+    marker = root / "last-prune"
+    if not force and marker.exists() and now - marker.stat().st_mtime < _PRUNE_EVERY_S:
+        return []
+    _touch(marker)
+    removed = []
+    for folder in root.iterdir():
+        if folder == current or not folder.is_dir() or len(folder.name) != _STAMP_CHARS:
+            continue
+        used = folder / "last-used"
+        try:
+            last = (used if used.exists() else folder).stat().st_mtime
+        except OSError:
+            continue
+        if now - last > stale_after_days * 86400.0:
+            shutil.rmtree(folder, ignore_errors=True)
+            removed.append(folder)
+    return removed
 
 
 install_cache_locator()

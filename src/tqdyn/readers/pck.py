@@ -9,7 +9,7 @@
   of the Sun (:func:`read_iau_sun_elements` -> :class:`IauSunElements`),
   through the generic text-kernel parser :mod:`tqdyn.readers.naif`;
 * the text PCK ``gm_de431.tpc``: the GMs of the DE430/DE431 ephemerides
-  (:func:`parse_gm_tpc`; the shipped file via ``_shipped_gm``, used by
+  (:func:`parse_gm_tpc`; the shipped file via :func:`shipped_gm`, used by
   :func:`tqdyn.astro.ephemeris.planetary_gm`).
 
 Readers only: the orientation models are evaluated in
@@ -36,6 +36,7 @@ __all__ = [
     "parse_gm_tpc",
     "read_iau_moon_elements",
     "read_iau_sun_elements",
+    "shipped_gm",
 ]
 
 #: Default data files (in ``tqdyn/data``).
@@ -230,7 +231,7 @@ def parse_gm_tpc(text: str, *, exact: bool = False) -> dict[int, float]:
 
 
 @functools.lru_cache(maxsize=1)
-def _shipped_gm(exact: bool = False) -> dict[int, float]:
+def shipped_gm(exact: bool = False) -> dict[int, float]:
     """{NAIF id: GM [m^3/s^2]} of the shipped ``data/gm_de431.tpc`` (float64, or exact Decimals)."""
     path = importlib.resources.files("tqdyn") / "data" / "gm_de431.tpc"
     if not path.is_file():

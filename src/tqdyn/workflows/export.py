@@ -48,7 +48,7 @@ import os
 
 import numpy as np
 
-from .. import __version__ as _TQDYN_VERSION
+from .._version import __version__ as _TQDYN_VERSION
 from ..astro.constants import GM_EARTH_EGM2008
 from ..formats import trajectory as _io
 from ..formats.lisa import (AXES, FRAMES, TIME_ORIGINS, _FRAME, _TIME, _TPS_DEFINITION, _uniform_grid, write_lisa_orbits)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import erfa
 import numpy as np
 
-from .. import __version__ as _TQDYN_VERSION
+from .._version import __version__ as _TQDYN_VERSION
 from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, J2000_JD, L_B
 from ..astro.geocentric import gcrs_to_bcrs_offsets
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER

@@ -33,7 +33,7 @@ short SHA-256 of the resolved scenario (with ``run.output`` normalised), so a
 scaled ("quick") set and the full set can coexist.  A run whose file is a
 complete trajectory of the same resolved scenario is reused, anything else
 is (re)run.  Pending runs execute as tasks on a Dask ``LocalCluster``
-(processes, 1 thread each; as in :mod:`tqdyn.sweep`, whose ``run_sweep``
+(processes, 1 thread each; as in :mod:`tqdyn.workflows.sweep`, whose ``run_sweep``
 is not used because it gathers all members, on one time grid, into one
 netCDF file) or in this process when only one worker is asked for.
 
@@ -242,33 +242,12 @@ class PlannedRun:
 
 
 def run_complete(path, canonical_toml: str) -> bool:
-    """True if ``path`` is a readable tqdyn trajectory of the scenario
-    ``canonical_toml`` (compared with ``run.output`` normalised) whose last
-    time row is the scenario's duration."""
-    import h5py
+    """True if ``path`` is a complete run of the study scenario
+    ``canonical_toml`` (resolved with the studies' ``run.output``
+    placeholder): :func:`tqdyn.formats.trajectory.run_is_complete`."""
+    from ..formats.trajectory import run_is_complete
 
-    from ..formats import trajectory as io
-    from ..scenario import ScenarioError, loads_scenario
-
-    try:
-        with h5py.File(path, "r") as h5:
-            if h5.attrs.get("format") != io.FORMAT:
-                return False
-            stored = h5.attrs.get("scenario", "")
-            stored = stored.decode("utf-8") if isinstance(stored, bytes) else str(stored)
-            n = h5["t/hi"].shape[0]
-            if n == 0:
-                return False
-            t_end = float(h5["t/hi"][n - 1]) + float(h5["t/lo"][n - 1])
-    except (OSError, KeyError, ValueError, TypeError):
-        return False
-    try:
-        scen = loads_scenario(stored, [f"run.output={_PLACEHOLDER}"])
-    except ScenarioError:
-        return False
-    if scen.to_toml() != canonical_toml:
-        return False
-    return abs(t_end - float(scen.run.duration_s)) <= 1e-6 * float(scen.integrator.step_s)
+    return run_is_complete(path, canonical_toml, _PLACEHOLDER)
 
 
 def _check_names(studies, catalogue=None) -> tuple[str, ...]:

@@ -10,13 +10,13 @@ from typing import Any, Mapping
 import h5py
 import numpy as np
 
-from ... import __version__ as _TQDYN_VERSION
+from ..._version import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
 from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, ReferenceSystem
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["SpacecraftRecord", "Trajectory", "read_trajectory"]
+__all__ = ["SpacecraftRecord", "Trajectory", "read_trajectory", "run_is_complete"]
 
 
 @dataclass(frozen=True)
@@ -431,3 +431,38 @@ def _read_open(h5, p, fname) -> Trajectory:
             raise TrajectoryFormatError(f"{fname}: {f!r} has shape {_fmt_shape(shape)}, expected "
                                         f"{_fmt_shape(expected)}")
     return Trajectory(p, attrs, data, n_sat)
+
+
+def run_is_complete(path, canonical_toml: str, output_placeholder: str) -> bool:
+    """True if ``path`` is a complete run of the scenario ``canonical_toml``.
+
+    Complete means: a readable tqdyn trajectory whose stored resolved
+    scenario, with ``run.output`` set to ``output_placeholder``, is
+    ``canonical_toml`` (which must have been resolved with the same
+    placeholder, so that a moved output folder still counts), and whose last
+    time row is ``run.duration`` (within 1e-6 of the step [s], at least 1e-6 s).
+    Anything else -- missing, unreadable, another scenario, cut short -- is
+    False: the caller runs it (again).  Used by the studies and the sweeps.
+    """
+    from ...scenario import ScenarioError, loads_scenario
+
+    try:
+        with h5py.File(path, "r") as h5:
+            if h5.attrs.get("format") != FORMAT:
+                return False
+            stored = h5.attrs.get("scenario", "")
+            stored = stored.decode("utf-8") if isinstance(stored, bytes) else str(stored)
+            t_hi, t_lo = h5["t/hi"], h5["t/lo"]
+            n = t_hi.shape[0]
+            if n == 0:
+                return False
+            t_end = float(t_hi[n - 1]) + float(t_lo[n - 1])
+    except (OSError, KeyError, ValueError, TypeError):
+        return False
+    try:
+        scen = loads_scenario(stored, [f"run.output={output_placeholder}"])
+    except ScenarioError:
+        return False
+    if scen.to_toml() != canonical_toml:
+        return False
+    return abs(t_end - float(scen.run.duration_s)) <= 1e-6 * max(1.0, float(scen.integrator.step_s))

@@ -17,7 +17,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ... import __version__ as _TQDYN_VERSION
+from ..._version import __version__ as _TQDYN_VERSION
 from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS
 
 __all__ = [

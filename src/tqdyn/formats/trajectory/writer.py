@@ -20,10 +20,11 @@ from typing import Any, Mapping, Sequence
 import h5py
 import numpy as np
 
+from . import _h5safe
 from ._h5safe import _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
 from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, dataset_attrs
 
-__all__ = ["check_writable", "TrajectoryWriter"]
+__all__ = ["check_writable", "hdf5_poisoned", "TrajectoryWriter"]
 
 _DEFAULT_CHUNK_ROWS = 1024  # rows per chunk: also the rows buffered in memory (~2 MB for a coupled run)
 # The rows are buffered here and written a whole chunk at a time, so HDF5's
@@ -129,6 +130,12 @@ def check_writable(path) -> pathlib.Path:
         raise OutputError(f"output directory {str(parent)!r} is not writable (for {str(p)!r}): "
                           f"{exc.strerror or exc}") from None
     return p
+
+
+def hdf5_poisoned() -> bool:
+    """True once an HDF5 file failed to close in this process (HDF5 then
+    crashes on any later close: a command line ends with ``os._exit``)."""
+    return _h5safe.HDF5_POISONED
 
 
 class TrajectoryWriter:

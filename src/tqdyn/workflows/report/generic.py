@@ -21,12 +21,12 @@ from ...analysis.metrics import (
     TAIJI,
     TIANQIN,
     ConstellationReference,
-    _control_values,
+    control_values,
     actuation_values,
     arm_lengths_of,
-    _link_dd,
-    _t,
-    _uniform,
+    link_of,
+    times_s,
+    is_uniform_grid,
     breathing_angles_of,
     flight_axis_check,
     orbit_deviation,
@@ -128,9 +128,9 @@ def report_runs(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike, 
             cref = constellation_reference(tr, info)
             _generic_arms(rep, tr, label, cref)
             _generic_breathing(rep, tr, label, cref)
-            t = _t(tr)
+            t = times_s(tr)
             nyquist = 0.5 / float(np.median(np.diff(t))) if t.size >= 2 else 0.0
-            if not (_uniform(t) and t.size >= 80):
+            if not (is_uniform_grid(t) and t.size >= 80):
                 rep.notes.append(f"{label}: no range ASD (needs a uniform grid of at least 80 rows)")
             elif nyquist <= 1e-4:
                 rep.notes.append(f"{label}: no range ASD: the grid's Nyquist frequency {nyquist:.3g} Hz (rows "
@@ -192,7 +192,7 @@ def _generic_control(rep, tr, label, info):
     rep.figures += plot_actuation(tr, rep.out_dir, f"{label}-actuation",
                                   f"{label}: actuation per axis ({craft.architecture} architecture, "
                                   f"{craft.dragfree_scheme} drag-free scheme)" if craft else f"{label}: actuation")
-    v = _control_values(tr)
+    v = control_values(tr)
     rep.values[f"{label}/control"] = v
     act = actuation_values(tr)
     rep.values[f"{label}/actuation"] = act
@@ -251,7 +251,7 @@ def _actuation_rows(rep, tr, label, act):
 
 
 def _generic_arms(rep, tr, label, cref):
-    t = _t(tr)
+    t = times_s(tr)
     L, Ld = arm_lengths_of(tr)
     span = f" over {_span_days(tr):.3g} d"
     rep.figures += plot_arms(t, L, Ld, rep.out_dir, f"{label}-arms", f"{label}: arm lengths ({cref.name})",
@@ -281,7 +281,7 @@ def _generic_arms(rep, tr, label, cref):
 
 
 def _generic_breathing(rep, tr, label, cref=TIANQIN):
-    t = _t(tr)
+    t = times_s(tr)
     alpha = breathing_angles_of(tr)
     deg = np.degrees(alpha)
     band = cref.breathing_band_deg
@@ -322,11 +322,11 @@ def _generic_pointing(rep, tr, label, paper: bool, max_rows: int):
 
 def _generic_asd(rep, tr, label, paper: bool = True):
     lt = light_travel_times_of(tr)
-    t = _t(tr)
+    t = times_s(tr)
     curves = []
     worst = (0.0, None, None)
     for ln in LINKS:
-        res = range_asd_in_band(t, *_link_dd(lt.range, ln))
+        res = range_asd_in_band(t, *link_of(lt.range, ln))
         curves.append((f"link {int(ln)}", res, {"lw": 0.8}))
         if np.isfinite(res.max_ratio) and res.max_ratio > worst[0]:
             worst = (res.max_ratio, ln, res)

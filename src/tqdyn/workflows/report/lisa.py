@@ -26,9 +26,9 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from ...analysis import lisa_estimates as le
-from ...analysis.figures import _SAT_COLORS, plot_control, plot_pointing
+from ...analysis.figures import SAT_COLORS, plot_control, plot_pointing
 from ...analysis.figures_lisa import plot_arm_response, plot_deviation, plot_esa_ramp, plot_estimate
-from ...analysis.metrics import _common_rows, _control_values, _t, orbit_deviation
+from ...analysis.metrics import common_rows, control_values, times_s, orbit_deviation
 from ...analysis.pointing_study import pointing_study_of
 from ...constellation import geometry
 from ...constellation.indices import Sat
@@ -105,7 +105,7 @@ def _ramp_g(tr) -> np.ndarray:
     from ...dynamics.system import centre_ramp
 
     ramp = _scenario(tr).self_gravity_centre_ramp()
-    t = _t(tr)
+    t = times_s(tr)
     return np.zeros_like(t) if ramp is None else centre_ramp(ramp, t)
 
 
@@ -156,7 +156,7 @@ def _esa_on_grid(tr) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     esa = _esa_files()
     ep = tr.epoch.tdb
-    t = _t(tr)
+    t = times_s(tr)
     end = ((esa[0].stop[0] - ep[0]) + (esa[0].stop[1] - ep[1])) * 86400.0 if esa[0].stop else np.inf
     rows = np.nonzero(t <= end)[0]
     st = [states_at(o, ep[0], ep[1] + t[rows] / 86400.0) for o in esa]
@@ -194,7 +194,7 @@ def _decomposition(tr, d) -> dict:
     from ...constellation import control
 
     r = _r(tr)
-    t = _t(tr)
+    t = times_s(tr)
     T = tr["sat/T_S_I"]
     w, wd = tr["sat/omega"], tr["sat/omega_dot"]
     th = 2.0 * tr["mosa/angle"][..., 0]
@@ -247,7 +247,7 @@ def _study_estimate(rep, runs):
         kepler = sc.initial.design != "none" and not sc.forces.third_bodies
         shown = (Ge, Ae) if kepler else (None, None)
         panels.append([f"{label}: max |G| {mG:.3e}, max A {mA:.3e} m/s$^2$" +
-                       (f" (formula {eG:.3e}, {eA:.3e})" if kepler else ""), _t(tr), G, A, *shown])
+                       (f" (formula {eG:.3e}, {eA:.3e})" if kepler else ""), times_s(tr), G, A, *shown])
         what = f"{label}, L = {L:.3g} m, d = {d:g} m, {_span(tr)}"
         if kepler:
             rows += [
@@ -270,7 +270,7 @@ def _study_estimate(rep, runs):
                                    "2 (L'/L) D'/L + (L''/L - 2 L'^2/L^2) u of g_l/d grow with it"))
     # ESA's orbit: the exact identity on ESA's files (no attitude or control code)
     tr = runs.get("dragfree-1y")
-    t_esa, R, V, A_esa = _esa_records(float(_t(tr)[-1]), tr.epoch.tdb)
+    t_esa, R, V, A_esa = _esa_records(float(times_s(tr)[-1]), tr.epoch.tdb)
     if t_esa.size >= 2:
         Gi, Ai = le.arm_identity_control(R, V, A_esa, gm=_gm_sun(), d=float(_scenario(tr).spacecraft.tm_distance_m))
         iG, iA = float(np.linalg.norm(Gi, axis=-1).max()), float(np.abs(Ai).max())
@@ -305,15 +305,15 @@ def _study_deviation(rep, runs):
                               ("kepler-dragfree-1y", "kepler-gravity-1y", "Keplerian design", "--")):
         a, b = runs.get(df), runs.get(gr)
         dev = orbit_deviation(a, b)
-        t = _t(a)
-        _, ia, ib = _common_rows(t, dev.t)
+        t = times_s(a)
+        _, ia, ib = common_rows(t, dev.t)
         pred = le.cw_response(t[ia], _r(b)[ib], b["sat/v"][ib], a["sat/a_dragfree"][ia], gm=gm)
         vals[df] = {"max": dev.norm.max(axis=0), "end": np.stack([dev.radial[-1], dev.along[-1], dev.cross[-1]], -1),
                     "pred_end": pred[-1], "t_end": float(dev.t[-1])}
         for s in Sat:
-            series.append((f"|dr| Sat{int(s)}, {label}", dev.t, dev.norm[:, s.index], _SAT_COLORS[s.index], ls))
+            series.append((f"|dr| Sat{int(s)}, {label}", dev.t, dev.norm[:, s.index], SAT_COLORS[s.index], ls))
             series.append((f"CW prediction from G, Sat{int(s)}, {label}", dev.t, np.linalg.norm(pred[:, s.index], axis=-1),
-                           _SAT_COLORS[s.index], ":"))
+                           SAT_COLORS[s.index], ":"))
         span = float(dev.t[-1] - dev.t[0]) / 86400
         rep.rows += [
             SummaryRow(f"drag-free (no self-gravity) vs pure-gravity orbit, {label}, max |dr| over {span:.4g} d",
@@ -365,7 +365,7 @@ def _study_control(rep, runs):
                               ("table-iv-1y", "lisa-control-table-iv", "Table IV per-TM self-gravity"),
                               ("ramp-1y", "lisa-control-ramp", "ESA's ramp through the TMs (+X_S)")):
         tr = runs.get(name)
-        v = _control_values(tr)
+        v = control_values(tr)
         vals[name] = v
         rep.figures += plot_control(tr, rep.out_dir, stem, f"LISA (ESA's orbit), nominal control, {label}, "
                                                             f"{_span(tr)}")
@@ -376,7 +376,7 @@ def _study_control(rep, runs):
     X = ramp["sat/T_S_I"][:, :, 0, :]
     nominal = np.linalg.norm(ramp["sat/a_dragfree"] - g[:, None, None] * X, axis=-1).max(axis=0)
     base = runs.get("dragfree-1y")
-    _, ia, ib = _common_rows(_t(ramp), _t(base))
+    _, ia, ib = common_rows(times_s(ramp), times_s(base))
     dA = float(np.abs(ramp["tm/a_suspension"][ia] - base["tm/a_suspension"][ib]).max())
     vals["scheme_table_iv"] = {"G": G4, "A": A4}
     vals["ramp_nominal"] = nominal
@@ -409,7 +409,7 @@ def _study_control(rep, runs):
 
 def _study_common_sg(rep, runs):
     base = runs.get("dragfree-1y")
-    t0 = _t(base)
+    t0 = times_s(base)
     a0 = geometry.arms(base.dd("sat/r"), base.dd("sat/v"))
     al0 = geometry.breathing_angles(a0)[0]
     r0, v0 = _r(base)[0], base["sat/v"][0]
@@ -418,7 +418,7 @@ def _study_common_sg(rep, runs):
     curves, vals = [], {}
     for label, d in SG_DIRECTIONS.items():
         tr = runs.get(f"sg{label}-1y")
-        _, ia, ib = _common_rows(_t(tr), t0)
+        _, ia, ib = common_rows(times_s(tr), t0)
         a1 = geometry.arms(tr.dd("sat/r"), tr.dd("sat/v"))
         dL = (a1.length[ia] - a0.length[ib])[:, :3]
         dLd = (a1.length_dot[ia] - a0.length_dot[ib])[:, :3]
@@ -487,7 +487,7 @@ def _study_pointing(rep, runs):
                            f"light time ~{L / _C:.3g} s; iterative residual {st.ltt_residual:.1e} s"))
     if runs.has("dragfree-global-1y"):
         g = runs.get("dragfree-global-1y")
-        _, ia, ib = _common_rows(_t(g), _t(tr))
+        _, ia, ib = common_rows(times_s(g), times_s(tr))
         dG = float(np.linalg.norm(g["sat/a_dragfree"][ia] - tr["sat/a_dragfree"][ib], axis=-1).max())
         dA = float(np.abs(g["tm/a_suspension"][ia] - tr["tm/a_suspension"][ib]).max())
         dev = orbit_deviation(g, tr)
@@ -506,8 +506,8 @@ def _study_pointing(rep, runs):
 def _study_esa_ramp(rep, runs, coupled="ramp-1y", pm="esa-1y", stem="lisa-esa-ramp"):
     c, e = runs.get(coupled), runs.get(pm)
     dev = orbit_deviation(c, e)
-    t = _t(c)
-    _, ia, ib = _common_rows(t, dev.t)
+    t = times_s(c)
+    _, ia, ib = common_rows(t, dev.t)
     r, v = _r(c)[ia], c["sat/v"][ia]
     g = _ramp_g(c)[ia]
     ch = _centroid_dirs(r)
@@ -530,7 +530,7 @@ def _study_esa_ramp(rep, runs, coupled="ramp-1y", pm="esa-1y", stem="lisa-esa-ra
     for name, tr in ((coupled, c), (pm, e)):
         rows_, R, _ = _esa_on_grid(tr)
         dr = np.linalg.norm(_r(tr)[rows_] - R, axis=-1)
-        vs.append((f"{'coupled lisa' if tr is c else 'lisa-esa'} - ESA files", _t(tr)[rows_], dr,
+        vs.append((f"{'coupled lisa' if tr is c else 'lisa-esa'} - ESA files", times_s(tr)[rows_], dr,
                    "-" if tr is c else "--"))
         out[name] = dr[-1]
     k_end = -1

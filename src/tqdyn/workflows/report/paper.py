@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from ...analysis.figures import (
-    _SAT_COLORS,
+    SAT_COLORS,
     plot_asd,
     plot_common_self_gravity,
     plot_control,
@@ -26,12 +26,12 @@ from ...analysis.figures import (
 )
 from ...analysis.metrics import (
     BREATHING_BAND_DEG,
-    _common_rows,
-    _control_values,
-    _diff_dd,
-    _link_dd,
-    _sat_light_path,
-    _t,
+    common_rows,
+    control_values,
+    dd_difference,
+    link_of,
+    sat_light_travel_times,
+    times_s,
     breathing_angles_of,
     flight_axis_check,
     orbit_deviation,
@@ -103,12 +103,12 @@ def _study_pointing(rep, runs):
 def _study_range_asd(rep, runs):
     grav, glob, loc = (runs.get(n) for n in ("gravity-30d-50s", "dragfree-global-30d-50s", "dragfree-local-30d-50s"))
     ln = PAPER_LINK
-    t = _t(grav)
-    lps = {name: _link_dd(_sat_light_path(tr).range, ln) for name, tr in
+    t = times_s(grav)
+    lps = {name: link_of(sat_light_travel_times(tr).range, ln) for name, tr in
            (("gravity", grav), ("global", glob), ("local", loc))}
     res = {k: range_asd_in_band(t, *v) for k, v in lps.items()}
-    d_df = range_asd_in_band(t, *_diff_dd(lps["global"], lps["gravity"]))
-    d_gl = range_asd_in_band(t, *_diff_dd(lps["global"], lps["local"]))
+    d_df = range_asd_in_band(t, *dd_difference(lps["global"], lps["gravity"]))
+    d_gl = range_asd_in_band(t, *dd_difference(lps["global"], lps["local"]))
     rep.figures += plot_asd([("gravity orbits", res["gravity"], {"color": "tab:blue", "lw": 1.4}),
                              ("drag-free, global pointing", res["global"], {"color": "tab:red", "ls": "--"}),
                              ("drag-free, local pointing (taylor2)", res["local"], {"color": "tab:green", "ls": ":"}),
@@ -135,7 +135,7 @@ def _study_range_asd(rep, runs):
 
 def _study_control_no_sg(rep, runs):
     tr = runs.get("dragfree-global-30d-50s")
-    v = _control_values(tr)
+    v = control_values(tr)
     span = _span_days(tr)
     rep.figures += plot_control(tr, rep.out_dir, "fig7-control-no-self-gravity",
                                 f"Fig. 7: nominal control without self-gravity, {span:.3g} d")
@@ -154,14 +154,14 @@ def _study_control_no_sg(rep, runs):
                    "same order" if _order_ok(v["max_G"], 1e-13) else "differs"),
         SummaryRow("Flight direction in S (sets the sign of the +flight runs)", "-",
                    f"Y_S . v/|v| in [{yv.min():.6f}, {yv.max():.6f}]",
-                   "flight = -Y_S, as tqdyn.studies assumes" if yv.max() < -0.99 else
-                   "NOT -Y_S: the +flight runs of tqdyn.studies are mislabelled"),
+                   "flight = -Y_S, as tqdyn.workflows.studies assumes" if yv.max() < -0.99 else
+                   "NOT -Y_S: the +flight runs of tqdyn.workflows.studies are mislabelled"),
     ]
 
 
 def _study_control_table_iv(rep, runs):
     tr = runs.get("table-iv-30d-50s")
-    v = _control_values(tr)
+    v = control_values(tr)
     span = _span_days(tr)
     rep.figures += plot_control(tr, rep.out_dir, "fig8-control-table-iv",
                                 f"Fig. 8: nominal control with the Table IV self-gravity, {span:.3g} d")
@@ -184,16 +184,16 @@ def _study_dragfree_deviation(rep, runs):
                             ("dragfree-local-90d", "local pointing (taylor2)", "--")):
         tr = runs.get(name)
         dev = orbit_deviation(tr, grav)
-        t = _t(tr)
+        t = times_s(tr)
         pred = secular_along_track_drift(t, tr["sat/r"], tr["sat/v"], tr["sat/a_dragfree"])
-        _, ia, _ = _common_rows(t, dev.t)
+        _, ia, _ = common_rows(t, dev.t)
         pred = pred[ia]
         span = float(dev.t[-1] - dev.t[0]) / 86400
         for s in Sat:
-            series.append((f"|dr| Sat{int(s)}, {label}", dev.t, dev.norm[:, s.index], _SAT_COLORS[s.index], ls))
+            series.append((f"|dr| Sat{int(s)}, {label}", dev.t, dev.norm[:, s.index], SAT_COLORS[s.index], ls))
             if ls == "-":
                 series.append((f"secular along-track prediction Sat{int(s)}", dev.t, np.abs(pred[:, s.index]),
-                               _SAT_COLORS[s.index], ":"))
+                               SAT_COLORS[s.index], ":"))
         dmax = dev.norm.max(axis=0)
         G = np.linalg.norm(tr["sat/a_dragfree"], axis=-1)
         k1 = max(1, round(86400 / float(np.median(np.diff(t)))))
@@ -236,8 +236,8 @@ def _local_vs_global(rep, glob, loc):
     dev = orbit_deviation(loc, glob)
     if dev is None:
         return
-    t = _t(glob)
-    _, ia, ib = _common_rows(_t(loc), t)
+    t = times_s(glob)
+    _, ia, ib = common_rows(times_s(loc), t)
     dG = loc["sat/a_dragfree"][ia] - glob["sat/a_dragfree"][ib]
     pred = secular_along_track_drift(t[ib], glob["sat/r"][ib], glob["sat/v"][ib], dG)
     Tg, Tl = glob["sat/T_S_I"][ib], loc["sat/T_S_I"][ia]
@@ -267,13 +267,13 @@ def _local_vs_global(rep, glob, loc):
 def _study_common_sg(rep, runs):
     grav = runs.get("gravity-90d")
     a_grav = breathing_angles_of(grav)
-    t_grav = _t(grav)
+    t_grav = times_s(grav)
     results = {}
     curves = []
     for label, d in SG_DIRECTIONS.items():
         tr = runs.get(f"sg{label}-90d")
         dev = orbit_deviation(tr, grav)
-        _, ia, ib = _common_rows(_t(tr), t_grav)
+        _, ia, ib = common_rows(times_s(tr), t_grav)
         dal = np.degrees(breathing_angles_of(tr)[ia] - a_grav[ib])
         flight = float(np.dot(d, FLIGHT_DIRECTION_S))
         tag = " (+flight)" if flight > 0 else " (-flight)" if flight < 0 else ""
@@ -320,7 +320,7 @@ def _study_extreme(rep, runs):
     grav = runs.get("gravity-90d")
     tr = runs.get("sg-extreme-90d")
     ag, ae = breathing_angles_of(grav), breathing_angles_of(tr)
-    tg, te = _t(grav), _t(tr)
+    tg, te = times_s(grav), times_s(tr)
     dev = orbit_deviation(tr, grav)
     rep.figures += plot_extreme(te, ae, tg, ag, rep.out_dir)
     deg = np.degrees(ae)
@@ -328,7 +328,7 @@ def _study_extreme(rep, runs):
     first = float(te[np.argmax(out.any(axis=1))]) / 86400 if out.any() else None
     dg = np.degrees(ag)
     span = _span_days(tr)
-    _, ia, ib = _common_rows(te, tg)
+    _, ia, ib = common_rows(te, tg)
     change = np.abs(deg[ia] - dg[ib]).max(axis=0)
     rep.values["extreme"] = {"range": (float(deg.min()), float(deg.max())), "first_exit_day": first,
                              "gravity_range": (float(dg.min()), float(dg.max())), "dev_end": dev.norm[-1],
@@ -348,16 +348,16 @@ def _study_extreme(rep, runs):
 def _study_light_path(rep, runs):
     tr = runs.get("table-iv-30d-50s")
     ln = PAPER_LINK
-    t = _t(tr)
+    t = times_s(tr)
     lt = light_travel_times_of(tr)
-    lp = _link_dd(lt.range, ln)
-    inst_tm = _link_dd(instantaneous_ranges(tr.dd("tm/r")), ln)
-    inst_sat = _link_dd(instantaneous_ranges(tr.dd("sat/r")), ln)
+    lp = link_of(lt.range, ln)
+    inst_tm = link_of(instantaneous_ranges(tr.dd("tm/r")), ln)
+    inst_sat = link_of(instantaneous_ranges(tr.dd("sat/r")), ln)
     r_lp = range_asd_in_band(t, *lp)
     r_tm = range_asd_in_band(t, *inst_tm)
     r_sat = range_asd_in_band(t, *inst_sat)
-    r_lp_tm = range_asd_in_band(t, *_diff_dd(lp, inst_tm))
-    r_tm_sat = range_asd_in_band(t, *_diff_dd(inst_tm, inst_sat))
+    r_lp_tm = range_asd_in_band(t, *dd_difference(lp, inst_tm))
+    r_tm_sat = range_asd_in_band(t, *dd_difference(inst_tm, inst_sat))
     span = _span_days(tr)
     who = f"Sat{int(ln.receiver)} TM <- Sat{int(ln.emitter)} TM (link {int(ln)})"
     rep.figures += plot_asd([("light path c tau, TM-TM", r_lp, {"color": "tab:blue", "lw": 1.4}),

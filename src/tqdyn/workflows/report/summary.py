@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...analysis.metrics import _t
+from ...analysis.metrics import times_s
 from ...formats import trajectory as io
 
 __all__ = ["Report", "RunFiles", "evaluate_studies", "SummaryRow", "check_out_dir", "format_summary"]
@@ -104,7 +104,7 @@ def _asd_verdict(res) -> str:
 
 
 def _span_days(traj) -> float:
-    t = _t(traj)
+    t = times_s(traj)
     return float(t[-1] - t[0]) / 86400.0
 
 

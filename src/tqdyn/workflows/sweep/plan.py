@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ...formats import trajectory as io
-from ...scenario import ScenarioError, load_scenario, loads_scenario
+from ...scenario import ScenarioError, load_scenario
 from ...scenario.toml_text import toml_value
 from .spec import SweepSpec, _err, load_sweep
 
@@ -120,33 +120,11 @@ def _resolve_members(spec: SweepSpec) -> tuple[Member, ...]:
 
 
 def member_done(member: Member) -> bool:
-    """True if ``member.path`` is a complete trajectory of this member: a
-    readable tqdyn trajectory whose stored resolved scenario equals the
-    member's (``run.output`` aside, so a moved output directory still counts)
-    and whose last time row is ``run.duration``.  Anything else (missing,
-    unreadable, another scenario, cut short) is False: the member is run."""
-    import h5py
-
-    try:
-        with h5py.File(member.path, "r") as h5:
-            if h5.attrs.get("format") != io.FORMAT:
-                return False
-            stored = h5.attrs.get("scenario", "")
-            stored = stored.decode("utf-8") if isinstance(stored, bytes) else str(stored)
-            t_hi, t_lo = h5["t/hi"], h5["t/lo"]
-            n = t_hi.shape[0]
-            if n == 0:
-                return False
-            t_end = float(t_hi[n - 1]) + float(t_lo[n - 1])
-    except (OSError, KeyError, ValueError, TypeError):
-        return False
-    try:
-        scen = loads_scenario(stored, [f"run.output={_OUTPUT_PLACEHOLDER}"])
-    except ScenarioError:
-        return False
-    if scen.to_toml() != member.canonical_toml:
-        return False
-    return abs(t_end - float(scen.run.duration_s)) <= 1e-6 * max(1.0, float(scen.integrator.step_s))
+    """True if ``member.path`` is a complete run of this member
+    (:func:`tqdyn.formats.trajectory.run_is_complete`: the stored resolved
+    scenario equals the member's, ``run.output`` aside, and the last time row
+    is ``run.duration``); anything else is False and the member is run."""
+    return io.run_is_complete(member.path, member.canonical_toml, _OUTPUT_PLACEHOLDER)
 
 
 @dataclass(frozen=True)

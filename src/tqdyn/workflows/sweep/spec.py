@@ -245,7 +245,7 @@ def _reserved_names() -> set[str]:
 def _check_parameter(p: Any, i: int, common_keys: dict[str, int], mode: str) -> Parameter:
     where = f"sweep.parameter.{i}"
     if not isinstance(p, Parameter):
-        raise _err(where, p, "is not a Parameter", "tqdyn.sweep.Parameter(key, values, labels=None, name=None)")
+        raise _err(where, p, "is not a Parameter", "tqdyn.workflows.sweep.Parameter(key, values, labels=None, name=None)")
     key = p.key
     if not (isinstance(key, str) and _KEY_RE.match(key.strip())):
         raise _err(f"{where}.key", key, "is not a scenario key",
