@@ -22,8 +22,11 @@ PACKAGE = pathlib.Path(tqdyn.__file__).resolve().parent
 #: Layers from the bottom up (docs/design.md).  ``readers`` may also import
 #: ``astro.constants``, the one dependency-free module of ``astro``.  ``_version``
 #: is the version string alone (so that no layer imports the package root,
-#: whose lazy attributes import the front door).
-LAYERS = ("_version", "numerics", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
+#: whose lazy attributes import the front door).  ``peers`` (other libraries'
+#: formulations of tqdyn's models) sit just above ``numerics``, so that they
+#: cannot borrow tqdyn's physics; only the workflows use them
+#: (:func:`test_only_workflows_use_the_peers`).
+LAYERS = ("_version", "numerics", "peers", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
           "formats", "analysis", "workflows", "cli", "<front>")
 #: Top-level modules outside the layer packages: the front door and the
 #: version-0.1 import paths kept for users' scripts (they re-export).
@@ -31,6 +34,7 @@ FRONT = ("__init__", "api", "io", "sweep")
 #: Third-party packages a layer must not import (I/O, plotting, CLI, distributed engine).
 FORBIDDEN = {
     "numerics": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
+    "peers": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "readers": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "astro": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "forces": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
@@ -129,6 +133,11 @@ def test_dependencies_point_down(name):
 def test_physics_and_formats_import_no_io_plotting_or_cli(name):
     bad = _third_party(name) & set(FORBIDDEN[_layer(name)])
     assert not bad, f"{name} imports {sorted(bad)}"
+
+
+def test_only_workflows_use_the_peers():
+    users = {m for m in MODULES for t, _ in _imports(m) if _layer(t) == "peers" and _layer(m) != "peers"}
+    assert users and {_layer(m) for m in users} == {"workflows"}, f"peers imported by {sorted(users)}"
 
 
 def test_no_import_cycles():

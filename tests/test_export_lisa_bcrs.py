@@ -23,7 +23,6 @@ import pytest
 
 from tqdyn.astro.constants import C_LIGHT, L_B
 from tqdyn.formats import trajectory as io
-from tqdyn.workflows import export_bcrs as E
 from tqdyn.workflows.export import export_lisa
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
@@ -225,14 +224,14 @@ def test_helio_clocks(helio):
 
 def test_tianqin_bcrs_positions(geo):
     from tqdyn.astro.ephemeris import default_ephemeris
-    from tqdyn.astro.geocentric import TDB_TO_TT_SCALE
+    from tqdyn.astro.geocentric import TDB_TO_TT_SCALE, gcrs_to_bcrs_states
     from tqdyn.astro.timescales import tdb_jd
 
     attrs, data = _read(geo["bcrs0"].path)
     tr = io.read_trajectory(geo["run"])
     assert "geocentric tqdyn run" in attrs["coordinates_from"] and "1PN" in attrs["gcrs_to_bcrs"]
-    st = E._bcrs_states_geocentric(tr, {"sat": (tr.dd("sat/r"), tr.dd("sat/v"), tr["sat/a_gravity"])},
-                                   default_ephemeris())
+    st = gcrs_to_bcrs_states(tr.epoch, tr.dd("t"), {"sat": (tr.dd("sat/r"), tr.dd("sat/v"), tr["sat/a_gravity"])},
+                             default_ephemeris())
     xe = default_ephemeris().earth_barycentric(*tdb_jd(tr.epoch, *st["T"]))[0]
     naive = (xe[:, None] + (tr["sat/r"] / TDB_TO_TT_SCALE)) / (1 - L_B)  # geocentre + scaled GCRS position
     d = np.linalg.norm(data["tcb/x"] - naive[1:], axis=-1)

@@ -154,3 +154,24 @@ def test_tidal_accelerations_move_as_a_rescaled_body():
         size = np.linalg.norm(a_old, axis=-1)
         assert (np.linalg.norm(a_new - a_old, axis=-1) / size).min() > 5e-8   # the change: 5.2e-8 .. 8.7e-8
         assert (np.linalg.norm(a_new - a_scaled, axis=-1) / size).max() < bound
+
+
+def test_earth_barycentric_field_is_the_ephemeris_acceleration():
+    # Reference: the ephemeris's own Earth velocity, differentiated (central differences over +-60 s, truncation
+    # ~1e-13 m/s^2).  A DE integrates the Newtonian attraction of the Sun, the Moon and the planets plus their 1PN
+    # terms (~1e-8 relative, 6e-11 m/s^2), the Earth-Moon figure torques and the asteroids, so a_E must be
+    # dv_E/dt to ~1e-10 m/s^2 (measured 1.6e-10 of 5.8e-3 m/s^2 over 30 days from 2004-06-06); U_ext is the
+    # Sun's GM/r plus 2.2e-4 .. 2.4e-4 of it (the Moon and the planets: Jupiter ~1e-4, the Moon ~6e-5).
+    from tqdyn.astro.geocentric import earth_barycentric_field
+
+    eph = default_ephemeris()
+    t = np.arange(0.0, 30 * 86400.0, 3600.0)
+    jd1, jd2 = EPOCH.tdb[0] + 0 * t, EPOCH.tdb[1] + t / 86400.0
+    x, v, a, u, names = earth_barycentric_field(eph, jd1, jd2)
+    assert names[:2] == ("sun", "moon") and x.shape == v.shape == a.shape == (t.size, 3) and u.shape == (t.size, 1)
+    _, vp = eph.earth_barycentric(jd1, jd2 + 60.0 / 86400.0)
+    _, vm = eph.earth_barycentric(jd1, jd2 - 60.0 / 86400.0)
+    assert np.abs(a - (vp - vm) / 120.0).max() < 8e-10
+    xs = eph.sun_barycentric(jd1, jd2)[0]
+    share = u[:, 0] / (planetary_gm()["sun"] / np.linalg.norm(xs - x, axis=-1)) - 1
+    assert 1.5e-4 < share.min() and share.max() < 3e-4

@@ -249,3 +249,26 @@ def test_second_derivatives_vs_mpmath_finite_differences(trajectory):
           f"{np.max(np.abs(g.alpha_ddot)):.1e}); L'' vs mpmath FD: {worst_L:.2e} m/s^2 (tol {tol_L:.1e})")
     assert worst_a < tol_alpha
     assert worst_L < tol_L
+
+
+def test_centroid_directions_exact_and_free_of_cancellation():
+    # Reference: exact rational arithmetic (fractions) of (R_1 + R_2 + R_3)/3 - R_i for a LISA-sized triangle
+    # 1 au from the origin, given in dd (hi, lo): the arm vectors of the dd pair keep the direction to round-off
+    # (measured 1.1e-16; the same positions rounded to float64 first: 3.0e-15).
+    from fractions import Fraction
+
+    rng = np.random.default_rng(7)
+    tri = 2.5e9 / math.sqrt(3) * np.array([[math.cos(a), math.sin(a), 0.3 * math.sin(2 * a)]
+                                           for a in (0.1, 2.2, 4.3)])
+    hi = 1.496e11 * np.array([0.6, 0.8, 0.0]) + tri + rng.uniform(-1e3, 1e3, (3, 3))
+    lo = rng.uniform(-0.5, 0.5, (3, 3)) * np.spacing(hi)
+    u = G.centroid_directions((hi[None], lo[None]))[0]
+    exact = [[Fraction(float(hi[i, k])) + Fraction(float(lo[i, k])) for k in range(3)] for i in range(3)]
+    for i in range(3):
+        c = [sum(exact[j][k] for j in range(3)) / 3 - exact[i][k] for k in range(3)]
+        norm = math.sqrt(float(sum(x * x for x in c)))
+        assert np.abs(u[i] - [float(x) / norm for x in c]).max() < 1e-15
+    # the equilateral triangle: centroid and incenter coincide
+    eq = np.array([[math.cos(a), math.sin(a), 0.0] for a in (0.0, 2 * math.pi / 3, 4 * math.pi / 3)]) * 1e8
+    inc = G.incenter(eq, G.arms(eq)).offset
+    assert np.abs(G.centroid_directions(eq) - inc / np.linalg.norm(inc, axis=-1, keepdims=True)).max() < 1e-15

@@ -1,4 +1,4 @@
-"""Tests of the heyoka real128 Kepler reference peer (tqdyn._heyoka_peer)."""
+"""Tests of the heyoka real128 Kepler reference peer (tqdyn.peers.heyoka)."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import pytest
 hy = pytest.importorskip("heyoka")
 mpmath = pytest.importorskip("mpmath")
 
-from tqdyn.workflows.heyoka_peer import (  # noqa: E402
+from tqdyn.peers.heyoka import (  # noqa: E402
     propagate_kepler_grid,
     real128_to_dd,
     to_real128,
@@ -201,7 +201,7 @@ def _third_body_acc(r, s, gm):
 
 def test_reduced_model_vs_tqdyn_one_day():
     from tqdyn import dynamics
-    from tqdyn.workflows.heyoka_peer import _epoch_days, _reduced_system, propagate_reduced_grid
+    from tqdyn.peers.heyoka import _epoch_days, _reduced_system, propagate_reduced_grid
     from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
     from tqdyn.scenario import load_scenario
     from tqdyn.astro.timescales import tdb_jd

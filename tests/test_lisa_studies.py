@@ -406,6 +406,71 @@ def test_bisector_median_angle_first_order():
         assert abs(est - exact) < 0.03 * abs(exact) + 1e-5, (est, exact)
 
 
+def test_lisa_scheme_constant_meets_the_scheme_conditions():
+    # Reference: the scheme's defining conditions, checked directly in S (first principles): G = A_l + g_l for
+    # both TMs, no actuation along the sensitive axes X_OA_l, equal and opposite out-of-plane actuation; and the
+    # control module's own solution (constellation.control.dragfree_general), another implementation.  Table IV's
+    # self-gravity at theta = 60 and 61.3 deg; measured: conditions to 4e-27 m/s^2 on ~1e-10 m/s^2.
+    from tqdyn.constellation.control import dragfree_general, oa_rotation
+    from tqdyn.constellation.spacecraft import TABLE_IV_SELF_GRAVITY
+
+    sg = np.asarray(TABLE_IV_SELF_GRAVITY)
+    for theta in (math.pi / 3, math.radians(61.3)):
+        G, A = le.lisa_scheme_constant(sg, theta)
+        T = oa_rotation(theta)                                     # (2, 3, 3): S -> OA_l
+        g_S = np.einsum("lji,lj->li", T, sg)                       # g_l in S
+        A_S = np.einsum("lji,lj->li", T, A)
+        assert np.abs(G[None] - (A_S + g_S)).max() < 1e-25
+        assert np.abs(A[:, 0]).max() < 1e-25 and abs(A[0, 2] + A[1, 2]) < 1e-25
+        G2, A2 = dragfree_general(g_S, theta)
+        assert np.abs(G - G2).max() < 1e-25 and np.abs(A - A2).max() < 1e-25
+
+
+def test_control_terms_of_a_uniformly_turning_frame():
+    # Reference: first principles for S fixed to the inertial axes' orientation at t = 0 and turning at
+    # n = sqrt(GM/R^3) about Z_S, the satellites on the x axis at R (T_S_I = I held, a frozen snapshot), the TMs at
+    # d (cos 30, +-sin 30, 0) (theta = 60 deg, constant): centrifugal n^2 d, Euler and MOSA terms 0, the Sun's
+    # tide GM/R^3 d sqrt(13)/2, and tide + centrifugal = 3 cos 30 n^2 d (the x parts add, the y parts cancel).
+    from tqdyn.analysis.metrics import control_terms
+
+    N, R, d = 9, AU, D_TM
+    n2 = GM_SUN / R ** 3
+    t = np.arange(N) * 3600.0
+    r = np.zeros((N, 3, 3))
+    r[..., 0] = R
+    fields = {"sat/T_S_I": np.broadcast_to(np.eye(3), (N, 3, 3, 3)), "sat/omega_dot": np.zeros((N, 3, 3)),
+              "sat/omega": np.broadcast_to([0.0, 0.0, math.sqrt(n2)], (N, 3, 3)),
+              "mosa/angle": np.broadcast_to([math.pi / 6, -math.pi / 6], (N, 3, 2))}
+    dd = {"t": (t, 0 * t), "sat/r": (r, 0 * r)}
+    tr = type("Run", (), {"dd": lambda self, k: dd[k], "__getitem__": lambda self, k: fields[k]})()
+    m = control_terms(tr, d, GM_SUN)
+    assert m["centrifugal"] == pytest.approx(n2 * d, rel=1e-12)
+    assert m["tide"] == pytest.approx(n2 * d * math.sqrt(13) / 2, rel=1e-12)
+    assert m["rigid"] == pytest.approx(3 * math.cos(math.pi / 6) * n2 * d, rel=1e-12)
+    assert m["euler"] == m["mosa"] == m["alpha_dot_max"] == m["alpha_ddot_max"] == 0.0
+    assert control_terms(type("Run", (), {"dd": lambda self, k: (t[:4], 0 * t[:4])})(), d, GM_SUN) == {}
+
+
+def test_esa_states_on_grid_at_the_records():
+    # Reference: ESA's file records themselves (Hermite interpolation at its nodes returns them, to the rounding
+    # of the polynomial at 1.5e11 m): a trajectory whose rows are the first 20 records' times (measured 3.2e-4 m,
+    # 3.5e-9 m/s), and esa_records over the same span (the records as stored).
+    from types import SimpleNamespace
+
+    from tqdyn.analysis.esa_orbits import esa_records, esa_states_on_grid
+
+    esa = _esa()
+    tdb = (float(esa[0].jd1[0]), float(esa[0].jd2[0]))
+    t = ((esa[0].jd1[:20] - tdb[0]) + (esa[0].jd2[:20] - tdb[1])) * DAY
+    traj = SimpleNamespace(epoch=SimpleNamespace(tdb=tdb), dd=lambda name: (t, np.zeros_like(t)))
+    rows, R, V = esa_states_on_grid(traj)
+    assert np.array_equal(rows, np.arange(20))
+    ref = np.stack([o.r[:20] for o in esa], 1)
+    assert np.abs(R - ref).max() < 2e-3 and np.abs(V - np.stack([o.v[:20] for o in esa], 1)).max() < 2e-8
+    tr, Rr, Vr, Ar = esa_records(float(t[-1]), tdb)
+    assert tr.size == 20 and np.array_equal(Rr, ref) and Ar.shape == (20, 3, 3)
+
+
 # --------------------------------------------------------------------------- catalogue and CLI
 
 

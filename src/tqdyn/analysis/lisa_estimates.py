@@ -76,6 +76,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..astro.constants import C_LIGHT
+
 __all__ = [
     "KEPLER_MAX_G",
     "KEPLER_MAX_SUSPENSION",
@@ -90,11 +92,11 @@ __all__ = [
     "cw_response",
     "kepler_control",
     "kepler_control_estimate",
+    "lisa_scheme_constant",
     "pointing_law_bounds",
 ]
 
 _S3 = math.sqrt(3.0)
-_C_LIGHT = 299792458.0
 
 #: max over tau of |G| of the Keplerian design, unit alpha n^2 d (module docstring, section 1).
 KEPLER_MAX_G = 4.120403156
@@ -175,6 +177,32 @@ def kepler_control_estimate(arm_length: float, d: float = 0.30, a: float = 14959
 _PERM = ((0, 1, 2), (1, 2, 0), (2, 0, 1))  # (i, j, k) even permutations
 
 
+def _lisa_scheme(e1, e2, Z, g1, g2) -> np.ndarray:
+    """G of the LISA drag-free scheme, G . e_l = g_l . e_l and G . Z = Z . (g_1 + g_2) / 2, by Cramer's rule:
+    e_l the sensitive axes, Z the normal, g_l the TMs' relative accelerations, all (..., 3) in one frame;
+    returns G (..., 3) in that frame."""
+    det = np.sum(e1 * np.cross(e2, Z), -1)[..., None]
+    b1 = np.sum(e1 * g1, -1)[..., None]
+    b2 = np.sum(e2 * g2, -1)[..., None]
+    b3 = 0.5 * np.sum(Z * (g1 + g2), -1)[..., None]
+    return (b1 * np.cross(e2, Z) + b2 * np.cross(Z, e1) + b3 * np.cross(e1, e2)) / det
+
+
+def lisa_scheme_constant(sg_oa, theta: float = math.pi / 3) -> tuple[np.ndarray, np.ndarray]:
+    """G (3,) in S and A (2, 3) in OA_l [m/s^2] of the LISA drag-free scheme when the TMs' relative
+    accelerations are constant vectors sg_oa (2, 3) [m/s^2] given in OA_l (e.g. a per-TM self-gravity), at
+    the opening angle theta [rad]: OA_l is X_S turned by +-theta/2 about Z_S (MOSA 1 +, facing k), the
+    sensitive axes X_OA_l; Cramer's rule, written out independently of :mod:`tqdyn.constellation.control`."""
+    h = 0.5 * theta
+    e = np.array([[math.cos(h), math.sin(h), 0.0], [math.cos(h), -math.sin(h), 0.0]])
+    y = np.array([[-math.sin(h), math.cos(h), 0.0], [math.sin(h), math.cos(h), 0.0]])
+    z = np.array([0.0, 0.0, 1.0])
+    g = np.array([sg_oa[l, 0] * e[l] + sg_oa[l, 1] * y[l] + sg_oa[l, 2] * z for l in range(2)])
+    G = _lisa_scheme(e[0], e[1], z, g[0], g[1])
+    A = np.array([[(G - g[l]) @ e[l], (G - g[l]) @ y[l], (G - g[l]) @ z] for l in range(2)])
+    return G, A
+
+
 def arm_identity_control(R, V, A, gm: float = 1.3271244004193938e20, d: float = 0.30) -> tuple[np.ndarray, np.ndarray]:
     """G and A_l of TMs at ``d`` [m] on the optical axes, from the exact identity g_l = d (T u_l - u_l'').
 
@@ -213,11 +241,7 @@ def arm_identity_control(R, V, A, gm: float = 1.3271244004193938e20, d: float = 
         X = e1 + e2
         X /= np.linalg.norm(X, axis=-1)[:, None]
         Y = np.cross(Z, X)
-        det = np.sum(e1 * np.cross(e2, Z), -1)[:, None]
-        b1 = np.sum(e1 * gs[0], -1)[:, None]
-        b2 = np.sum(e2 * gs[1], -1)[:, None]
-        b3 = 0.5 * np.sum(Z * (gs[0] + gs[1]), -1)[:, None]
-        G = (b1 * np.cross(e2, Z) + b2 * np.cross(Z, e1) + b3 * np.cross(e1, e2)) / det
+        G = _lisa_scheme(e1, e2, Z, gs[0], gs[1])
         G_out[:, i] = np.stack([np.sum(G * X, -1), np.sum(G * Y, -1), np.sum(G * Z, -1)], -1)
         for l, (e, g) in enumerate(zip(us, gs)):
             a = G - g
@@ -424,5 +448,5 @@ def pointing_law_bounds(v: float, L: float) -> dict[str, float]:
     ``global`` v/c [rad] (the emitter moves by v tau during the light time tau = L/c),
     ``taylor`` v^2 / (2 c^2) [rad] (tau = L/c misses L (n.v)/c^2; the emission point
     then moves by |n x v| L (n.v)/c^2, at most L v^2 / (2 c^2)), ``tau`` L v / c^2 [s]."""
-    c = _C_LIGHT
+    c = C_LIGHT
     return {"global": v / c, "taylor": v * v / (2 * c * c), "tau": L * v / (c * c)}

@@ -55,6 +55,7 @@ __all__ = [
     "arm_lengths_of",
     "breathing_angles_of",
     "common_rows",
+    "control_terms",
     "control_values",
     "dd_difference",
     "flight_axis_check",
@@ -63,6 +64,7 @@ __all__ = [
     "orbit_deviation",
     "range_asd_in_band",
     "sat_light_travel_times",
+    "sat_positions",
     "secular_along_track_drift",
     "times_s",
 ]
@@ -130,6 +132,14 @@ def times_s(traj) -> np.ndarray:
     trajectory, rounded to float64 (hi + lo): for plotting and for matching
     rows, never for differences that need the dd time."""
     hi, lo = traj.dd("t")
+    return hi + lo
+
+
+def sat_positions(traj) -> np.ndarray:
+    """Satellite positions (N, n_sat, 3) [m] of a trajectory in its inertial frame, float64 (hi + lo of the dd
+    field ``sat/r``; differences of positions are better formed from the dd pair, as
+    :mod:`tqdyn.constellation.geometry` does)."""
+    hi, lo = traj.dd("sat/r")
     return hi + lo
 
 
@@ -363,3 +373,40 @@ def actuation_values(tr) -> dict:
             "A_max": np.linalg.norm(A, axis=-1).max(axis=(0, 2)), "G_axis_S": np.abs(G_S).max(axis=0),
             "G_mean_S": G_S.mean(axis=0), "G_max": np.linalg.norm(G, axis=-1).max(axis=0),
             "alpha_max": np.linalg.norm(tr["tm/alpha_suspension"], axis=-1).max(axis=(0, 2))}
+
+
+def control_terms(tr, d: float, gm: float) -> dict:
+    """Max magnitudes [m/s^2] of the terms of g_l (:mod:`tqdyn.constellation.control`) along a coupled
+    heliocentric run, its TMs at d [m] from the CoM on the optical axes (pivots at the CoM): the tide of a
+    point mass ``gm`` [m^3/s^2] at the origin (first order in d), the centrifugal and Euler terms of S, their
+    sum (``rigid``), and the MOSA terms (:func:`tqdyn.constellation.control.tm_relative_acceleration` term by
+    term), with the beam opening angle's rates ``alpha_dot_max`` [rad/s], ``alpha_ddot_max`` [rad/s^2] by
+    central differences of ``mosa/angle``; the two rows at each end are left out.  {} for runs of < 5 rows."""
+    from ..constellation.control import mosa_angular_rates, tm_relative_acceleration
+
+    t = times_s(tr)
+    if t.size < 5:
+        return {}
+    r = sat_positions(tr)
+    T = tr["sat/T_S_I"]
+    w, wd = tr["sat/omega"], tr["sat/omega_dot"]
+    th = 2.0 * tr["mosa/angle"][..., 0]
+    ad = np.gradient(th, t, axis=0)
+    add = np.gradient(ad, t, axis=0)
+    u = np.array([np.cos(0.5 * th), np.sin(0.5 * th)])
+    r0 = d * np.stack([np.stack([u[0], u[1], 0 * u[0]], -1), np.stack([u[0], -u[1], 0 * u[0]], -1)], -2)
+    r0I = np.einsum("nsji,nslj->nsli", T, r0)
+    rn = np.linalg.norm(r, axis=-1)[..., None, None]
+    rh = (r / rn[..., 0])[:, :, None, :]
+    tide = np.einsum("nsij,nslj->nsli", T, gm / rn ** 3 * (3 * np.sum(rh * r0I, -1, keepdims=True) * rh - r0I))
+    wm, wmd = mosa_angular_rates(ad, add)
+    zero, still = np.zeros_like(r0), np.zeros_like(w)
+    cf = tm_relative_acceleration(zero, w, still, zero, zero, r0, zero)
+    eu = tm_relative_acceleration(zero, still, wd, zero, zero, r0, zero)
+    mosa = tm_relative_acceleration(zero, w, still, wm, wmd, zero, r0)
+    sl = slice(2, -2)  # central differences only
+    m = {k: float(np.linalg.norm(v[sl], axis=-1).max()) for k, v in
+         (("tide", tide), ("centrifugal", cf), ("euler", eu), ("rigid", tide + cf + eu), ("mosa", mosa))}
+    m["alpha_dot_max"] = float(np.abs(ad[sl]).max())
+    m["alpha_ddot_max"] = float(np.abs(add[sl]).max())
+    return m

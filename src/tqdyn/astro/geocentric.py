@@ -36,15 +36,27 @@ themselves (up to 8.1e-13 m/s^2) and the Sun's 6.0e-6 m/s^2 by 7.3e-8 (up to
 Not modelled: the 1PN corrections of the tidal field itself, of the same
 relative order (v^2/c^2 ~ 1e-8 of the tidal acceleration; IERS 2010 eq.
 10.12 leaves them out too), and O(c^-4).
+
+The other way, GCRS -> BCRS (the LISA export of geocentric runs):
+:func:`gcrs_to_bcrs_offsets` inverts the transformation to O(c^-2) and
+:func:`gcrs_to_bcrs_states` moves a geocentric trajectory's states to the
+solar-system barycentre on a uniform TDB grid, with the Earth's
+barycentric state and the external field U_ext, a_E at the geocentre from
+:func:`earth_barycentric_field` (:func:`external_field`, the same sums as
+:func:`bcrs_to_gcrs`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..numerics.dd import np_dd_add, np_dd_add_d, np_dd_div_d, np_two_sum
+from ..numerics.hermite import interpolate_states
 from .constants import C_LIGHT, L_B, L_G
+from .timescales import geocentre_tdb_grid, tdb_jd
 
-__all__ = ["TDB_TO_TT_SCALE", "bcrs_to_gcrs", "gcrs_to_bcrs_offsets"]
+__all__ = ["EXTERNAL_BODIES", "TDB_TO_TT_SCALE", "bcrs_to_gcrs", "earth_barycentric_field", "external_field",
+           "gcrs_to_bcrs_offsets", "gcrs_to_bcrs_states"]
 
 #: K = (1 - L_G) / (1 - L_B): TDB-compatible -> TT-compatible lengths and GMs [1].
 TDB_TO_TT_SCALE = 1.0 + (L_B - L_G) / (1.0 - L_B)  # written so that only the last rounding is left
@@ -66,16 +78,56 @@ def bcrs_to_gcrs(r, v, v_earth, gms) -> np.ndarray:
     r = np.asarray(r, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
     ve = np.asarray(v_earth, dtype=np.float64)[..., None, :]
-    gm = np.asarray(gms, dtype=np.float64)
     d = np.linalg.norm(r, axis=-1)                                  # (..., n)
-    u_ext = np.sum(gm / d, axis=-1)[..., None, None]                # (..., 1, 1)
-    a_e = np.sum((gm / d ** 3)[..., None] * r, axis=-2)[..., None, :]   # (..., 1, 3)
+    u_ext, a_e = external_field(r, gms)
+    u_ext, a_e = u_ext[..., None, None], a_e[..., None, :]          # (..., 1, 1), (..., 1, 3)
     c2 = C_LIGHT * C_LIGHT
     ve_r = np.sum(ve * r, axis=-1)[..., None]                       # (..., n, 1)
     ae_r = np.sum(a_e * r, axis=-1)[..., None]
     x = r + v * (ve_r / c2)                                         # simultaneity
     x = x + (0.5 * ve_r * ve + u_ext * r + ae_r * r - 0.5 * a_e * (d ** 2)[..., None]) / c2
     return TDB_TO_TT_SCALE * x
+
+
+def external_field(r, gms) -> tuple[np.ndarray, np.ndarray]:
+    """The other bodies' Newtonian potential and attraction at the geocentre.
+
+    r: (..., n, 3) [m] geocentric positions of n bodies (BCRS, TDB-compatible,
+    ICRF axes); gms: (n,) [m^3/s^2] their TDB-compatible GMs.  Returns
+    U_ext = sum_j GM_j / |r_j| (...) [m^2/s^2] and a_E = sum_j GM_j r_j /
+    |r_j|^3 (..., 3) [m/s^2] (the Earth's barycentric acceleration due to
+    them), TDB-compatible.
+    """
+    r = np.asarray(r, dtype=np.float64)
+    gm = np.asarray(gms, dtype=np.float64)
+    d = np.linalg.norm(r, axis=-1)
+    return np.sum(gm / d, axis=-1), np.sum((gm / d ** 3)[..., None] * r, axis=-2)
+
+
+#: Bodies whose potential and attraction at the geocentre enter the GCRS -> BCRS transformation (those of them
+#: that the ephemeris holds): the Sun, the Moon and the planets' systems.
+EXTERNAL_BODIES = ("sun", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+
+
+def earth_barycentric_field(ephemeris, jd1, jd2):
+    """The Earth's barycentric state and the external field at the geocentre at TDB dates.
+
+    ephemeris: an :class:`tqdyn.astro.ephemeris.Ephemeris`; jd1, jd2: (N,)
+    two-part TDB Julian dates [d].  Returns (x_E, v_E, a_E, U_ext, bodies):
+    the Earth's barycentric position [m] and velocity [m/s] (N, 3), its
+    acceleration a_E (N, 3) [m/s^2] and the potential U_ext (N, 1)
+    [m^2/s^2] of the :data:`EXTERNAL_BODIES` the ephemeris holds
+    (:func:`external_field`, DE430/DE431 GMs), and the names of those
+    bodies; BCRS, TDB-compatible, ICRF axes.
+    """
+    from .ephemeris import planetary_gm
+
+    x_e, v_e = ephemeris.earth_barycentric(jd1, jd2)
+    names = tuple(b for b in EXTERNAL_BODIES if b in ephemeris.bodies)
+    rel, _ = ephemeris.geocentric_states(names, jd1, jd2, velocity=False)
+    gms = planetary_gm()
+    u_ext, a_e = external_field(rel, np.array([gms[b] for b in names]))
+    return x_e, v_e, a_e, u_ext[:, None], names
 
 
 def _vdot(a, b):
@@ -115,3 +167,70 @@ def gcrs_to_bcrs_offsets(y, w, acc, v_e, a_e, u_ext):
     dw = -(0.5 * (ay + vw) * v_e + 0.5 * vy * a_e + u_ext * w + aw * y + ay * w - a_e * wy
            + acc * vy + w * (ay + vw)) / c2
     return dr, dw
+
+
+def _bc(x, ndim: int):
+    """(N, k) -> (N, 1, ..., 1, k) with ndim dimensions (broadcast over the bodies' axes)."""
+    return x.reshape(x.shape[:1] + (1,) * (ndim - 2) + x.shape[-1:])
+
+
+def gcrs_to_bcrs_states(epoch, t, bodies, ephemeris) -> dict:
+    """Geocentric states (TT-compatible GCRS, TT) -> barycentric ones (BCRS: origin the solar-system barycentre,
+    ICRF axes, TDB-compatible) on the uniform TDB grid that spans the TT grid.
+
+    epoch: the :class:`tqdyn.astro.timescales.Epoch` of t; t: dd (hi, lo)
+    (N,) [s TT since the epoch]; bodies: name -> (r, v, a) with r, v dd
+    (hi, lo) pairs of (N, ..., 3) [m, m/s] and a float64 (N, ..., 3)
+    [m/s^2] (e.g. (N, 3, 3) satellites or (N, 3, 2, 3) test masses), GCRS
+    on the grid t; ephemeris: an :class:`tqdyn.astro.ephemeris.Ephemeris`.
+
+    The grid t_k and the geocentre's TT instants T_k are those of
+    :func:`tqdyn.astro.timescales.geocentre_tdb_grid`; the states at T_k come
+    from the quintic Hermite dense output of the grid
+    (:func:`tqdyn.numerics.hermite.interpolate_states`; accelerations:
+    linear between rows).  Then y = X / K, w = V / K (K =
+    :data:`TDB_TO_TT_SCALE`), r = y + dr (:func:`gcrs_to_bcrs_offsets`), x_B
+    = x_E(TDB(T_k)) + r, v_B = v_E + (w + dw) dT/dt, a_B = a_E + (acc/K)
+    (dT/dt)^2 (the 1PN terms of a, < 1e-9 m/s^2, are not applied), with x_E,
+    v_E, a_E, U_ext from :func:`earth_barycentric_field`.
+
+    Returns a dict: ``t`` (hi, lo) [s TDB since the epoch's TDB], ``T``
+    (hi, lo) [s TT since the epoch], ``x_e``, ``v_e``, ``a_e`` (N, 3),
+    ``u_ext`` (N, 1), ``dT_dt_m1`` (N,) (dT/dt - 1), ``u_ext_bodies``
+    (names), ``bodies``: name -> ((hi, lo) positions [m], (hi, lo)
+    velocities [m/s], float64 accelerations [m/s^2]) in the BCRS, and
+    ``y``: name -> (y, w), the geocentric positions and velocities at T_k in
+    TDB-compatible units (float64).
+    """
+    th, tl = (np.asarray(p, np.float64) for p in t)
+    N = th.size
+    (bh, bl), (Th, Tl), dT_dt_m1 = geocentre_tdb_grid(epoch, (th, tl))
+    jd1, jd2 = tdb_jd(epoch, Th, Tl)
+    x_e, v_e, a_e, u_ext, names = earth_barycentric_field(ephemeris, jd1, jd2)
+    K = float(TDB_TO_TT_SCALE)
+    nodes = np.ascontiguousarray(np.stack([th, tl], -1))
+    query = np.ascontiguousarray(np.stack([Th, Tl], -1))
+    jn = np.clip(np.searchsorted(th + tl, Th + Tl, side="right") - 1, 0, N - 2)
+    frac = ((Th - th[jn]) + (Tl - tl[jn])) / ((th[jn + 1] - th[jn]) + (tl[jn + 1] - tl[jn]))
+    out, ys = {}, {}
+    for name, (r, v, a) in bodies.items():
+        r = np.ascontiguousarray(np.stack([np.asarray(p, np.float64) for p in r], -1))
+        v = np.ascontiguousarray(np.stack([np.asarray(p, np.float64) for p in v], -1))
+        a = np.ascontiguousarray(np.asarray(a, np.float64))
+        rq, vq = interpolate_states(nodes, r, v, a, query)
+        fr = frac.reshape((-1,) + (1,) * (a.ndim - 1))
+        acc = (a[jn] * (1 - fr) + a[jn + 1] * fr) / K
+        yh, yl = np_dd_div_d(rq[..., 0], rq[..., 1], K)
+        y = yh + yl
+        w = (vq[..., 0] + vq[..., 1]) / K
+        nd = y.ndim
+        ve, ae = _bc(v_e, nd), _bc(a_e, nd)
+        dr, dw = gcrs_to_bcrs_offsets(y, w, acc, ve, ae, _bc(u_ext, nd))
+        xh, xl = np_dd_add_d(yh, yl, dr)
+        xh, xl = np_dd_add(xh, xl, *np_two_sum(_bc(x_e, nd) + 0.0 * y, np.zeros_like(y)))
+        rate = 1.0 + _bc(dT_dt_m1[:, None], nd)
+        vh, vl = np_two_sum(ve + 0.0 * w, (w + dw) * rate)
+        out[name] = ((xh, xl), (vh, vl), ae + acc * rate * rate)
+        ys[name] = (y, w)
+    return {"t": (bh, bl), "T": (Th, Tl), "x_e": x_e, "v_e": v_e, "a_e": a_e, "u_ext": u_ext, "dT_dt_m1": dT_dt_m1,
+            "bodies": out, "y": ys, "u_ext_bodies": names}

@@ -18,6 +18,13 @@ Conventions
   geocentric equations of motion and EGM2008's GM hold); the JPL ephemerides
   are read at TDB(TT) (:func:`tdb_jd`).  Version 0.1 read them at
   TDB(epoch) + t instead (25 us/day off near 2004).
+* TCB (the BCRS's coordinate time, that of LISA orbit files): TDB = TCB -
+  L_B (JD_TCB - T0) 86400 s + TDB0 (IAU 2006 Resolution B3) is linear, so
+  TCB intervals, lengths and GMs are S = 1/(1 - L_B) times the
+  TDB-compatible ones (:data:`TCB_PER_TDB`, :func:`tdb_to_tcb`) and only
+  the epoch's TCB date needs ``erfa.tdbtcb`` (:func:`tcb_jd_of_epoch`).
+  TT -> TCB is not linear (TDB - TT is periodic, 1.7 ms): a geocentric TT
+  grid goes to TDB at the geocentre first (:func:`geocentre_tdb_grid`).
 
 Leap seconds: on import this module merges the IERS leap-second table
 ``Leap_Second.dat`` of the installed ``astropy-iers-data`` package (released
@@ -41,18 +48,21 @@ import math
 import re
 import warnings
 from dataclasses import dataclass
+from decimal import Decimal, localcontext
 from typing import NamedTuple
 
 import erfa
 import numpy as np
 
-from ..numerics.dd import np_two_prod, np_two_sum
+from ..numerics.dd import np_dd_add_d, np_fast_two_sum, np_two_prod, np_two_sum
 from ..numerics.lagrange import MARGIN, grid_interp
 from ..readers.leap_seconds import LeapSeconds, read_leap_seconds
-from .constants import DAY_S
+from .constants import DAY_S, J2000_JD, L_B
 
-__all__ = ["Epoch", "UTCFields", "install_leap_seconds", "installed_leap_seconds", "leap_seconds_note",
-           "parse_utc", "tdb_after", "tdb_jd", "tdb_minus_tt", "tt_jd"]
+__all__ = ["TCB_ORIGINS", "TCB_PER_TDB", "TCB_SCALE", "TCB_SCALE_MINUS_1", "Epoch", "UTCFields",
+           "geocentre_tdb_grid", "install_leap_seconds", "installed_leap_seconds", "leap_seconds_note", "parse_utc",
+           "tcb_jd_of_epoch", "tcb_origin_offset", "tdb_after", "tdb_jd", "tdb_minus_tt", "tdb_to_tcb", "tt_jd",
+           "unix_of_tcb"]
 
 _ISO_FORMAT = "YYYY-MM-DDTHH:MM:SS[.fff] (UTC; 'T' or a space between date and time; optional trailing 'Z')"
 
@@ -371,3 +381,122 @@ def tdb_jd(epoch: Epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
     """
     jd1, jd2 = tt_jd(epoch, t_hi, t_lo)
     return jd1, jd2 + tdb_minus_tt(jd1, jd2) / float(DAY_S)
+
+
+# --------------------------------------------------------------------------- TCB and the geocentre's TDB grid
+
+def _tcb_per_tdb() -> tuple[float, float]:
+    with localcontext() as ctx:
+        ctx.prec = 40
+        k = 1 / (1 - Decimal(repr(L_B)))  # L_B = 1.550519768e-8 exactly (IAU 2006 Resolution B3)
+        hi = float(k)
+        return hi, float(k - Decimal(hi))
+
+
+#: S = dTCB / dTDB = 1 / (1 - L_B) as a dd pair (hi, lo) [1] (IAU 2006 Resolution B3: TDB = TCB - L_B (JD_TCB -
+#: T0) 86400 s + TDB0 is linear in TCB, so TCB intervals are S times TDB intervals, and TCB-compatible lengths
+#: and GMs S times the TDB-compatible ones; velocities are the same in both).
+TCB_PER_TDB = _tcb_per_tdb()
+#: S rounded to float64 (= 1 + L_B / (1 - L_B) to the last bit).
+TCB_SCALE = TCB_PER_TDB[0]
+#: S - 1 = L_B / (1 - L_B) [1], correctly rounded (for the small TCB - TDB terms).
+TCB_SCALE_MINUS_1 = (TCB_PER_TDB[0] - 1.0) + TCB_PER_TDB[1]
+
+#: Origins of a TCB time axis (:func:`tcb_origin_offset`).
+TCB_ORIGINS = ("epoch", "j2000", "unix")
+_UNIX_EPOCH_JD = 2440587.5  # 1970-01-01T00:00:00 UTC (ERFA quasi-JD)
+
+
+def tdb_to_tcb(hi, lo) -> tuple[np.ndarray, np.ndarray]:
+    """TDB-compatible -> TCB-compatible: S (hi + lo) = (hi + lo) + (S - 1)(hi + lo) as a dd pair.
+
+    hi, lo: float64 arrays (any shape) of a dd TDB interval [s since an
+    instant, e.g. the epoch's TDB] or a TDB-compatible length [m] (light
+    travel time, BCRS coordinate).  Returns the TCB seconds since the same
+    instant's TCB, or the TCB-compatible length, (hi, lo) of the same shape.
+    The correction (S - 1)(hi + lo) ~ 1.55e-8 (hi + lo) is formed in float64,
+    so the result holds ~3e-24 of |hi + lo| (1e-15 s on 10 years, 5e-13 m at
+    1.5e11 m; tests/test_timescales.py).
+    """
+    hi = np.asarray(hi, np.float64)
+    d = (hi + np.asarray(lo, np.float64)) * TCB_SCALE_MINUS_1
+    s, e = np_two_sum(hi, d)
+    return np_fast_two_sum(s, e + lo)
+
+
+def tcb_jd_of_epoch(epoch: Epoch) -> tuple[float, float]:
+    """Two-part TCB Julian date [d] of ``epoch`` (``erfa.tdbtcb`` of its TDB: IAU 2006 B3)."""
+    c1, c2 = erfa.tdbtcb(*epoch.tdb)
+    return float(c1), float(c2)
+
+
+def unix_of_tcb(jd1: float, jd2: float) -> float:
+    """Unix time [s] of a TCB instant (two-part JD), as astropy's ``Time(..., scale="tcb").unix``: TCB -> TDB
+    (IAU 2006 B3) -> TT (erfa.dtdb at the geocentre) -> TAI -> UTC, then (JD_UTC - 2440587.5) * 86400 (ERFA's
+    quasi-JD: 86400 s a day; leap seconds are not counted)."""
+    b1, b2 = erfa.tcbtdb(jd1, jd2)
+    dtr = erfa.dtdb(b1, b2, 0.0, 0.0, 0.0, 0.0)
+    t1, t2 = erfa.tdbtt(b1, b2, dtr)
+    a1, a2 = erfa.tttai(t1, t2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)
+        u1, u2 = erfa.taiutc(a1, a2)
+    return float(((u1 - _UNIX_EPOCH_JD) + u2) * DAY_S)
+
+
+def tcb_origin_offset(origin: str, epoch: Epoch, t_first: float) -> float:
+    """Seconds [s] to add to "TCB seconds since ``epoch``'s TCB instant" to count from ``origin``.
+
+    ``"epoch"``: 0; ``"j2000"``: the TCB seconds from J2000.0 TCB (JD
+    2451545.0 TCB) to the epoch's TCB; ``"unix"``: such that the instant
+    ``t_first`` [s TCB since the epoch's TCB] gets its Unix time
+    (:func:`unix_of_tcb`), the following ones TCB seconds after it.
+    """
+    if origin not in TCB_ORIGINS:
+        raise ValueError(f"time origin {origin!r} is not allowed; allowed: {', '.join(TCB_ORIGINS)}")
+    if origin == "epoch":
+        return 0.0
+    c1, c2 = tcb_jd_of_epoch(epoch)
+    if origin == "j2000":
+        return float((c1 - J2000_JD) * DAY_S + c2 * DAY_S)
+    return unix_of_tcb(c1, c2 + t_first / DAY_S) - t_first
+
+
+_DIFF_S = 300.0  # s: half-step of the central differences of TDB - TT
+
+
+def geocentre_tdb_grid(epoch: Epoch, t) -> tuple[tuple, tuple, np.ndarray]:
+    """The uniform TDB grid spanning a geocentric TT grid, and the geocentre's TT on it.
+
+    t: dd (hi, lo) (N,), N >= 2: TT seconds since ``epoch`` (the
+    geocentric time axis).  The grid t_k (TDB seconds since the epoch's
+    TDB) runs from TDB(T_0) to TDB(T_{N-1}) in N - 1 equal steps, formed
+    in dd as t_0 + k (t_{N-1} - t_0)/(N - 1); the geocentre's event at t_k
+    has the TT instant T_k = t_k - (TDB - TT)(T_k) (:func:`tdb_minus_tt`
+    relative to the epoch's; fixed point, 3 iterations, held inside [T_0,
+    T_{N-1}] against the last rounding), and dT/dt = 1 / (1 + d(TDB -
+    TT)/dT) (central differences over +-300 s; |dT/dt - 1| < 4e-10).
+
+    Returns (t_k dd, T_k dd, dT/dt - 1): two (hi, lo) pairs and an array,
+    each (N,), [s, s TT since the epoch, 1].
+    """
+    th, tl = (np.asarray(p, np.float64) for p in t)
+    N = th.size
+    d0 = float(tdb_minus_tt(*epoch.tt))
+
+    def dtdb(hi, lo):  # (TDB - TT)(T) - (TDB - TT)(epoch) [s]
+        return np.asarray(tdb_minus_tt(*tt_jd(epoch, hi, lo)), np.float64) - d0
+
+    b0 = np_dd_add_d(th[0], tl[0], float(dtdb(th[0], tl[0])))
+    b1 = np_dd_add_d(th[-1], tl[-1], float(dtdb(th[-1], tl[-1])))
+    span = (b1[0] - b0[0]) + (b1[1] - b0[1])
+    kdt_h, kdt_l = np_two_prod(np.arange(N, dtype=np.float64), span / (N - 1))
+    bh, bl = np_two_sum(np.full(N, b0[0]), kdt_h)
+    bh, bl = np_fast_two_sum(bh, bl + (kdt_l + b0[1]))
+    Th, Tl = np_dd_add_d(bh, bl, -dtdb(th, tl))
+    for _ in range(3):
+        Th, Tl = np_dd_add_d(bh, bl, -dtdb(Th, Tl))
+    lo_t, hi_t = th[0] + tl[0], th[-1] + tl[-1]  # rounding at the ends must not leave the grid
+    Tl = np.where(Th + Tl < lo_t, lo_t - Th, np.where(Th + Tl > hi_t, hi_t - Th, Tl))
+    ddt = (dtdb(Th + _DIFF_S, Tl) - dtdb(Th - _DIFF_S, Tl)) / (2 * _DIFF_S)
+    return (bh, bl), (Th, Tl), -ddt / (1.0 + ddt)

@@ -52,6 +52,7 @@ __all__ = [
     "arms",
     "breathing_angles",
     "by_mosa",
+    "centroid_directions",
     "constellation_geometry",
     "incenter",
     "link_pairs",
@@ -190,6 +191,21 @@ def breathing_angles(a: Arms):
     cdd = _dot(nddj, nk) + _dot(nj, nddk) + 2.0 * _dot(ndj, ndk)
     alpha_ddot = -(cdd + alpha_dot ** 2 * c) / s
     return alpha, alpha_dot, alpha_ddot
+
+
+def centroid_directions(R) -> np.ndarray:
+    """Unit vectors (..., 3, 3) from each satellite toward the centroid (R_1 + R_2 + R_3) / 3 of the three.
+
+    R: positions (..., 3, 3) [m] as for :func:`arms` (float64, dd or (hi,
+    lo)); formed from the arm vectors, centroid - R_i = (r_ij + r_ik) / 3,
+    so free of the cancellation of the absolute positions.  Same axes as R.
+    The incenter's direction (:class:`Incenter`, X_S of the global law)
+    differs from it by the first-order angle (L_ik - L_ij) / (2 sqrt(3) L)
+    (:func:`tqdyn.analysis.lisa_estimates.bisector_median_angle`).
+    """
+    a = arms(R)
+    c = a.r[..., _IJ, :] + a.r[..., _IK, :]
+    return c / np.linalg.norm(c, axis=-1, keepdims=True)
 
 
 @dataclass(frozen=True)

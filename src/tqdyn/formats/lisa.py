@@ -65,23 +65,28 @@ file at the destination is left untouched.
 from __future__ import annotations
 
 import pathlib
-import warnings
 from collections.abc import Mapping
 from typing import Any
 
-import erfa
 import h5py
 import numpy as np
 
+from ..astro.timescales import TCB_ORIGINS, tcb_jd_of_epoch
+from ..lightpath.lisa_bcrs import BCRS_AXES
 from . import trajectory as _io
 from .atomic import replacing
 
 __all__ = [
     "AXES",
     "FRAMES",
+    "GCRS_FRAME_NOTE",
+    "GCRS_TIME_NOTE",
+    "GCRS_TPS_DEFINITION",
     "TIME_ORIGINS",
     "LISA_LINK_ORDER",
     "tcb_jd_of_epoch",
+    "time_convention",
+    "uniform_grid",
     "LISA_ORBIT_FORMAT_VERSION",
     "write_lisa_orbits",
 ]
@@ -95,13 +100,13 @@ LISA_LINK_ORDER = (12, 23, 31, 13, 32, 21)
 
 _UNIFORM_TOL_S = 1e-6  # max deviation of a grid time from t0 + k dt [s]
 
-# reserved root attributes (set by the writer) and their meaning
-_TPS_DEFINITION = (
+# root attributes of a GCRS/TT file (tqdyn's geocentric variant of the format): what tps, frame and time mean
+GCRS_TPS_DEFINITION = (
     "proper time of each satellite's centre of mass against the coordinate time TT: d tau/dTT = (1 - (GM_E/r + "
     "v^2/2)/c^2) / (1 - L_G), L_G = 6.969290134e-10, along the tqdyn orbit (GM_E = attribute gm_earth); not "
     "applied: the tidal potentials of Moon and Sun (~1e-17); delta_tau = 0 at t_init")
-_FRAME = "GCRS (geocentric, ICRF axes) of tqdyn -- not the BCRS of LISA orbit files; group 'tcb' kept for readers"
-_TIME = ("tqdyn coordinate time t: TT seconds since epoch_utc (used in place of TCB); "
+GCRS_FRAME_NOTE = "GCRS (geocentric, ICRF axes) of tqdyn -- not the BCRS of LISA orbit files; group 'tcb' kept for readers"
+GCRS_TIME_NOTE = ("tqdyn coordinate time t: TT seconds since epoch_utc (used in place of TCB); "
          "tps/* are sampled at each receiver's proper time tau = t0 + k dt")
 
 _DATASETS = {
@@ -127,57 +132,35 @@ _RESERVED_ATTRS = ("version", "t0", "dt", "size")
 #: Frames of ``export_lisa(frame=...)``: "gcrs" (the trajectory's own geocentric GCRS and TT; geocentric runs
 #: only) or "bcrs" (barycentric, TCB).
 FRAMES = ("gcrs", "bcrs")
-#: Axes of a BCRS file: "icrf" (the BCRS's own) or "ecliptic" (IAU 2006 mean ecliptic and equinox of J2000,
-#: erfa.ecm06 at J2000 TT: the axes of lisaorbits' files and of lisagwresponse's ecliptic source coordinates).
-AXES = ("icrf", "ecliptic")
-#: Origins of the TCB time axis of a BCRS file (``t = t0 + k dt``).
-TIME_ORIGINS = ("epoch", "j2000", "unix")
+#: Axes of a BCRS file (:data:`tqdyn.lightpath.lisa_bcrs.BCRS_AXES`): "icrf" or "ecliptic" (IAU 2006 mean
+#: ecliptic and equinox of J2000, the axes of lisaorbits' files).
+AXES = BCRS_AXES
+#: Origins of the TCB time axis of a BCRS file (``t = t0 + k dt``; :func:`tqdyn.astro.timescales.tcb_origin_offset`).
+TIME_ORIGINS = TCB_ORIGINS
 
-_UNIX_EPOCH_JD = 2440587.5  # 1970-01-01T00:00:00 UTC (ERFA quasi-JD)
-_J2000_JD = 2451545.0
-_DAY_S = 86400.0
-
-
-def tcb_jd_of_epoch(epoch) -> tuple[float, float]:
-    """Two-part TCB Julian date of an epoch (erfa.tdbtcb of its TDB: IAU 2006 B3)."""
-    c1, c2 = erfa.tdbtcb(*epoch.tdb)
-    return float(c1), float(c2)
-
-
-def _unix_of_tcb(c1: float, c2: float) -> float:
-    """Unix time [s] of a TCB instant, as astropy's ``Time(..., scale="tcb").unix``: TCB -> TDB (IAU 2006 B3) ->
-    TT (erfa.dtdb at the geocentre) -> TAI -> UTC, then (JD_UTC - 2440587.5) * 86400 (ERFA's quasi-JD: 86400 s a
-    day; leap seconds are not counted)."""
-    b1, b2 = erfa.tcbtdb(c1, c2)
-    dtr = erfa.dtdb(b1, b2, 0.0, 0.0, 0.0, 0.0)
-    t1, t2 = erfa.tdbtt(b1, b2, dtr)
-    a1, a2 = erfa.tttai(t1, t2)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", erfa.ErfaWarning)
-        u1, u2 = erfa.taiutc(a1, a2)
-    return float(((u1 - _UNIX_EPOCH_JD) + u2) * _DAY_S)
+_TIME_CONVENTIONS = {
+    "epoch": "t = TCB seconds since the trajectory epoch's TCB instant (attributes epoch_tcb_jd1 + epoch_tcb_jd2), "
+             "as lisaorbits' analytic orbits count TCB seconds from their t_init (default 0)",
+    "j2000": "t = TCB seconds since J2000.0 TCB (JD 2451545.0 TCB); a float64 t near 1e9 s resolves 2.4e-7 s",
+    "unix": "t0 = the Unix time of the first sample's TCB instant (astropy Time(..., scale='tcb').unix: seconds since "
+            "1970-01-01T00:00:00 UTC, leap seconds not counted), as lisaorbits' OEMOrbits dates its samples; the "
+            "samples t0 + k dt are TCB seconds after it (a Unix stamp at t0 only); a float64 t near 2e9 s resolves "
+            "4.8e-7 s",
+}
 
 
-def _time_offset(origin: str, epoch, t_first: float) -> tuple[float, str]:
-    """t_off [s] added to the TCB seconds since the epoch's TCB, and the sentence stating the convention."""
-    c1, c2 = tcb_jd_of_epoch(epoch)
-    if origin == "epoch":
-        return 0.0, ("t = TCB seconds since the trajectory epoch's TCB instant (attributes epoch_tcb_jd1 + "
-                     "epoch_tcb_jd2), as lisaorbits' analytic orbits count TCB seconds from their t_init (default 0)")
-    if origin == "j2000":
-        return float((c1 - _J2000_JD) * _DAY_S + c2 * _DAY_S), (
-            "t = TCB seconds since J2000.0 TCB (JD 2451545.0 TCB); a float64 t near 1e9 s resolves 2.4e-7 s")
-    first = _unix_of_tcb(c1, c2 + t_first / _DAY_S)
-    return first - t_first, (
-        "t0 = the Unix time of the first sample's TCB instant (astropy Time(..., scale='tcb').unix: seconds since "
-        "1970-01-01T00:00:00 UTC, leap seconds not counted), as lisaorbits' OEMOrbits dates its samples; the "
-        "samples t0 + k dt are TCB seconds after it (a Unix stamp at t0 only); a float64 t near 2e9 s resolves "
-        "4.8e-7 s")
+def time_convention(origin: str) -> str:
+    """The sentence (attribute ``t0_convention``) that states what t of a BCRS file counts from ``origin``
+    (one of :data:`TIME_ORIGINS`)."""
+    return _TIME_CONVENTIONS[origin]
 
 
 # ------------------------------------------------------------------ writer
 
-def _uniform_grid(t, name: str = "t") -> tuple[float, float]:
+def uniform_grid(t, name: str = "t") -> tuple[float, float]:
+    """(t0, dt) [s] of a uniform time grid t0 + k dt: ``t`` an (N,) array or a
+    dd pair (hi, lo), N >= 2, each time within 1e-6 s of the grid; else a
+    one-line ValueError naming ``name``."""
     tt = (t[0] + t[1]) if isinstance(t, tuple) else np.asarray(t, np.float64)
     tt = np.asarray(tt, np.float64)
     if tt.ndim != 1 or tt.size < 2:
@@ -249,7 +232,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
     or :class:`tqdyn.formats.trajectory.OutputError` (path not writable).
     """
     out = _io.check_writable(path)
-    t0, dt = _uniform_grid(t)
+    t0, dt = uniform_grid(t)
     N = (t[0] if isinstance(t, tuple) else np.asarray(t)).shape[0]
     data = {"tcb/x": x, "tcb/v": v, "tcb/a": a, "tcb/delta_tau": delta_tau, "tcb/n": n, "tcb/ltt": ltt,
             "tcb/d_ltt": d_ltt, "tcb/ppr": ppr, "tcb/d_ppr": d_ppr, "tps/delta_t": tps_delta_t,

@@ -9,8 +9,10 @@ Modules: :mod:`~tqdyn.lightpath.light_time` (the light-time solver,
 :mod:`~tqdyn.lightpath.proper_time` (proper times of the satellites' clocks
 in the GCRS and the LISA orbit-file quantities),
 :mod:`~tqdyn.lightpath.proper_time_bcrs` (proper times of heliocentric
-clocks against TDB or TCB) and :mod:`~tqdyn.lightpath.heliocentric` (the
-Sun's barycentric motion and the bodies' states from the ephemeris).
+clocks against TDB or TCB, and of geocentric ones against TCB),
+:mod:`~tqdyn.lightpath.heliocentric` (the Sun's barycentric motion and the
+bodies' states from the ephemeris) and :mod:`~tqdyn.lightpath.lisa_bcrs`
+(the quantities of a BCRS / TCB LISA orbit file).
 The public names of the first four are re-exported here.
 """
 

@@ -15,6 +15,8 @@ what they need from the JPL ephemeris, at the ephemeris dates
   :meth:`~tqdyn.astro.ephemeris.Ephemeris.heliocentric_states`; rounding
   ~3e-5 m and ~4e-12 m/s), the acceleration the central difference of
   dS/dt over +-300 s (truncation ~1e-16 m/s^2, rounding ~1e-14 m/s^2);
+* :func:`ssb_states`: Sun-centred states moved to the solar-system
+  barycentre (+ the Sun's barycentric motion);
 * :func:`body_states`: Sun-centred positions and velocities of the Earth,
   the Moon and the planets (system barycentres);
 * :func:`ephemeris_of`, :func:`run_third_bodies`, :func:`resolve_bodies`:
@@ -30,9 +32,10 @@ import numpy as np
 
 from ..astro.ephemeris import HELIOCENTRIC_BODIES, Ephemeris, default_ephemeris, planetary_gm
 from ..astro.reference import HELIOCENTRIC
+from ..numerics.dd import np_dd_add_d
 
 __all__ = ["BODY_SETS", "body_states", "ephemeris_of", "gm_of", "resolve_bodies", "run_third_bodies",
-           "sun_barycentric_motion"]
+           "ssb_states", "sun_barycentric_motion"]
 
 #: Named body lists: ``"third_bodies"`` = the run's ``forces.third_bodies``
 #: (the heliocentric ones), ``"all"`` = every body of
@@ -118,6 +121,32 @@ def sun_barycentric_motion(ephemeris: Ephemeris, epoch, t, reference=HELIOCENTRI
     _, vp = state(_FD_STEP)
     _, vm = state(-_FD_STEP)
     return s, v, (vp - vm) / (2.0 * _FD_STEP)
+
+
+def ssb_states(ephemeris: Ephemeris, epoch, t, bodies, reference=HELIOCENTRIC) -> dict:
+    """Sun-centred states -> BCRS states with the origin at the solar-system barycentre.
+
+    t as :func:`sun_barycentric_motion` (N,) [s TDB since ``epoch``];
+    bodies: name -> (r, v, a), r and v dd (hi, lo) pairs of (N, ..., 3) [m,
+    m/s] and a float64 (N, ..., 3) [m/s^2], Sun-centred BCRS
+    (TDB-compatible, ICRF axes).  Each state gets the Sun's barycentric
+    position, velocity and acceleration S, dS/dt, d2S/dt2 at the same TDB
+    (x + S, v + dS/dt in dd; a + d2S/dt2).  Returns a dict: ``t`` (hi,
+    lo), ``x_sun``, ``v_sun``, ``a_sun`` (N, 3) and ``bodies``: name ->
+    ((hi, lo) positions [m], (hi, lo) velocities [m/s], float64
+    accelerations [m/s^2]).
+    """
+    th, tl = _times(t)
+    x_s, v_s, a_s = sun_barycentric_motion(ephemeris, epoch, (th, tl), reference)
+    out = {}
+    for name, (r, v, a) in bodies.items():
+        rh, rl = (np.asarray(p, np.float64) for p in r)
+        vh, vl = (np.asarray(p, np.float64) for p in v)
+        shape = (-1,) + (1,) * (rh.ndim - 2) + (3,)  # broadcast over the bodies' axes
+        out[name] = (np_dd_add_d(rh, rl, x_s.reshape(shape) + 0.0 * rh),
+                     np_dd_add_d(vh, vl, v_s.reshape(shape) + 0.0 * vh),
+                     np.asarray(a, np.float64) + a_s.reshape(shape))
+    return {"t": (th, tl), "x_sun": x_s, "v_sun": v_s, "a_sun": a_s, "bodies": out}
 
 
 def body_states(ephemeris: Ephemeris, epoch, t, bodies, reference=HELIOCENTRIC, *, velocity: bool = True):

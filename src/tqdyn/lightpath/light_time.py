@@ -130,6 +130,7 @@ __all__ = [
     "light_travel_times",
     "light_travel_times_of",
     "link_bodies",
+    "satellite_states",
 ]
 
 BODY_LAYOUTS = ("tm", "sat")
@@ -415,14 +416,21 @@ def _trajectory_arrays(trajectory):
     for f in ("sat/r", "sat/v", "sat/a_gravity"):
         if f not in trajectory:
             raise ValueError(f"trajectory: has no field {f!r} (needed for light paths between satellite centres)")
-    acc = np.asarray(trajectory["sat/a_gravity"], np.float64)
-    parts = "sat/a_gravity"
-    if "sat/a_dragfree" in trajectory:
-        acc = acc + np.asarray(trajectory["sat/a_dragfree"], np.float64)
-        parts += " + sat/a_dragfree"
+    parts = "sat/a_gravity" + (" + sat/a_dragfree" if "sat/a_dragfree" in trajectory else "")
     note = ("no test-mass fields (tm/r, tm/v, tm/a) in the trajectory: links between the satellites' centres of "
             f"mass (sat/r, sat/v, {parts})")
-    return t, trajectory.dd("sat/r"), trajectory.dd("sat/v"), acc, {"note": note}
+    return (t, *satellite_states(trajectory), {"note": note})
+
+
+def satellite_states(trajectory) -> tuple[tuple, tuple, np.ndarray]:
+    """The satellites' centres of a trajectory (duck-typed like :class:`tqdyn.formats.trajectory.Trajectory`):
+    positions ``sat/r`` [m] and velocities ``sat/v`` [m/s] as dd (hi, lo) pairs, and the total acceleration
+    ``sat/a_gravity`` (+ ``sat/a_dragfree`` when present) [m/s^2] float64, each (N, n_sat, 3), in the
+    trajectory's frame."""
+    acc = np.asarray(trajectory["sat/a_gravity"], np.float64)
+    if "sat/a_dragfree" in trajectory:
+        acc = acc + np.asarray(trajectory["sat/a_dragfree"], np.float64)
+    return trajectory.dd("sat/r"), trajectory.dd("sat/v"), acc
 
 
 def light_travel_times_of(trajectory, *, shapiro_bodies=None, ephemeris=None, **kwargs) -> LightTravelTimes:

@@ -50,9 +50,10 @@ from numba import njit
 
 from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, L_G
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
+from .heliocentric import _scenario
 from .light_time import LightTravelTimes
 
-__all__ = ["lisa_orbit_quantities", "proper_time_deviation"]
+__all__ = ["lisa_orbit_quantities", "proper_time_deviation", "pseudorange_quantities", "scenario_gm_earth"]
 
 _RECV, _EMIT = LINK_RECEIVER, LINK_EMITTER
 
@@ -112,6 +113,17 @@ def proper_time_deviation(t, r, v, a, gm: float | None = None) -> tuple[np.ndarr
     return out, -f, -fd
 
 
+def scenario_gm_earth(trajectory) -> float:
+    """The Earth's GM [m^3/s^2] of a trajectory's run, for its clocks: the scenario's ``forces.gm_earth``
+    (TT-compatible), else :data:`tqdyn.astro.constants.GM_EARTH_EGM2008` (no scenario, or one that does not
+    parse)."""
+    try:
+        gm = _scenario(trajectory).get("forces", {}).get("gm_earth")
+        return float(GM_EARTH_EGM2008) if gm is None else float(gm)
+    except (TypeError, ValueError, AttributeError):
+        return float(GM_EARTH_EGM2008)
+
+
 # ------------------------------------------------------------------ the quantities
 
 def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: float | None = None, *,
@@ -152,32 +164,48 @@ def lisa_orbit_quantities(t, sat_r, sat_v, sat_a, lp: LightTravelTimes, gm: floa
         if not (dtau.shape == rate.shape == rate_dot.shape == x.shape[:2]):
             raise ValueError(f"proper_time: shapes {dtau.shape}, {rate.shape}, {rate_dot.shape}; allowed: "
                              f"{x.shape[:2]} each")
-    ltt = lp.tau[0] + lp.tau[1]
-    ltt_lo = lp.tau[1] - (ltt - lp.tau[0])
-    d_ltt = lp.tau_rate
+    tgrid = th + tl
+    q = pseudorange_quantities(tgrid, lp.tau, lp.tau_rate, dtau, rate, rate_dot)
+    return {"t": tgrid, "t_init": float(tgrid[0]), "tcb/x": x, "tcb/v": v, "tcb/a": a, "tcb/n": lp.unit_vectors,
+            **q}
+
+
+def pseudorange_quantities(t, ltt, d_ltt, dtau, rate, rate_dot) -> dict[str, np.ndarray]:
+    """The clock-dependent datasets of a LISA orbit file (the module docstring's definitions).
+
+    In one coordinate time (TT, TDB or TCB) shared by all inputs: t (N,)
+    grid times [s] (float64); ltt: dd (hi, lo) light travel times (N, 6)
+    [s] and d_ltt (N, 6) their rates [s/s] (rows without a light time:
+    NaN); dtau, rate, rate_dot (N, 3): the clocks' proper-time deviations
+    tau - t [s], their rates [s/s] and the rates' derivatives [1/s].
+
+    Returns a dict of (N, ...) arrays: ``tcb/ltt`` (float64) and ``ltt_lo``
+    (its dd remainder), ``tcb/d_ltt``, ``tcb/delta_tau``, ``tcb/ppr`` =
+    ltt + delta_tau_recv(t) - delta_tau_emit(t - ltt), ``tcb/d_ppr``,
+    ``tps/delta_t``, ``tps/ppr``, ``tps/d_ppr`` (d(d_ppr)/dt by second-order
+    finite differences over the rows with a light time, when there are 3 or
+    more; else NaN).
+    """
+    ltt_hi, ltt_lo = ltt
+    f = ltt_hi + ltt_lo
     # receiver clock at t, emitter clock at t - ltt (Taylor series about the grid time t)
     dt_r, rate_r = dtau[:, _RECV], rate[:, _RECV]
-    dt_e = dtau[:, _EMIT] - ltt * rate[:, _EMIT] + 0.5 * ltt ** 2 * rate_dot[:, _EMIT]
-    rate_e = rate[:, _EMIT] - ltt * rate_dot[:, _EMIT]
-    ppr = lp.tau[0] + (lp.tau[1] + (dt_r - dt_e))
+    dt_e = dtau[:, _EMIT] - f * rate[:, _EMIT] + 0.5 * f ** 2 * rate_dot[:, _EMIT]
+    rate_e = rate[:, _EMIT] - f * rate_dot[:, _EMIT]
+    ppr = ltt_hi + (ltt_lo + (dt_r - dt_e))
     d_ppr = (rate_r - rate_e + d_ltt * (1.0 + rate_e)) / (1.0 + rate_r)
     # proper-time grid: coordinate time of tau = t_k is t_k + delta_t, delta_t = -delta_tau(t_k + delta_t)
     delta_t = -dtau
     delta_t = -(dtau + rate * delta_t)
     shift = delta_t[:, _RECV]
-    tgrid = th + tl
     # d(d_ppr)/dt by second-order finite differences over the rows that have a light travel time
     d_ppr_dt = np.full_like(d_ppr, np.nan)
     ok = np.all(np.isfinite(d_ppr), axis=1)
     i0 = int(np.argmax(ok)) if ok.any() else ok.size
     if ok.size - i0 >= 3 and ok[i0:].all():
-        d_ppr_dt[i0:] = np.gradient(d_ppr[i0:], tgrid[i0:], axis=0, edge_order=2)
-    tps_ppr = ppr + shift * d_ppr * (1.0 + rate_r)
-    tps_d_ppr = d_ppr + shift * d_ppr_dt
+        d_ppr_dt[i0:] = np.gradient(d_ppr[i0:], t[i0:], axis=0, edge_order=2)
     return {
-        "t": tgrid, "t_init": float(tgrid[0]),
-        "tcb/x": x, "tcb/v": v, "tcb/a": a, "tcb/delta_tau": dtau, "tcb/n": lp.unit_vectors,
-        "tcb/ltt": ltt, "tcb/d_ltt": d_ltt, "tcb/ppr": ppr, "tcb/d_ppr": d_ppr,
-        "tps/delta_t": delta_t, "tps/ppr": tps_ppr, "tps/d_ppr": tps_d_ppr, "ltt_lo": ltt_lo,
+        "tcb/ltt": f, "ltt_lo": ltt_lo - (f - ltt_hi), "tcb/d_ltt": d_ltt, "tcb/delta_tau": dtau,
+        "tcb/ppr": ppr, "tcb/d_ppr": d_ppr, "tps/delta_t": delta_t, "tps/ppr": ppr + shift * d_ppr * (1.0 + rate_r),
+        "tps/d_ppr": d_ppr + shift * d_ppr_dt,
     }
-

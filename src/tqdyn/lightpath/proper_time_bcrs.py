@@ -1,4 +1,4 @@
-"""Proper times of clocks on heliocentric orbits, against TCB or TDB (physics).
+"""Proper times of clocks on heliocentric orbits, against TCB or TDB, and of geocentric ones against TCB (physics).
 
 Heliocentric trajectories (:data:`tqdyn.astro.reference.HELIOCENTRIC`) give
 Sun-centred positions r, velocities v and accelerations a in the
@@ -49,18 +49,27 @@ as :func:`tqdyn.lightpath.proper_time.proper_time_deviation` integrates the
 geocentric ones (end-corrected trapezoid; error ~2e-20 s per hour step at 1
 au, the derivative dF/dt from r, v, a and the bodies' states, its 1/c^4
 part (~2e-25 /s) omitted).
+
+Geocentric runs (GCRS, TT) in the BCRS / TCB file of the LISA export:
+:func:`proper_time_deviation_geocentric_tcb` reads the clocks against TT of
+:mod:`tqdyn.lightpath.proper_time` at each satellite's BCRS event and
+re-expresses them against TCB.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..astro.constants import C_LIGHT, GM_EARTH_EGM2008, L_B
+from ..astro.constants import C_LIGHT, L_B
 from ..astro.reference import GEOCENTRIC
+from ..astro.timescales import TCB_SCALE, TCB_SCALE_MINUS_1
+from ..numerics.dd import np_two_sum
 from . import heliocentric as _helio
-from .proper_time import _dd_cumsum, proper_time_deviation
+from .light_time import satellite_states
+from .proper_time import _dd_cumsum, proper_time_deviation, scenario_gm_earth
 
-__all__ = ["PROPER_TIME_SCALES", "proper_time_deviation_bcrs", "proper_time_deviation_of"]
+__all__ = ["PROPER_TIME_SCALES", "proper_time_deviation_bcrs", "proper_time_deviation_geocentric_tcb",
+           "proper_time_deviation_of"]
 
 #: Time scales a heliocentric proper-time deviation can be taken against.
 PROPER_TIME_SCALES = ("TCB", "TDB")
@@ -145,9 +154,58 @@ def proper_time_deviation_bcrs(t, r, v, a, *, origin_velocity, origin_accelerati
     return out, rate, rate_dot
 
 
-def _scenario_gm_earth(trajectory) -> float:
-    gm = _helio._scenario(trajectory).get("forces", {}).get("gm_earth")
-    return float(GM_EARTH_EGM2008) if gm is None else float(gm)
+def proper_time_deviation_geocentric_tcb(t, r, v, a, states, gm: float | None = None):
+    """Proper-time deviations against TCB of clocks of a geocentric (GCRS, TT) run, at their BCRS samples.
+
+    t: dd (hi, lo) (N,) grid times [s TT since the epoch]; r, v, a: (N, B,
+    3) float64 GCRS positions [m], velocities [m/s], accelerations [m/s^2]
+    of B clocks on that grid; states: the
+    :func:`tqdyn.astro.geocentric.gcrs_to_bcrs_states` of the same clocks
+    under the name ``"sat"`` (its uniform TDB grid t_k, the geocentre's TT
+    T_k, v_E, a_E, dT/dt and the clocks' geocentric y, w at T_k); gm: the
+    Earth's TT-compatible GM [m^3/s^2] (default GM_EARTH_EGM2008).
+
+    The clocks against TT, tau(T) = T + delta_tau_TT(T)
+    (:func:`tqdyn.lightpath.proper_time.proper_time_deviation`, the
+    Earth's monopole: d tau/dTT = (1 - (GM_E/r + v^2/2)/c^2)/(1 - L_G)),
+    are read at each clock's BCRS event: sample k of clock i is its event at
+    TCB t_c,k = S t_k (S = :data:`tqdyn.astro.timescales.TCB_SCALE`), whose
+    TT is T_ik = T_k - (v_E . y_i)/c^2 (the 1PN simultaneity: TCB - TCG =
+    c^-2 [int (v_E^2/2 + U_ext) dt + v_E . r]); its proper time is T_ik +
+    delta_tau_TT(T_ik) (Taylor series from grid row k: |T_ik - T_row| < 1
+    ms), and delta_tau_c = tau - t_c, synchronised to 0 at the first
+    sample.  Rate: d tau/dt_c = (1 + rate_TT) dT_i/dt_c with dT_i/dt_c =
+    (dT/dt - (a_E . y + v_E . w)/c^2) / S; its derivative by second-order
+    finite differences along the grid.
+
+    Returns (delta_tau, rate, rate_dot), each (N, B): [s], [s/s] and [1/s]
+    per TCB second, at the TCB instants S t_k.
+    """
+    dtau, rate, rate_dot = proper_time_deviation(t, r, v, a, gm)
+    th, tl = (np.asarray(p, np.float64) for p in t)
+    Th, Tl = states["T"]
+    bh, bl = states["t"]
+    y, w = states["y"]["sat"]
+    c2 = C_LIGHT * C_LIGHT
+    ve, ae = states["v_e"][:, None, :], states["a_e"][:, None, :]
+    shift = -np.einsum("nsk,nsk->ns", ve, y) / c2                   # T_ik - T_k
+    eps = ((Th - th) + (Tl - tl))[:, None] + shift                  # T_ik - T_row
+    dtau_e = dtau + rate * eps + 0.5 * rate_dot * eps ** 2
+    # tau - t_c = (T_ik - T_0) + delta_tau(T_ik) - S (t_k - t_0) - const; elapsed parts in dd
+    dTb_h, dTb_l = np_two_sum(Th - bh, Tl - bl)                     # T_k - t_k: -(TDB - TT) drift, ms
+    dtk = (bh - bh[0]) + (bl - bl[0])
+    lin = (dTb_h + dTb_l)[:, None] - (dTb_h[0] + dTb_l[0]) - (TCB_SCALE_MINUS_1 * dtk)[:, None]
+    raw = lin + shift + dtau_e
+    dtau_c = raw - raw[0]
+    q = (np.einsum("nsk,nsk->ns", ae, y) + np.einsum("nsk,nsk->ns", ve, w)) / c2
+    ddt = states["dT_dt_m1"][:, None]                               # dT/dt - 1 (|.| < 4e-10)
+    rate_e = rate + eps * rate_dot
+    # (1 + rate)(1 + ddt - q)(1 - L_B) - 1, small terms kept small
+    g = ddt - q
+    rate_c = -L_B + (1.0 - L_B) * (rate_e + g + rate_e * g)
+    dt_c = TCB_SCALE * (dtk[1] - dtk[0]) if dtk.size > 1 else 1.0
+    rate_dot_c = np.gradient(rate_c, dt_c, axis=0, edge_order=2)
+    return dtau_c, rate_c, rate_dot_c
 
 
 def proper_time_deviation_of(trajectory, *, against: str | None = None, bodies="all", ephemeris=None,
@@ -174,18 +232,13 @@ def proper_time_deviation_of(trajectory, *, against: str | None = None, bodies="
     [1/s] per second of the time scale against which delta_tau is taken.
     """
     t = trajectory.dd("t")
-    x = trajectory.dd("sat/r")
-    x = x[0] + x[1]
-    vel = trajectory.dd("sat/v")
-    vel = vel[0] + vel[1]
-    acc = np.asarray(trajectory["sat/a_gravity"], np.float64)
-    if "sat/a_dragfree" in trajectory:
-        acc = acc + np.asarray(trajectory["sat/a_dragfree"], np.float64)
+    x, vel, acc = satellite_states(trajectory)
+    x, vel = x[0] + x[1], vel[0] + vel[1]
     ref = getattr(trajectory, "reference", None) or GEOCENTRIC
     if ref.central_body != "sun":
         if against not in (None, "TT"):
             raise ValueError(f"against = {against!r}: a geocentric trajectory's proper times are against TT")
-        return proper_time_deviation(t, x, vel, acc, _scenario_gm_earth(trajectory) if gm is None else gm)
+        return proper_time_deviation(t, x, vel, acc, scenario_gm_earth(trajectory) if gm is None else gm)
     eph = _helio.ephemeris_of(trajectory) if ephemeris is None else ephemeris
     epoch = trajectory.epoch
     _, vo, ao = _helio.sun_barycentric_motion(eph, epoch, t, ref)

@@ -8,26 +8,14 @@ documents the equations); re-exported by :mod:`tqdyn.lightpath` and
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from decimal import Decimal, localcontext
 
 import numpy as np
 
-from ..astro.constants import C_LIGHT, L_B
+from ..astro.constants import C_LIGHT
+from ..astro.timescales import TCB_PER_TDB
 from ..numerics.dd import np_two_prod, np_two_sum
 
 __all__ = ["LightTravelTimes", "TCB_PER_TDB"]
-
-
-def _tcb_per_tdb() -> tuple[float, float]:
-    with localcontext() as ctx:
-        ctx.prec = 40
-        k = 1 / (1 - Decimal(repr(L_B)))  # L_B = 1.550519768e-8 exactly (IAU 2006 Resolution B3)
-        hi = float(k)
-        return hi, float(k - Decimal(hi))
-
-
-#: dTCB / dTDB = 1 / (1 - L_B) as a dd pair (hi, lo) (IAU 2006 B3; L_B = 1.550519768e-8 exactly).
-TCB_PER_TDB = _tcb_per_tdb()
 
 
 def _dd_scale(x, k):

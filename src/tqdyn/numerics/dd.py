@@ -54,7 +54,7 @@ __all__ = [
     "two_sum", "two_prod", "fast_two_sum",
     "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "mp_from_pair", "split_dd", "join_dd",
     "np_two_sum", "np_two_prod", "mp_exact", "np_fast_two_sum", "np_dd_add", "np_dd_sqr",
-    "np_dd_sqrt", "np_dd_div_d",
+    "np_dd_sqrt", "np_dd_div_d", "np_dd_add_d",
     "is_dd_array",
 ]
 
@@ -427,6 +427,16 @@ def np_dd_add(ah, al, bh, bl):
     s, e = np_fast_two_sum(s, e)
     e = e + f
     return np_fast_two_sum(s, e)
+
+
+def np_dd_add_d(ah, al, b):
+    """Vectorised dd + float64 (numpy): (ah + al) + b as a dd pair.
+
+    two_sum of the high parts, then a fast renormalisation: exact as long as
+    ah + b does not cancel below al (|ah + b| >= |al|), e.g. a small
+    correction b to a dd coordinate or time."""
+    s, e = np_two_sum(np.asarray(ah, np.float64), np.asarray(b, np.float64))
+    return np_fast_two_sum(s, e + al)
 
 
 def np_dd_sqr(ah, al):

@@ -102,7 +102,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
         }
     if heyoka:
         try:
-            from . import heyoka_peer as _heyoka_peer
+            from ..peers import heyoka as _heyoka_peer
             y0 = dynamics.initial_state(scen)
             out = _heyoka_peer.propagate_kepler_grid(
                 (y0[:, 0:3, 0], y0[:, 0:3, 1]), (y0[:, 3:6, 0], y0[:, 3:6, 1]), str(scen.forces.gm_earth),
@@ -180,7 +180,7 @@ def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
             report["reduced_final"] = res.y_final
     if heyoka:
         try:
-            from . import heyoka_peer as _heyoka_peer
+            from ..peers import heyoka as _heyoka_peer
             peer = getattr(_heyoka_peer, "propagate_reduced_grid")
         except (ImportError, AttributeError) as exc:
             report["heyoka"] = f"skipped: {exc}"

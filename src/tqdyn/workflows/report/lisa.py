@@ -26,20 +26,22 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from ...analysis import lisa_estimates as le
+from ...analysis.esa_orbits import esa_records, esa_states_on_grid
 from ...analysis.figures import SAT_COLORS, plot_control, plot_pointing
 from ...analysis.figures_lisa import plot_arm_response, plot_deviation, plot_esa_ramp, plot_estimate
-from ...analysis.metrics import common_rows, control_values, times_s, orbit_deviation
+from ...analysis.metrics import (common_rows, control_values, times_s, arm_lengths_of, control_terms, orbit_deviation,
+                                 sat_positions)
 from ...analysis.pointing_study import pointing_study_of
+from ...astro.constants import C_LIGHT
+from ...astro.ephemeris import planetary_gm
 from ...constellation import geometry
 from ...constellation.indices import Sat
+from ...constellation.pointing import beam_directions, pointing_frames
 from ..studies_lisa import SG_DIRECTIONS, STUDIES
 from .summary import Report, SummaryRow, evaluate_studies, _e, _per_sat, _span_days, format_summary
 
 __all__ = ["report_lisa_studies"]
 
-_C = 299792458.0
-_YEAR_S = 365.25 * 86400.0
-_PERM = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
 
 
 def report_lisa_studies(run_paths: Mapping[str, str | os.PathLike | None], out_dir: str | os.PathLike, *,
@@ -71,20 +73,10 @@ def report_lisa_studies(run_paths: Mapping[str, str | os.PathLike | None], out_d
 # =========================================================================== helpers
 
 
-def _r(tr) -> np.ndarray:
-    hi, lo = tr.dd("sat/r")
-    return hi + lo
-
-
 def _scenario(tr):
     from ...scenario import loads_scenario
 
     return loads_scenario(tr.scenario_toml)
-
-
-def _G_S(tr) -> np.ndarray:
-    """Drag-free acceleration in S, (N, 3, 3) [m/s^2]."""
-    return np.einsum("nsij,nsj->nsi", tr["sat/T_S_I"], tr["sat/a_dragfree"])
 
 
 def _max_suspension(tr) -> np.ndarray:
@@ -109,69 +101,6 @@ def _ramp_g(tr) -> np.ndarray:
     return np.zeros_like(t) if ramp is None else centre_ramp(ramp, t)
 
 
-def _centroid_dirs(r) -> np.ndarray:
-    c = r.mean(axis=1, keepdims=True) - r
-    return c / np.linalg.norm(c, axis=-1, keepdims=True)
-
-
-def _instantaneous_bisectors(r) -> np.ndarray:
-    """Unit bisector of each satellite's two instantaneous arms (toward the incentre), (N, 3, 3)."""
-    out = np.zeros_like(r)
-    for i, j, k in _PERM:
-        a = r[:, j] - r[:, i]
-        b = r[:, k] - r[:, i]
-        x = a / np.linalg.norm(a, axis=-1, keepdims=True) + b / np.linalg.norm(b, axis=-1, keepdims=True)
-        out[:, i] = x / np.linalg.norm(x, axis=-1, keepdims=True)
-    return out
-
-
-def _arm_lengths(traj_r) -> dict:
-    """{(i, j): L_ij (N,)} [m] for every ordered pair of satellites (0-based)."""
-    out = {}
-    for i in range(3):
-        for j in range(3):
-            if i != j:
-                out[(i, j)] = np.linalg.norm(traj_r[:, j] - traj_r[:, i], axis=-1)
-    return out
-
-
-_ESA_CACHE: dict = {}
-
-
-def _esa_files():
-    """ESA's three CReMA 2.0 files (TDB), heliocentric, their "EME2000" axes read as ICRF (as the built-in
-    scenarios read them: docs/lisa-orbits.md)."""
-    if "orbits" not in _ESA_CACHE:
-        from ...readers.oem import esa_lisa_orbit_files, read_oem, to_heliocentric
-
-        _ESA_CACHE["orbits"] = [to_heliocentric(read_oem(p), eme2000_frame_bias=False)
-                                for p in esa_lisa_orbit_files("TDB")]
-    return _ESA_CACHE["orbits"]
-
-
-def _esa_on_grid(tr) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """ESA's files interpolated (Hermite, as they say) on the rows of ``tr`` inside their span:
-    (row indices (M,), R (M, 3, 3) [m], V (M, 3, 3) [m/s])."""
-    from ...readers.oem import states_at
-
-    esa = _esa_files()
-    ep = tr.epoch.tdb
-    t = times_s(tr)
-    end = ((esa[0].stop[0] - ep[0]) + (esa[0].stop[1] - ep[1])) * 86400.0 if esa[0].stop else np.inf
-    rows = np.nonzero(t <= end)[0]
-    st = [states_at(o, ep[0], ep[1] + t[rows] / 86400.0) for o in esa]
-    return rows, np.stack([s[0] for s in st], 1), np.stack([s[1] for s in st], 1)
-
-
-def _esa_records(t_end_s, epoch_tdb):
-    """ESA's records within [0, t_end_s] of the epoch: (t [s], R, V, A (M, 3, 3))."""
-    esa = _esa_files()
-    td = ((esa[0].jd1 - epoch_tdb[0]) + (esa[0].jd2 - epoch_tdb[1])) * 86400.0
-    sel = (td >= -1.0) & (td <= t_end_s + 1.0)
-    return (td[sel], np.stack([o.r[sel] for o in esa], 1), np.stack([o.v[sel] for o in esa], 1),
-            np.stack([o.a[sel] for o in esa], 1))
-
-
 def _pm(v, unit, fmt="{:.3g}") -> str:
     return _per_sat(v, unit, fmt)
 
@@ -182,50 +111,9 @@ def _pm(v, unit, fmt="{:.3g}") -> str:
 def _estimate_series(tr, arm_length, d):
     """|G| and max suspension component of the first-order formula at the run's cartwheel phases, (N, 3) each."""
     est = le.kepler_control_estimate(arm_length, d)
-    tau = le.cartwheel_phase_series(_r(tr), tr["sat/v"]) - math.pi
+    tau = le.cartwheel_phase_series(sat_positions(tr), tr["sat/v"]) - math.pi
     _, G, A = le.kepler_control(tau)
     return est, np.linalg.norm(G, axis=-1) * est.scale, np.abs(A).max(axis=(-2, -1)) * est.scale
-
-
-def _decomposition(tr, d) -> dict:
-    """Max magnitudes [m/s^2] of the terms of g_l (control module docstring): the Sun's tide,
-    the centrifugal and Euler terms of S, their sum, and the MOSA terms (alpha_dot, alpha_ddot of the
-    beam opening angle by central differences)."""
-    from ...constellation import control
-
-    r = _r(tr)
-    t = times_s(tr)
-    T = tr["sat/T_S_I"]
-    w, wd = tr["sat/omega"], tr["sat/omega_dot"]
-    th = 2.0 * tr["mosa/angle"][..., 0]
-    if t.size < 5:
-        return {}
-    ad = np.gradient(th, t, axis=0)
-    add = np.gradient(ad, t, axis=0)
-    u = np.array([np.cos(0.5 * th), np.sin(0.5 * th)])
-    r0 = d * np.stack([np.stack([u[0], u[1], 0 * u[0]], -1), np.stack([u[0], -u[1], 0 * u[0]], -1)], -2)
-    r0I = np.einsum("nsji,nslj->nsli", T, r0)
-    rn = np.linalg.norm(r, axis=-1)[..., None, None]
-    rh = (r / rn[..., 0])[:, :, None, :]
-    gm = float(_gm_sun())
-    tide = np.einsum("nsij,nslj->nsli", T, gm / rn ** 3 * (3 * np.sum(rh * r0I, -1, keepdims=True) * rh - r0I))
-    W = w[:, :, None, :]
-    cf = -np.cross(W, np.cross(W, r0))
-    eu = -np.cross(wd[:, :, None, :], r0)
-    wm, wmd = control.mosa_angular_rates(ad, add)
-    mosa = -2 * np.cross(W, np.cross(wm, r0)) - np.cross(wmd, r0) - np.cross(wm, np.cross(wm, r0))
-    sl = slice(2, -2)  # central differences only
-    m = {k: float(np.linalg.norm(v[sl], axis=-1).max()) for k, v in
-         (("tide", tide), ("centrifugal", cf), ("euler", eu), ("rigid", tide + cf + eu), ("mosa", mosa))}
-    m["alpha_dot_max"] = float(np.abs(ad[sl]).max())
-    m["alpha_ddot_max"] = float(np.abs(add[sl]).max())
-    return m
-
-
-def _gm_sun():
-    from ...forces.heliocentric import SunMonopole
-
-    return float(SunMonopole().gm)
 
 
 def _study_estimate(rep, runs):
@@ -243,7 +131,7 @@ def _study_estimate(rep, runs):
         A = _max_suspension(tr)
         mG, mA, eG, eA = float(G.max()), float(A.max()), float(Ge.max()), float(Ae.max())
         vals[name] = {"max_G": mG, "max_suspension": mA, "est_G": eG, "est_suspension": eA, "alpha": est.alpha,
-                      "scale": est.scale, "decomposition": _decomposition(tr, d)}
+                      "scale": est.scale, "decomposition": control_terms(tr, d, planetary_gm()["sun"])}
         kepler = sc.initial.design != "none" and not sc.forces.third_bodies
         shown = (Ge, Ae) if kepler else (None, None)
         panels.append([f"{label}: max |G| {mG:.3e}, max A {mA:.3e} m/s$^2$" +
@@ -270,9 +158,10 @@ def _study_estimate(rep, runs):
                                    "2 (L'/L) D'/L + (L''/L - 2 L'^2/L^2) u of g_l/d grow with it"))
     # ESA's orbit: the exact identity on ESA's files (no attitude or control code)
     tr = runs.get("dragfree-1y")
-    t_esa, R, V, A_esa = _esa_records(float(times_s(tr)[-1]), tr.epoch.tdb)
+    t_esa, R, V, A_esa = esa_records(float(times_s(tr)[-1]), tr.epoch.tdb)
     if t_esa.size >= 2:
-        Gi, Ai = le.arm_identity_control(R, V, A_esa, gm=_gm_sun(), d=float(_scenario(tr).spacecraft.tm_distance_m))
+        Gi, Ai = le.arm_identity_control(R, V, A_esa, gm=planetary_gm()["sun"],
+                                         d=float(_scenario(tr).spacecraft.tm_distance_m))
         iG, iA = float(np.linalg.norm(Gi, axis=-1).max()), float(np.abs(Ai).max())
         panels[-1].append((t_esa, np.linalg.norm(Gi, axis=-1), np.abs(Ai).max(axis=(-2, -1))))
         v = vals["dragfree-1y"]
@@ -300,14 +189,14 @@ def _study_estimate(rep, runs):
 
 def _study_deviation(rep, runs):
     series, vals = [], {}
-    gm = _gm_sun()
+    gm = planetary_gm()["sun"]
     for df, gr, label, ls in (("dragfree-1y", "gravity-1y", "ESA's orbit", "-"),
                               ("kepler-dragfree-1y", "kepler-gravity-1y", "Keplerian design", "--")):
         a, b = runs.get(df), runs.get(gr)
         dev = orbit_deviation(a, b)
         t = times_s(a)
         _, ia, ib = common_rows(t, dev.t)
-        pred = le.cw_response(t[ia], _r(b)[ib], b["sat/v"][ib], a["sat/a_dragfree"][ia], gm=gm)
+        pred = le.cw_response(t[ia], sat_positions(b)[ib], b["sat/v"][ib], a["sat/a_dragfree"][ia], gm=gm)
         vals[df] = {"max": dev.norm.max(axis=0), "end": np.stack([dev.radial[-1], dev.along[-1], dev.cross[-1]], -1),
                     "pred_end": pred[-1], "t_end": float(dev.t[-1])}
         for s in Sat:
@@ -342,21 +231,6 @@ def _study_deviation(rep, runs):
                                   "Keplerian design (dashed), CW response to the run's G (dotted)", ymin=1e-5)
 
 
-def _scheme_constant(sg_oa, theta=math.pi / 3):
-    """G (3,) in S and A (2, 3) in OA_l of the LISA scheme for g_l = sg_l only (sg_oa (2, 3) in OA_l),
-    at opening angle theta [rad]: Cramer's rule (control module docstring), written out here."""
-    h = 0.5 * theta
-    e = np.array([[math.cos(h), math.sin(h), 0.0], [math.cos(h), -math.sin(h), 0.0]])
-    y = np.array([[-math.sin(h), math.cos(h), 0.0], [math.sin(h), math.cos(h), 0.0]])
-    z = np.array([0.0, 0.0, 1.0])
-    g = np.array([sg_oa[l, 0] * e[l] + sg_oa[l, 1] * y[l] + sg_oa[l, 2] * z for l in range(2)])
-    det = e[0] @ np.cross(e[1], z)
-    G = ((e[0] @ g[0]) * np.cross(e[1], z) + (e[1] @ g[1]) * np.cross(z, e[0])
-         + 0.5 * (z @ (g[0] + g[1])) * np.cross(e[0], e[1])) / det
-    A = np.array([[(G - g[l]) @ e[l], (G - g[l]) @ y[l], (G - g[l]) @ z] for l in range(2)])
-    return G, A
-
-
 def _study_control(rep, runs):
     from ...constellation.spacecraft import TABLE_IV_SELF_GRAVITY
 
@@ -370,7 +244,7 @@ def _study_control(rep, runs):
         rep.figures += plot_control(tr, rep.out_dir, stem, f"LISA (ESA's orbit), nominal control, {label}, "
                                                             f"{_span(tr)}")
     v0, v4, vr = vals["dragfree-1y"], vals["table-iv-1y"], vals["ramp-1y"]
-    G4, A4 = _scheme_constant(np.asarray(TABLE_IV_SELF_GRAVITY))
+    G4, A4 = le.lisa_scheme_constant(np.asarray(TABLE_IV_SELF_GRAVITY))
     ramp = runs.get("ramp-1y")
     g = _ramp_g(ramp)
     X = ramp["sat/T_S_I"][:, :, 0, :]
@@ -412,8 +286,8 @@ def _study_common_sg(rep, runs):
     t0 = times_s(base)
     a0 = geometry.arms(base.dd("sat/r"), base.dd("sat/v"))
     al0 = geometry.breathing_angles(a0)[0]
-    r0, v0 = _r(base)[0], base["sat/v"][0]
-    gm = _gm_sun()
+    r0, v0 = sat_positions(base)[0], base["sat/v"][0]
+    gm = planetary_gm()["sun"]
     n = math.sqrt(gm / float(np.linalg.norm(r0.mean(axis=0))) ** 3)
     curves, vals = [], {}
     for label, d in SG_DIRECTIONS.items():
@@ -467,9 +341,9 @@ def _study_pointing(rep, runs):
     rep.figures += plot_pointing(st, rep.out_dir, "lisa-pointing",
                                  f"LISA: pointing laws vs iterative (light time ~8.3 s), drag-free orbit, {span:.4g} d",
                                  time_scale=str(tr.attrs.get("time_scale", "TDB")))
-    r = _r(tr)
+    r = sat_positions(tr)
     v = float(np.linalg.norm(tr["sat/v"], axis=-1).max())
-    L = float(max(np.linalg.norm(r[:, j] - r[:, i], axis=-1).max() for i, j, _ in _PERM))
+    L = float(arm_lengths_of(tr)[0].max())
     b = le.pointing_law_bounds(v, L)
     vals = {"maxima": st.maxima(), "tau_error": float(np.max(st.tau_error)), "bounds": b, "v_max": v, "L_max": L,
             "ltt_residual": st.ltt_residual}
@@ -484,14 +358,14 @@ def _study_pointing(rep, runs):
                                                               "; 2nd order no better: tau = L/c limits both")))
     rows.append(SummaryRow(f"tau = L/c vs the iterative light time ({span:.4g} d)",
                            f"<= L v / c^2 = {b['tau']:.3e} s (L = {L:.5g} m)", _e(vals["tau_error"], "s", 3),
-                           f"light time ~{L / _C:.3g} s; iterative residual {st.ltt_residual:.1e} s"))
+                           f"light time ~{L / C_LIGHT:.3g} s; iterative residual {st.ltt_residual:.1e} s"))
     if runs.has("dragfree-global-1y"):
         g = runs.get("dragfree-global-1y")
         _, ia, ib = common_rows(times_s(g), times_s(tr))
         dG = float(np.linalg.norm(g["sat/a_dragfree"][ia] - tr["sat/a_dragfree"][ib], axis=-1).max())
         dA = float(np.abs(g["tm/a_suspension"][ia] - tr["tm/a_suspension"][ib]).max())
         dev = orbit_deviation(g, tr)
-        n2 = _gm_sun() / float(np.mean(np.linalg.norm(r, axis=-1))) ** 3
+        n2 = planetary_gm()["sun"] / float(np.mean(np.linalg.norm(r, axis=-1))) ** 3
         d = float(_scenario(tr).spacecraft.tm_distance_m)
         vals["in_loop_global"] = {"dG": dG, "dA": dA, "dev_max": dev.norm.max(axis=0)}
         rows.append(SummaryRow(f"global pointing in the loop vs iterative ({_span(g)}): max |dG|; max |dA|; orbit",
@@ -508,28 +382,29 @@ def _study_esa_ramp(rep, runs, coupled="ramp-1y", pm="esa-1y", stem="lisa-esa-ra
     dev = orbit_deviation(c, e)
     t = times_s(c)
     _, ia, ib = common_rows(t, dev.t)
-    r, v = _r(c)[ia], c["sat/v"][ia]
+    r, v = sat_positions(c)[ia], c["sat/v"][ia]
+    r_dd = tuple(p[ia] for p in c.dd("sat/r"))
     g = _ramp_g(c)[ia]
-    ch = _centroid_dirs(r)
+    ch = geometry.centroid_directions(r_dd)
     T = c["sat/T_S_I"][ia]
     X, Y = T[:, :, 0, :], T[:, :, 1, :]
-    Xi = _instantaneous_bisectors(r)
+    Xi = pointing_frames(beam_directions("global", r_dd).n).X_S  # the beams' bisectors, toward the incentre
     G = c["sat/a_dragfree"][ia]
-    gm = _gm_sun()
+    gm = planetary_gm()["sun"]
     parts = {"geometric": g[:, None, None] * (Xi - ch), "aberration": g[:, None, None] * (X - Xi),
              "nominal": G - g[:, None, None] * X}
     resp = {k: le.cw_response(t[ia], r, v, f, gm=gm) for k, f in parts.items()}
     total = sum(resp.values())
     ang = np.degrees(np.arctan2(np.einsum("nsk,nsk->ns", ch, Y), np.einsum("nsk,nsk->ns", ch, X)))
-    Ls = _arm_lengths(r)
-    est = np.degrees(np.stack([le.bisector_median_angle(Ls[(i, j)], Ls[(i, k)]) for i, j, k in _PERM], -1))
+    L_arm, (ij, ik) = geometry.arms(r_dd).length, geometry.link_pairs()
+    est = np.degrees(le.bisector_median_angle(L_arm[:, ij], L_arm[:, ik]))
     span = float(dev.t[-1] - dev.t[0]) / 86400
     # against ESA's files
     vs = []
     out = {}
     for name, tr in ((coupled, c), (pm, e)):
-        rows_, R, _ = _esa_on_grid(tr)
-        dr = np.linalg.norm(_r(tr)[rows_] - R, axis=-1)
+        rows_, R, _ = esa_states_on_grid(tr)
+        dr = np.linalg.norm(sat_positions(tr)[rows_] - R, axis=-1)
         vs.append((f"{'coupled lisa' if tr is c else 'lisa-esa'} - ESA files", times_s(tr)[rows_], dr,
                    "-" if tr is c else "--"))
         out[name] = dr[-1]

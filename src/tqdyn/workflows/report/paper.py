@@ -39,8 +39,9 @@ from ...analysis.metrics import (
     secular_along_track_drift,
 )
 from ...analysis.pointing_study import pointing_study_of
-from ...astro.constants import GM_EARTH_EGM2008
+from ...astro.constants import C_LIGHT, GM_EARTH_EGM2008
 from ...constellation.indices import Link, Sat
+from ...constellation.pointing import angle_between
 from ...lightpath import instantaneous_ranges, light_travel_times_of
 from ..studies import FLIGHT_DIRECTION_S, SG_DIRECTIONS, STUDIES
 from .summary import Report, SummaryRow, evaluate_studies, _asd_verdict, _e, _finish, _order_ok, _per_sat, _span_days
@@ -241,8 +242,7 @@ def _local_vs_global(rep, glob, loc):
     dG = loc["sat/a_dragfree"][ia] - glob["sat/a_dragfree"][ib]
     pred = secular_along_track_drift(t[ib], glob["sat/r"][ib], glob["sat/v"][ib], dG)
     Tg, Tl = glob["sat/T_S_I"][ib], loc["sat/T_S_I"][ia]
-    delta = np.arctan2(np.linalg.norm(np.cross(Tg[:, :, 0], Tl[:, :, 0]), axis=-1),
-                       np.einsum("nsk,nsk->ns", Tg[:, :, 0], Tl[:, :, 0]))
+    delta = angle_between(Tg[:, :, 0], Tl[:, :, 0])
     dG_S = np.einsum("nsij,nsj->nsi", Tg, dG)
     try:
         d_tm = float(loads_scenario(glob.scenario_toml).spacecraft.d_tm_m)
@@ -386,7 +386,7 @@ def _study_light_path(rep, runs):
                    "attitude / control effects below the requirement in band",
                    r_tm_sat.describe(), _asd_verdict(r_tm_sat)),
         SummaryRow("Light-travel-time equation residual (iterative, dd)", "up to 1e-34 m (paper, quad)",
-                   _e(float(np.nanmax(np.abs(lt.residual))) * 299792458.0, "m"),
+                   _e(float(np.nanmax(np.abs(lt.residual))) * C_LIGHT, "m"),
                    "double-double: ~1e-23 m resolution, far below pm"),
     ]
 

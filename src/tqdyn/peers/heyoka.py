@@ -1,4 +1,4 @@
-"""heyoka real128 reference peers for the Kepler and force-model benchmarks.
+"""heyoka real128 reference peers for the Kepler and force-model benchmarks (a peer: no tqdyn physics inside).
 
 This module propagates bodies with heyoka's adaptive Taylor integrator in
 ``real128`` (IEEE 754 binary128, 113-bit significand, epsilon = 2**-112 ~
@@ -12,8 +12,8 @@ integrator produces:
   12x12 + Moon + Sun) built from heyoka's own models (EGM2008, IAU 2006 +
   bundled EOP, ELP2000, VSOP2013): the force-model benchmark's peer.  Its
   ephemerides are truncated analytical theories, so it differs from tqdyn's
-  DE421-based reduced model at the level of the ephemeris differences
-  (~0.01 m after 1 day), not at the integration-error level.
+  DE421-based reduced model at the level of the ephemeris differences (the
+  benchmark reports by how much), not at the integration-error level.
 
 heyoka is an *optional* dependency (``pip install tqdyn[heyoka]``).  It is
 imported lazily inside the functions, so importing this module never needs
@@ -440,18 +440,17 @@ def propagate_reduced_grid(r0, v0, epoch_tdb_jd, step, n_steps, *, gm="3.9860044
     ===============  =============   ================  ===============
 
     ELP2000-82B itself differs from DE421 by ~100 m (full series, mostly
-    along-track; building it takes ~9 min): ~1 m lunar positions are out of
-    reach of this theory.  A Moon position error dm changes the tidal
+    along-track): ~1 m lunar positions are out of reach of this theory.  A Moon position error dm changes the tidal
     acceleration at r = 1e5 km by ~3 GM_Moon r dm / d^4 ~ 7e-14 m/s^2 per
     metre (171 m: ~1e-11 m/s^2); a Sun error by ~8e-17 m/s^2 per metre
     (1 km: ~1e-13 m/s^2).  The Earth rotation agrees with tqdyn's IAU
     2006/2000A + EOP 14 C04 rotation to 3.5 mas (1.7e-8 rad) over the 90 days.
 
-    Cost (2-core x86-64, 3 satellites, 90 days, 50 s grid = 155521 points):
-    real128 with the default thresholds: setup (JIT) ~3-6 s, propagate_grid
-    ~457 s, 879 Taylor steps of order 40 (~0.5 s per step: the time-only
-    series dominate -- ~0.24 s/step with elp_thresh=1e-7, vsop_thresh=1e-9);
-    float64: setup ~6 s, propagate_grid ~1.9 s, 586 steps of order 20.
+    Cost: the time-only series (ephemerides, rotation) dominate each Taylor
+    step in real128, so coarser thresholds (e.g. elp_thresh=1e-7,
+    vsop_thresh=1e-9) make it faster; ``tqdyn bench --model full`` measures
+    it (the ``setup_s`` and ``wall_s`` returned here, with
+    ``n_taylor_steps``).
 
     Parameters
     ----------
