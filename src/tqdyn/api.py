@@ -161,5 +161,6 @@ def range_asd(light_times: LightTravelTimes, link: str | int | Link = "13") -> _
 def breathing_angles(trajectory: Trajectory) -> np.ndarray:
     """Breathing angles alpha_i [rad], (N, 3) -- the angle at each satellite
     between its two arms, from the double-double satellite positions (any
-    run, coupled or pure gravity)."""
+    run of 3 satellites, coupled or pure gravity; ValueError for other
+    counts)."""
     return _metrics.breathing_angles_of(trajectory)

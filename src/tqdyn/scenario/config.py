@@ -263,7 +263,10 @@ class Scenario:
     ``epoch_utc``: normalised UTC ``YYYY-MM-DDTHH:MM:SS[.fff]`` (the epoch of
     the satellite elements and t = 0 of the run); ``satellites``: tuple of
     :class:`SatelliteConfig` (elements relative to the central body, in the
-    frame of :attr:`reference`), at least one, unique names;
+    frame of :attr:`reference`), at least one, unique names: any number for
+    point-mass runs, exactly 3 when the run is coupled
+    (``constellation.pointing`` != "none") or pulls them toward their centre
+    (``spacecraft.self_gravity_center``);
     ``central_body``: the origin of the propagation (one of
     :data:`tqdyn.astro.reference.CENTRAL_BODIES`).
     In fixed mode ``run.duration_s`` is an exact multiple of
@@ -332,12 +335,9 @@ class Scenario:
                 raise ScenarioError(f"satellites.{k}.name", sat.name, f"duplicates satellites.{seen[sat.name]}.name", "unique satellite names")
             seen[sat.name] = k
         _set(self, "satellites", sats)
+        self._check_satellite_count()
         if not self.allow_below_surface:
             check_above_surface(self.satellites, self.initial, self.central_body)
-        if self.constellation.coupled:
-            _require(len(sats) == 3, "constellation.pointing", self.constellation.pointing,
-                     f"needs exactly 3 satellites (the scenario has {len(sats)})",
-                     '"none" for other constellations')
         if self.integrator.step_s > self.run.duration_s:
             raise ScenarioError("integrator.step", self.integrator.step_s,
                                 f"s is longer than run.duration = {self.run.duration_s} s",
@@ -354,6 +354,26 @@ class Scenario:
                     "a duration that is a whole number of steps",
                 )
         self._check_steps()
+
+    def _check_satellite_count(self) -> None:
+        """Point-mass runs take any number of satellites; what couples them
+        (attitudes locked to the beams, TMs, drag-free control; the
+        self-gravity toward the constellation's centre) is defined for a
+        triangle of exactly 3."""
+        n = len(self.satellites)
+        if n == 3:
+            return
+        c = self.constellation
+        given = "satellite given" if n == 1 else "satellites given"
+        if c.coupled:
+            raise ScenarioError("satellites", n, f"{given}; a coupled run (constellation.pointing = "
+                                f"{c.pointing!r}) needs exactly 3",
+                                '3 satellites, or constellation.pointing = "none" and control = "off" '
+                                "(point masses: any number)")
+        if self.spacecraft.self_gravity_center is not None:
+            raise ScenarioError("satellites", n, f"{given}; spacecraft.self_gravity_center (the pull "
+                                "toward the centre of a triangle) needs exactly 3",
+                                "3 satellites, or no spacecraft.self_gravity_center (point masses: any number)")
 
     def _check_steps(self) -> None:
         """At most ``run.max_steps`` steps; the error names the step when it is

@@ -228,8 +228,23 @@ class Trajectory:
 
     @property
     def n_sat(self) -> int:
-        """Length of the satellite axis (1..3; 0 if the file has no satellite field)."""
+        """Length of the satellite axis (>= 1; 0 if the file has no satellite field)."""
         return self._n_sat
+
+    @property
+    def satellite_names(self) -> tuple[str, ...]:
+        """The satellites' names in satellite-axis order: the ``name`` of each
+        ``[[satellites]]`` table of the file's resolved scenario (root attribute
+        ``scenario``), or ``Sat1``, ``Sat2``, ... when the scenario does not
+        name exactly :attr:`n_sat` satellites (no scenario, or a damaged one)."""
+        import tomllib
+
+        try:
+            sats = tomllib.loads(self.scenario_toml).get("satellites", [])
+            names = tuple(str(s["name"]) for s in sats)
+        except (tomllib.TOMLDecodeError, AttributeError, TypeError, KeyError):
+            names = ()
+        return names if len(names) == self._n_sat else tuple(f"Sat{k}" for k in range(1, self._n_sat + 1))
 
     @property
     def n_rows(self) -> int:
@@ -276,7 +291,8 @@ class Trajectory:
         """The trajectory as an ``xarray.Dataset``.
 
         Dimensions ``time`` (coordinate: float64 TT seconds since epoch,
-        hi + lo), ``sat`` (1..n_sat), ``tm`` (1, 2), ``comp`` ("x", "y", "z"),
+        hi + lo), ``sat`` (1..n_sat; the non-index coordinate ``sat_name``
+        along it holds :attr:`satellite_names`), ``tm`` (1, 2), ``comp`` ("x", "y", "z"),
         ``row`` ("X_S", "Y_S", "Z_S") and ``col`` ("x", "y", "z") for
         ``sat_T_S_I``.  Variables are named by path with "/" -> "_" (e.g.
         ``sat_r``); a dd field gives the float64 ``hi + lo`` in ``<name>`` and
@@ -302,6 +318,8 @@ class Trajectory:
                                                 "description": "residual of time: exact t = time + t_lo"})
         if self._n_sat:
             coords["sat"] = ("sat", np.arange(1, self._n_sat + 1))
+            coords["sat_name"] = ("sat", np.array(self.satellite_names, dtype=str),
+                                  {"description": "satellite name (the scenario's [[satellites]] name)"})
         for f in self.fields:
             if f == "t":
                 continue
@@ -422,9 +440,9 @@ def _read_open(h5, p, fname) -> Trajectory:
                 raise TrajectoryFormatError(f"{fname}: {f!r} has {shape[0]} rows but 't' has {n_rows}")
         if "sat" in spec.shape:
             ns = shape[lead + spec.shape.index("sat")]
-            if not 1 <= ns <= 3 or (n_sat and ns != n_sat):
+            if ns < 1 or (n_sat and ns != n_sat):
                 raise TrajectoryFormatError(f"{fname}: {f!r} has satellite axis length {ns}, expected "
-                                            f"{n_sat if n_sat else '1..3'}")
+                                            f"{n_sat if n_sat else '>= 1'}")
             n_sat = ns
         expected = shape[:lead] + spec.resolved_shape(n_sat)
         if shape != expected:

@@ -59,7 +59,8 @@ class FieldSpec:
         or ``"f8"`` (one float64 dataset).
     shape : tuple of (str | int)
         Trailing shape *without* the time axis; ``"sat"`` stands for the
-        satellite axis (length n_sat, 1..3), ``"tm"`` for the test-mass / MOSA
+        satellite axis (length n_sat >= 1: 3 in coupled runs, any number in
+        point-mass runs), ``"tm"`` for the test-mass / MOSA
         axis (length 2).  ``()`` for a scalar per time row.
     unit : str
         SI unit (``"1"`` for dimensionless).
