@@ -19,6 +19,7 @@ from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008
 from ..astro.eop_sources import DEFAULT_EOP_SOURCE, EOP_SOURCES, EOP_SOURCES_ALLOWED, normalize_eop_source
 from ..astro.timescales import Epoch
+from ..forces.body_gms import BODY_GM_KEYS, default_body_gm
 from .toml_text import toml_str, toml_value
 
 __all__ = [
@@ -123,6 +124,11 @@ MAX_OCEAN_TIDE_DEGREE = 100  # fes2004_Cnm-Snm.dat
 LIBRATION_MODELS = ("de421", "iau")
 
 
+def _gm_field(body: str):
+    """A [forces] GM key (:data:`BODY_GM_KEYS`), default the shipped DE430/DE431 value."""
+    return field(default_factory=lambda: default_body_gm(body))
+
+
 @dataclass(frozen=True)
 class ForcesConfig:
     """Force-model switches.  Every perturbation is off unless switched on
@@ -153,6 +159,12 @@ class ForcesConfig:
     ``earth_field_indirect``: the geocentre's acceleration by the Moon and
     Sun (those listed in third_bodies) acting on the Earth's non-central
     field (needs earth_degree >= 2).
+    ``gm_sun``, ``gm_earth_tdb``, ``gm_moon``, ``gm_mercury`` .. ``gm_neptune``
+    [m^3/s^2] (> 0): the GMs of the point-mass bodies, TDB-compatible (the
+    ephemerides'; default the exact DE430/DE431 values of
+    ``data/gm_de431.tpc``; planets as systems): every GM of a run but the
+    geocentric central body's comes from them (:mod:`tqdyn.forces.body_gms`);
+    ``gm_earth_tdb`` is the Earth's as a heliocentric third body.
     ``eop``: the source of polar motion, UT1-UTC and celestial-pole offsets,
     one of :data:`tqdyn.astro.eop_sources.EOP_SOURCES` (default "auto":
     measured, predicted, then the long-term model; true = "auto", false =
@@ -178,6 +190,17 @@ class ForcesConfig:
     relativity: bool = False
     earth_field_indirect: bool = False
     eop: str = DEFAULT_EOP_SOURCE
+    # GMs of the point-mass bodies (BODY_GM_KEYS), TDB-compatible
+    gm_sun: Decimal = _gm_field("sun")
+    gm_earth_tdb: Decimal = _gm_field("earth")
+    gm_moon: Decimal = _gm_field("moon")
+    gm_mercury: Decimal = _gm_field("mercury")
+    gm_venus: Decimal = _gm_field("venus")
+    gm_mars: Decimal = _gm_field("mars")
+    gm_jupiter: Decimal = _gm_field("jupiter")
+    gm_saturn: Decimal = _gm_field("saturn")
+    gm_uranus: Decimal = _gm_field("uranus")
+    gm_neptune: Decimal = _gm_field("neptune")
 
     def __post_init__(self) -> None:
         ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
@@ -207,6 +230,10 @@ class ForcesConfig:
         _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
         _require(not self.earth_field_indirect or self.earth_degree >= 2, "forces.earth_field_indirect", True,
                  "needs the Earth's non-central field", "false, or earth_degree >= 2")
+        for key in BODY_GM_KEYS.values():
+            _set(self, key, _to_decimal(getattr(self, key), f"forces.{key}"))
+            _require(getattr(self, key) > 0, f"forces.{key}", getattr(self, key), "is not positive",
+                     f"{key} > 0 m^3/s^2 (default: DE430/DE431, data/gm_de431.tpc)")
 
 
 POINTING_LAWS = ("none", "global", "taylor1", "taylor2", "iterative")
@@ -326,7 +353,7 @@ class Scenario:
         if self.initial.derived and not sats:
             from .initial import derived_satellites
 
-            sats = derived_satellites(self.initial, epoch, self.central_body)
+            sats = derived_satellites(self.initial, epoch, self.central_body, self.forces.gm_sun)
         _require(len(sats) >= 1, "satellites", list(sats), "is empty", "at least one satellite")
         seen: dict[str, int] = {}
         for k, sat in enumerate(sats, start=1):
@@ -487,7 +514,9 @@ class Scenario:
                 f"pole_tides = {b(f.pole_tides)}", f"atmospheric_tides = {b(f.atmospheric_tides)}",
                 f"moon_degree = {f.moon_degree}", f"moon_libration = {toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
-                f"eop = {toml_str(f.eop)}", ""]
+                f"eop = {toml_str(f.eop)}",
+                *(f"{key} = {toml_value(getattr(f, key))}  # m^3/s^2, TDB-compatible" for key in BODY_GM_KEYS.values()),
+                ""]
         s = self.spacecraft
         out += ["[spacecraft]", f"architecture = {toml_str(s.architecture)}", f"dragfree = {toml_str(s.dragfree)}"]
         if s.architecture == "tianqin":

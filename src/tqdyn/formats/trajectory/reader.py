@@ -16,7 +16,7 @@ from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, Ref
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["SpacecraftRecord", "Trajectory", "read_trajectory"]
+__all__ = ["SpacecraftRecord", "Trajectory", "is_trajectory_file", "read_attributes", "read_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -391,23 +391,63 @@ def read_trajectory(path) -> Trajectory:
                                     f"re-create it (run again)") from None
 
 
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def is_trajectory_file(path) -> bool:
+    """True when ``path`` is an existing file that starts with the HDF5 signature
+    (a trajectory file, or another HDF5 file that :func:`read_attributes` refuses)."""
+    try:
+        with open(os.fspath(path), "rb") as fh:
+            return fh.read(8) == _HDF5_SIGNATURE
+    except (OSError, TypeError, ValueError):
+        return False
+
+
+def read_attributes(path) -> dict:
+    """The root attributes of a trajectory file (native str / int / float),
+    without reading its datasets; the same format and version checks as
+    :func:`read_trajectory` (FileNotFoundError, or a one-line
+    :class:`TrajectoryFormatError` naming the file)."""
+    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
+    fname = str(p)
+    if not p.is_file():
+        raise FileNotFoundError(f"trajectory file {fname!r} does not exist or is not a file")
+    try:
+        h5 = h5py.File(p, "r")
+    except OSError as exc:
+        raise TrajectoryFormatError(f"{fname}: not a readable HDF5 file ({exc})") from None
+    try:
+        with h5:
+            return _checked_attrs(h5, fname)
+    except (OSError, RuntimeError, KeyError) as exc:
+        raise TrajectoryFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
+                                    f"re-create it (run again)") from None
+
+
+def _checked_attrs(h5, fname) -> dict:
+    """The root attributes of an open file, after the format and version checks."""
+    attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
+    fmt = attrs.get("format")
+    ver = attrs.get("format_version")
+    if fmt != FORMAT:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format "
+            f"{FORMAT!r} with format_version <= {FORMAT_VERSION}")
+    if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; expected an "
+            f"int 1..{FORMAT_VERSION}")
+    if ver > FORMAT_VERSION:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} format_version = {ver} is newer than this tqdyn "
+            f"({_TQDYN_VERSION}) supports (format_version <= {FORMAT_VERSION}); upgrade tqdyn")
+    return attrs
+
+
 def _read_open(h5, p, fname) -> Trajectory:
     with h5:
-        attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
-        fmt = attrs.get("format")
-        ver = attrs.get("format_version")
-        if fmt != FORMAT:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format "
-                f"{FORMAT!r} with format_version <= {FORMAT_VERSION}")
-        if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; expected an "
-                f"int 1..{FORMAT_VERSION}")
-        if ver > FORMAT_VERSION:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} format_version = {ver} is newer than this tqdyn "
-                f"({_TQDYN_VERSION}) supports (format_version <= {FORMAT_VERSION}); upgrade tqdyn")
+        attrs = _checked_attrs(h5, fname)
         data: dict[str, tuple[np.ndarray, ...]] = {}
         for f, spec in FIELDS.items():
             if f not in h5:

@@ -184,6 +184,8 @@ ROOT_ATTRS: dict[str, str] = {
     "eop": 'str, the Earth-orientation source: "auto" | "finals" | "c04-20" | "c04-14" | "off" | "custom" (extension)',
     "eop_sources": "str, which EOP source covered which days of the run (extension)",
     "eop_data": "str, the EOP files and the leap-second table used (extension)",
+    "constants": "str, JSON: the fixed constants the run used (value, unit, source), the SHA-256 of the data files "
+                 "it read and of the compiled force model's numbers (tqdyn.scenario.record; extension)",
 }
 """Root attributes of format version 1 and their type / allowed values."""
 
