@@ -144,9 +144,10 @@ def select_rows(t, y, a, precision, every, n0, aux=None, system=None) -> Rows:
 @dataclass(frozen=True)
 class Checkpoint:
     """State of a fixed-step run after ``n`` steps: y (working precision,
-    (n_body, 6[, 2]): the satellites, then the TMs in the free-TM mode) and its Kahan compensation ``comp``.  Resuming from it
-    reproduces the uninterrupted run bit for bit (every step depends only on
-    y, comp and the step index)."""
+    (n_body, 6[, 2]): the satellites, then the TMs in the free-TM mode) and
+    its Kahan compensation ``comp``.  Resuming from it reproduces the
+    uninterrupted run bit for bit (every step depends only on y, comp and
+    the step index)."""
 
     n: int
     y: np.ndarray

@@ -153,10 +153,11 @@ class CentralJ2:
 def sun_schwarzschild(gm: float | None = None) -> Relativity:
     """The Sun's post-Newtonian term on a heliocentric orbit: the
     Schwarzschild part of IERS 2010 eq. (10.12) with GM_S [m^3/s^2] (``gm``,
-    the scenario's ``forces.gm_sun``; None: DE430) in place of GM_E, beta = gamma = 1 (:class:`tqdyn.forces.relativity.Relativity`
-    with Lense-Thirring and de Sitter off: the Sun's Lense-Thirring
-    acceleration at 1 au is 2.5e-15 m/s^2, 0.8 m after a year, not modelled;
-    de Sitter is a geocentric-frame term)."""
+    the scenario's ``forces.gm_sun``; None: DE430) in place of GM_E, beta =
+    gamma = 1 (:class:`tqdyn.forces.relativity.Relativity` with
+    Lense-Thirring and de Sitter off: the Sun's Lense-Thirring acceleration
+    at 1 au is 2.5e-15 m/s^2, 0.8 m after a year, not modelled; de Sitter
+    is a geocentric-frame term)."""
     gm = float(planetary_gm()["sun"]) if gm is None else float(gm)
     rel = Relativity(schwarzschild=True, lense_thirring=False, de_sitter=False, gm_earth=gm, gm_sun=gm)
     object.__setattr__(rel, "description", "post-Newtonian correction of the Sun (Schwarzschild, IERS 2010 eq. 10.12 "

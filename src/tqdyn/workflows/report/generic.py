@@ -360,7 +360,8 @@ def _generic_deviations(rep, trajs, labels):
             rep.notes.append(f"{label}: other epoch than the reference {labels[ref_i]}: no deviation")
             continue
         if tr.n_sat != ref.n_sat:
-            rep.notes.append(f"{label}: {tr.n_sat} satellite(s), the reference {labels[ref_i]} {ref.n_sat}: no deviation")
+            rep.notes.append(f"{label}: {tr.n_sat} satellite(s), the reference {labels[ref_i]} {ref.n_sat}: "
+                             "no deviation")
             continue
         dev = orbit_deviation(tr, ref)
         if dev is None:
