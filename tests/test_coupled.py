@@ -351,7 +351,7 @@ def test_bad_configuration_is_one_clear_error(tmp_path, capsys, override, words)
 def test_constellation_needs_three_satellites():
     from tqdyn.scenario import ScenarioError, loads_scenario
 
-    with pytest.raises(ScenarioError, match="exactly 3 satellites"):
+    with pytest.raises(ScenarioError, match="^satellites: 1 satellite given; a coupled run .* needs exactly 3"):
         loads_scenario('[constellation]\npointing = "global"\n[[satellites]]\na_km = 1e5\n')
 
 

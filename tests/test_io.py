@@ -136,7 +136,7 @@ def test_fields_catalogue_matches_contract():
 # ---------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("n_sat", [3, 1, 2])
+@pytest.mark.parametrize("n_sat", [3, 1, 2, 6])
 def test_round_trip_every_field_bit_exact(tmp_path, n_sat):
     n = 37
     data = make_data(n, n_sat)
@@ -447,9 +447,9 @@ def test_append_unknown_undeclared_and_static_fields(tmp_path, writer):
 def test_writer_argument_errors(tmp_path):
     p = tmp_path / "x.h5"
     with pytest.raises(ValueError, match="n_sat"):
-        TrajectoryWriter(p, make_attrs(), TWO_BODY, 4)
-    with pytest.raises(ValueError, match="n_sat"):
         TrajectoryWriter(p, make_attrs(), TWO_BODY, 0)
+    with pytest.raises(ValueError, match="n_sat"):
+        TrajectoryWriter(p, make_attrs(), TWO_BODY, 2.0)
     with pytest.raises(ValueError, match="bogus"):
         TrajectoryWriter(p, make_attrs(), TWO_BODY + ["bogus"], 3)
     with pytest.raises(ValueError, match="'t'"):
@@ -592,7 +592,7 @@ def test_reader_ignores_unknown_objects(tmp_path):
 # ---------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("n_sat", [3, 1])
+@pytest.mark.parametrize("n_sat", [3, 1, 6])
 def test_xarray_view(tmp_path, n_sat):
     xr = pytest.importorskip("xarray")
     n = 7

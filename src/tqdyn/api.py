@@ -19,6 +19,7 @@ for the geocentric scenarios); times in seconds since the scenario epoch.
 from __future__ import annotations
 
 import sys
+import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -30,9 +31,8 @@ from .constellation.indices import Link
 from .formats.trajectory import Trajectory, read_trajectory
 from .lightpath import LightTravelTimes, light_travel_times_of
 from .scenario import Scenario, ScenarioError, builtin_scenarios
-from .scenario import load_scenario as _load_scenario
 from .scenario.toml_text import toml_value
-from .workflows.run import RunSummary, output_attrs, run_to_file
+from .workflows.run import RunSummary, load_run_scenario, output_attrs, run_to_file
 
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
            "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory", "propagate",
@@ -50,8 +50,11 @@ def _overrides(overrides) -> list[str]:
 def load_scenario(scenario: str | Scenario | None = None,
                   overrides: Mapping[str, object] | Sequence[str] = ()) -> Scenario:
     """A validated scenario: a built-in name (:func:`builtin_scenarios`; None
-    -> ``"tianqin"``), the path of a TOML file, or a :class:`Scenario`
-    (returned as is when there are no overrides).
+    -> ``"tianqin"``), the path of a TOML file, the path of a trajectory file
+    (its recorded, resolved scenario: running it reproduces the file; a
+    :class:`UserWarning` says what this tqdyn would do differently, see
+    :func:`tqdyn.workflows.run.scenario_of_trajectory`), or a
+    :class:`Scenario` (returned as is when there are no overrides).
 
     overrides : ``{"run.duration": "2d", "satellites.2.nu_deg": 151}`` or
         ``["run.duration=2d", ...]`` -- any scenario key (docs/scenarios.md),
@@ -65,7 +68,15 @@ def load_scenario(scenario: str | Scenario | None = None,
         from .scenario import loads_scenario
 
         return loads_scenario(scenario.to_toml(), over, source=f"scenario {scenario.name!r}")
-    return _load_scenario(scenario, over)
+    return _scenario(scenario, over, writes=False)
+
+
+def _scenario(scenario, over, writes: bool) -> Scenario:
+    """:func:`load_scenario` of a name or path; a trajectory file's notes as warnings."""
+    scen, notes = load_run_scenario(scenario, over, writes=writes)
+    for note in notes:
+        warnings.warn(note, UserWarning, stacklevel=3)
+    return scen
 
 
 def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, object] | Sequence[str] = (), *,
@@ -112,10 +123,13 @@ def run(scenario: str | Scenario | None = None, overrides: Mapping[str, object] 
     """Propagate a scenario to its trajectory file, as ``tqdyn run`` does
     (atomic: no file or a complete one; ``checkpoint_every`` steps and
     ``resume`` as ``--checkpoint-every`` / ``--resume``).  ``output``: the
-    file (default: the scenario's ``run.output``).  Returns the
-    :class:`~tqdyn.workflows.run.RunSummary` (its ``path``, rows, result)."""
+    file (default: the scenario's ``run.output``; a trajectory file given as
+    ``scenario`` runs its recorded scenario again and may not be its own
+    output).  Returns the :class:`~tqdyn.workflows.run.RunSummary` (its
+    ``path``, rows, result)."""
     over = _overrides(overrides) + ([f"run.output={output}"] if output is not None else [])
-    return run_to_file(load_scenario(scenario, over), checkpoint_every=checkpoint_every, resume=resume)
+    scen = load_scenario(scenario, over) if isinstance(scenario, Scenario) else _scenario(scenario, over, writes=True)
+    return run_to_file(scen, checkpoint_every=checkpoint_every, resume=resume)
 
 
 def open_trajectory(path) -> Trajectory:
@@ -161,5 +175,6 @@ def range_asd(light_times: LightTravelTimes, link: str | int | Link = "13") -> _
 def breathing_angles(trajectory: Trajectory) -> np.ndarray:
     """Breathing angles alpha_i [rad], (N, 3) -- the angle at each satellite
     between its two arms, from the double-double satellite positions (any
-    run, coupled or pure gravity)."""
+    run of 3 satellites, coupled or pure gravity; ValueError for other
+    counts)."""
     return _metrics.breathing_angles_of(trajectory)

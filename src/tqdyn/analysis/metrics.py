@@ -122,6 +122,7 @@ def arm_lengths_of(traj) -> tuple[np.ndarray, np.ndarray | None]:
     time), and their rates dL/dt = (v_j - v_i) . n_ij (N, 3) [m/s] (None
     without ``sat/v``).  Any central body and frame (a length and its rate
     do not depend on the axes); t in the file's time scale."""
+    _need_triangle(traj, "arm lengths")
     a = geometry.arms(traj.dd("sat/r"), traj.dd("sat/v") if "sat/v" in traj else None)
     rate = None if a.length_dot is None else a.length_dot[..., :3]
     return a.length[..., :3], rate
@@ -151,8 +152,19 @@ def breathing_angles_of(traj) -> np.ndarray:
     """Breathing angles alpha_i (N, 3) [rad] of a trajectory, from its dd
     satellite positions (:func:`tqdyn.constellation.geometry.breathing_angles`;
     the same for coupled and pure-gravity runs)."""
+    _need_triangle(traj, "breathing angles")
     alpha, _, _ = geometry.breathing_angles(geometry.arms(traj.dd("sat/r")))
     return alpha
+
+
+def _need_triangle(traj, what: str) -> None:
+    """ValueError (one line) unless the trajectory holds the 3 satellites of a
+    triangle: arms and breathing angles are defined for 3 (a point-mass run
+    may have any number)."""
+    n_sat = traj.dd("sat/r")[0].shape[1]
+    if n_sat != 3:
+        raise ValueError(f"trajectory: n_sat = {n_sat}; {what} are defined for the 3 satellites of a "
+                         "triangular constellation; allowed: a trajectory of 3 satellites")
 
 
 def common_rows(t_a, t_b):

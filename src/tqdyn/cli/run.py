@@ -132,18 +132,22 @@ def _checkpoint_interval(text) -> float:
 @click.option("--resume", is_flag=True, help="Continue an interrupted run from its checkpoint (same arguments).")
 def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_every, checkpoint_interval, resume):
     """Propagate SCENARIO (a built-in name or a TOML file; default: tianqin)
-    and write the trajectory file.  Interrupted runs (Ctrl-C, a crash) keep
-    their last checkpoint; `--resume` continues them to a bit-identical file."""
+    and write the trajectory file.  SCENARIO may also be a trajectory file
+    RUN.h5: its recorded scenario runs again (give another -o), reproducing
+    the file bit for bit unless a warning says what differs.  Interrupted
+    runs (Ctrl-C, a crash) keep their last checkpoint; `--resume` continues
+    them to a bit-identical file."""
     from tqdm import tqdm
 
     from ..formats import trajectory as io
     from .. import dynamics
     from ..workflows import run as runner
-    from ..scenario import ScenarioError, load_scenario
+    from ..scenario import ScenarioError
 
     try:
         interval_s = _checkpoint_interval(checkpoint_interval)
-        scen = load_scenario(scenario, _overrides(sets, duration, step, output, precision))
+        scen, notes = runner.load_run_scenario(scenario, _overrides(sets, duration, step, output, precision),
+                                               writes=True)
         io.check_writable(scen.run.output)
         runner.check_checkpoint(scen, resume)
         model = dynamics.check_inputs(scen)
@@ -159,9 +163,9 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
                + f", {scen.run.duration_s} s from {scen.epoch.iso}"
                + (f"; pointing {c.pointing}, control {c.control}" + (", free TMs" if c.free_tms else "")
                   if c.coupled else ""), err=True)
-    note = runner.eop_warning(scen, model)
-    if note:
-        click.echo(f"tqdyn: warning: {note}", err=True)
+    for note in notes + [runner.eop_warning(scen, model)]:
+        if note:
+            click.echo(f"tqdyn: warning: {note}", err=True)
     state = {"bar": None, "stop": {}}
 
     def progress(n):

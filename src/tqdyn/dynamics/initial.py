@@ -15,12 +15,10 @@ __all__ = ["central_gm", "initial_state", "satellite_states"]
 
 def central_gm(scenario) -> str:
     """GM [m^3/s^2] of the central body's monopole as an exact decimal
-    string: ``forces.gm_earth`` (geocentric) or the Sun's DE430 GM of
-    :class:`tqdyn.forces.heliocentric.SunMonopole` (heliocentric)."""
+    string: ``forces.gm_earth`` (geocentric) or ``forces.gm_sun``
+    (heliocentric)."""
     if scenario.central_body == "sun":
-        from ..forces.heliocentric import SunMonopole
-
-        return str(SunMonopole().gm)
+        return str(scenario.forces.gm_sun)
     return str(scenario.forces.gm_earth)
 
 

@@ -33,6 +33,9 @@ class Rows:
     sat_a_gravity : (m, n_sat, 3) -- m/s^2, inertial, all gravitational terms
         (point masses: the whole acceleration).
 
+    n_sat is the number of satellites: any (>= 1) for independent point
+    masses, 3 for the coupled constellation.
+
     Coupled constellation (``None`` otherwise; n_sat = 3):
 
     sat_a_dragfree : (m, 3, 3) -- m/s^2, inertial, the drag-free acceleration G_i;
@@ -117,9 +120,11 @@ def select_rows(t, y, a, precision, every, n0, aux=None, system=None) -> Rows:
     sel = (np.arange(n0, n0 + t.shape[0]) % every) == 0
     y_dd = to_dd(y[sel], 3)
     a_f = a[sel][..., 0] if precision == "dd" else a[sel]
-    base = dict(t=(t[sel, 0], t[sel, 1]), sat_r=(y_dd[:, :3, 0:3, 0], y_dd[:, :3, 0:3, 1]),
-                sat_v=(y_dd[:, :3, 3:6, 0], y_dd[:, :3, 3:6, 1]))
-    if system is None or not system.coupled:
+    coupled = system is not None and system.coupled
+    ns = 3 if coupled else y_dd.shape[1]  # point masses: every body is a satellite; coupled: bodies 0..2
+    base = dict(t=(t[sel, 0], t[sel, 1]), sat_r=(y_dd[:, :ns, 0:3, 0], y_dd[:, :ns, 0:3, 1]),
+                sat_v=(y_dd[:, :ns, 3:6, 0], y_dd[:, :ns, 3:6, 1]))
+    if not coupled:
         return Rows(sat_a_gravity=a_f, **base)
     v = _lay.aux_views(aux[sel])
     if system.free_tms:
@@ -139,9 +144,10 @@ def select_rows(t, y, a, precision, every, n0, aux=None, system=None) -> Rows:
 @dataclass(frozen=True)
 class Checkpoint:
     """State of a fixed-step run after ``n`` steps: y (working precision,
-    (n_sat, 6[, 2])) and its Kahan compensation ``comp``.  Resuming from it
-    reproduces the uninterrupted run bit for bit (every step depends only on
-    y, comp and the step index)."""
+    (n_body, 6[, 2]): the satellites, then the TMs in the free-TM mode) and
+    its Kahan compensation ``comp``.  Resuming from it reproduces the
+    uninterrupted run bit for bit (every step depends only on y, comp and
+    the step index)."""
 
     n: int
     y: np.ndarray

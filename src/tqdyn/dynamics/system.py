@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..astro.constants import C_LIGHT
-from ..astro.ephemeris import planetary_gm
 from ..constellation._kinematics_jit import LAW_CODES
 from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY, Spacecraft
 from ..forces.earth import EarthField
+from ..forces.body_gms import body_gms
 from ..astro.ephemeris import ephemeris_named
 from ..forces.model import ForceModel, build_force_model
 from . import layout as _lay
@@ -131,7 +131,7 @@ def build_system(scenario, model: ForceModel | None = None) -> System:
     else:
         bodies = tuple(b for b in _lay.SYSTEM_TDAT_BODIES if b in f.third_bodies) if law else ()
     eph = ephemeris_named(f.ephemeris) if bodies else None
-    gms = planetary_gm()
+    gms = body_gms(f)  # the scenario's forces.gm_* [m^3/s^2]
     ramp = scenario.self_gravity_centre_ramp()
     if model is None and (law or ramp is not None):
         model = build_force_model(f, ref)

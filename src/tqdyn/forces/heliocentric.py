@@ -61,12 +61,14 @@ class SunMonopole(EarthMonopole):
     """The Sun's point-mass term, heliocentric (the central monopole slot).
 
     gm: exact decimal [m^3/s^2]; default the DE430/DE431 value
-    1.3271244004193938e20 (TDB-compatible).  Parameters: [gm_hi, gm_lo]."""
+    1.3271244004193938e20 (TDB-compatible; a run passes its scenario's
+    ``forces.gm_sun``).  Parameters: [gm_hi, gm_lo]."""
 
     gm: object = field(default_factory=_gm_sun_decimal)
     name: str = field(default="sun_monopole", init=False)
     description: str = field(default="Sun point mass, -GM r/|r|^3 (extended precision)", init=False)
-    source: str = field(default="GM of the Sun, DE430/DE431 (tqdyn/data/gm_de431.tpc, TDB-compatible)", init=False)
+    source: str = field(default="GM of the Sun: the scenario's forces.gm_sun (default DE430/DE431, "
+                                "tqdyn/data/gm_de431.tpc, TDB-compatible)", init=False)
 
 
 @dataclass(frozen=True)
@@ -86,10 +88,11 @@ class HeliocentricPositions:
         return self.ephemeris.heliocentric_states(self.names, jd1, jd2, velocity=False)[0]
 
 
-def heliocentric_third_bodies(ephemeris: Ephemeris | None, names, extended=()) -> ThirdBodies:
+def heliocentric_third_bodies(ephemeris: Ephemeris | None, names, extended=(), gms=None) -> ThirdBodies:
     """Point-mass third bodies of a heliocentric run (names from
-    :data:`tqdyn.astro.ephemeris.HELIOCENTRIC_BODIES`), GMs [m^3/s^2] of
-    ``data/gm_de431.tpc`` as given (TDB-compatible; planets as systems at
+    :data:`tqdyn.astro.ephemeris.HELIOCENTRIC_BODIES`), GMs [m^3/s^2] from
+    ``gms`` ({body: GM}, the scenario's ``forces.gm_*``; None: those of
+    ``data/gm_de431.tpc``) as given (TDB-compatible; planets as systems at
     their barycentres, the Earth and the Moon separately).  ValueError for
     an unknown name, a name listed twice or an empty list."""
     eph = default_ephemeris() if ephemeris is None else ephemeris
@@ -102,11 +105,12 @@ def heliocentric_third_bodies(ephemeris: Ephemeris | None, names, extended=()) -
         if n not in HELIOCENTRIC_BODIES:
             raise ValueError(f"third bodies: {n!r} is not a heliocentric third body; allowed: "
                              f"{', '.join(HELIOCENTRIC_BODIES)}")
-    gm = planetary_gm()
+    gm = planetary_gm() if gms is None else dict(gms)
     return ThirdBodies(
         names=names, gms=tuple(gm[n] for n in names), position=HeliocentricPositions(eph, names),
         source=(f"JPL {eph.name} ({eph.path}) via jplephem, heliocentric (body minus Sun, BCRS, TDB); GM: "
-                f"tqdyn/data/gm_de431.tpc (DE430/DE431; planets as systems at their barycentres)"),
+                + ("tqdyn/data/gm_de431.tpc" if gms is None else "the scenario's forces.gm_* (default gm_de431.tpc)")
+                + " (DE430/DE431; planets as systems at their barycentres)"),
         extended=tuple(n for n in names if n in extended))
 
 
@@ -146,15 +150,16 @@ class CentralJ2:
         return np.zeros(np.shape(t_hi) + (0,))
 
 
-def sun_schwarzschild() -> Relativity:
+def sun_schwarzschild(gm: float | None = None) -> Relativity:
     """The Sun's post-Newtonian term on a heliocentric orbit: the
-    Schwarzschild part of IERS 2010 eq. (10.12) with GM_S (DE430) in place
-    of GM_E, beta = gamma = 1 (:class:`tqdyn.forces.relativity.Relativity`
-    with Lense-Thirring and de Sitter off: the Sun's Lense-Thirring
-    acceleration at 1 au is 2.5e-15 m/s^2, 0.8 m after a year, not modelled;
-    de Sitter is a geocentric-frame term)."""
-    rel = Relativity(schwarzschild=True, lense_thirring=False, de_sitter=False,
-                     gm_earth=float(planetary_gm()["sun"]))
+    Schwarzschild part of IERS 2010 eq. (10.12) with GM_S [m^3/s^2] (``gm``,
+    the scenario's ``forces.gm_sun``; None: DE430) in place of GM_E, beta =
+    gamma = 1 (:class:`tqdyn.forces.relativity.Relativity` with
+    Lense-Thirring and de Sitter off: the Sun's Lense-Thirring acceleration
+    at 1 au is 2.5e-15 m/s^2, 0.8 m after a year, not modelled; de Sitter
+    is a geocentric-frame term)."""
+    gm = float(planetary_gm()["sun"]) if gm is None else float(gm)
+    rel = Relativity(schwarzschild=True, lense_thirring=False, de_sitter=False, gm_earth=gm, gm_sun=gm)
     object.__setattr__(rel, "description", "post-Newtonian correction of the Sun (Schwarzschild, IERS 2010 eq. 10.12 "
                                            "with GM_S)")
     object.__setattr__(rel, "source", "IERS Conventions 2010 (TN36) ch. 10 eq. (10.12), first term, GM_S of DE430")

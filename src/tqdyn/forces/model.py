@@ -30,6 +30,7 @@ from numba import njit
 from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
+from .body_gms import body_gms
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import EarthField, degree2_accel_ext, earth_field_accel
@@ -144,14 +145,15 @@ class _Orientation:
         return self(epoch, t_hi, t_lo).T_ITRS_GCRS
 
 
-def _tide_models(forces, eph, orientation) -> tuple:
+def _tide_models(forces, eph, orientation, gms) -> tuple:
     """The tide providers switched on in ``forces`` (coefficient corrections
-    summed into the Earth field)."""
+    summed into the Earth field); gms: :func:`body_gms`."""
     tides = []
     if forces.solid_tides:
         from .solid_tides import SolidTides
 
-        tides.append(SolidTides(orientation=orientation, ephemeris=eph, gm_earth=float(forces.gm_earth)))
+        tides.append(SolidTides(orientation=orientation, ephemeris=eph, gm_earth=float(forces.gm_earth),
+                                gm_moon=gms["moon"], gm_sun=gms["sun"]))
     if forces.ocean_tides_degree:
         from .ocean_tides import OceanTides
 
@@ -184,6 +186,7 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
         raise ValueError(f"scenario.central_body: {reference.central_body!r} has no force model; "
                          "allowed: 'earth', 'sun'")
     terms = []
+    gms = body_gms(forces)
     if forces.earth_monopole:
         terms.append(EarthMonopole(gm=forces.gm_earth))
     needs_ephemeris = (forces.third_bodies or forces.relativity or forces.moon_degree or forces.sun_j2
@@ -199,27 +202,24 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
     orientation = _Orientation(eop)
     rotation = orientation.rotation
     if forces.earth_degree:
-        terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, orientation),
+        terms.append(EarthField(degree=forces.earth_degree, tides=_tide_models(forces, eph, orientation, gms),
                                 rotation=rotation, extended_degree2=forces.earth_degree2_extended))
     if forces.earth_field_indirect:
-        from ..astro.ephemeris import planetary_gm
-
-        gm = planetary_gm()
         bodies = tuple(b for b in ("moon", "sun") if b in forces.third_bodies)
         terms.append(EarthFieldIndirect(field=EarthField(degree=forces.earth_degree, rotation=rotation),
-                                        bodies=bodies, gms=tuple(gm[b] for b in bodies),
+                                        bodies=bodies, gms=tuple(gms[b] for b in bodies),
                                         gm_earth=float(forces.gm_earth), ephemeris=eph))
     if forces.third_bodies:
         from .third_body_ephemeris import third_bodies
 
         terms.append(third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended,
-                                  gcrs=forces.third_bodies_gcrs))
+                                  gcrs=forces.third_bodies_gcrs, gms=gms))
     if forces.moon_degree:
         terms.append(MoonField(degree=forces.moon_degree, libration=forces.moon_libration, ephemeris=eph))
     if forces.sun_j2:
-        terms.append(SunJ2(ephemeris=eph))
+        terms.append(SunJ2(ephemeris=eph, gm=gms["sun"]))
     if forces.relativity:
-        terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth)))
+        terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth), gm_sun=gms["sun"]))
     return ForceModel(terms, reference, eop=eop, eop_source=source if eop is not None else "off")
 
 
@@ -228,15 +228,18 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     from .heliocentric import heliocentric_third_bodies, sun_schwarzschild
 
     terms = []
+    gms = body_gms(forces)
     if forces.sun_monopole:
-        terms.append(SunMonopole())
+        gm_sun = getattr(forces, "gm_sun", None)  # the exact decimal for the extended-precision monopole
+        terms.append(SunMonopole() if gm_sun is None else SunMonopole(gm=str(gm_sun)))
     eph = ephemeris_named(forces.ephemeris) if forces.third_bodies else None
     if forces.third_bodies:
-        terms.append(heliocentric_third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended))
+        terms.append(heliocentric_third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended,
+                                               gms=gms))
     if forces.sun_j2:
-        terms.append(CentralJ2())
+        terms.append(CentralJ2(gm=gms["sun"]))
     if forces.relativity:
-        terms.append(sun_schwarzschild())
+        terms.append(sun_schwarzschild(gm=gms["sun"]))
     return ForceModel(terms, reference)
 
 

@@ -224,13 +224,16 @@ class Relativity:
         Direction of J: ``"cip"`` (rotation axis, default) or ``"gcrs_z"``.
     gm_earth : float
         GM_E [m^3/s^2], default EGM2008's 3.986004415e14.
+    gm_sun : float or None
+        GM_S [m^3/s^2] of the de Sitter term (None: DE430/431 of
+        :func:`tqdyn.astro.ephemeris.planetary_gm`; a run passes its
+        scenario's ``forces.gm_sun``).
     j_earth : float
         |J| [m^2/s], default 9.8e8 (TN36 sec. 10.3).
     beta, gamma : float
         PPN parameters, 1 in general relativity.
 
-    GM_S comes from :func:`tqdyn.astro.ephemeris.planetary_gm` (DE430/431), c is
-    exact (299792458 m/s).
+    c is exact (299792458 m/s).
     """
 
     schwarzschild: bool = True
@@ -240,6 +243,7 @@ class Relativity:
     j_axis: str = "cip"
     gm_earth: float = float(GM_EARTH_EGM2008)
     j_earth: float = J_EARTH_IERS2010
+    gm_sun: float | None = None
     beta: float = 1.0
     gamma: float = 1.0
     name: str = field(default="relativity", init=False)
@@ -268,7 +272,8 @@ class Relativity:
 
     def params(self) -> np.ndarray:
         """[gm_e, c, beta, gamma, gm_s, |J|, on_s, on_lt, on_ds] float64 (SI)."""
-        return np.array([self.gm_earth, C_LIGHT, self.beta, self.gamma, planetary_gm()["sun"], self.j_earth,
+        gm_sun = planetary_gm()["sun"] if self.gm_sun is None else float(self.gm_sun)
+        return np.array([self.gm_earth, C_LIGHT, self.beta, self.gamma, gm_sun, self.j_earth,
                          float(self.schwarzschild), float(self.lense_thirring), float(self.de_sitter)],
                         dtype=np.float64)
 

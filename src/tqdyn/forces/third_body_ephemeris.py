@@ -36,11 +36,15 @@ class EphemerisPositions:
     positions [m] of ``names`` at t = t_hi + t_lo [s TT since epoch]: the
     ephemeris at the geocentre's TDB (:func:`tqdyn.astro.timescales.tdb_jd`),
     transformed to the TT-compatible GCRS when ``gcrs`` (else the BCRS
-    differences, TDB-compatible, as in tqdyn 0.1)."""
+    differences, TDB-compatible, as in tqdyn 0.1).  ``gms``: ((body, GM
+    [m^3/s^2], TDB-compatible), ...) of the bodies whose potential enters
+    the transformation (the Sun, the Moon and ``names``; empty: the shipped
+    DE430/DE431 values of :func:`tqdyn.astro.ephemeris.planetary_gm`)."""
 
     ephemeris: Ephemeris
     names: tuple[str, ...]
     gcrs: bool = True
+    gms: tuple = ()
 
     def __call__(self, epoch, t_hi, t_lo=0.0) -> np.ndarray:
         jd1, jd2 = tdb_jd(epoch, t_hi, t_lo)
@@ -68,7 +72,7 @@ class EphemerisPositions:
         bodies = self.names + tuple(b for b in ("sun", "moon") if b not in self.names)
         pos, vel = self.ephemeris.geocentric_states(bodies, jd1, jd2, velocity=True)
         _, v_earth = self.ephemeris.earth_barycentric(jd1, jd2)
-        gm = planetary_gm()
+        gm = dict(self.gms) if self.gms else planetary_gm()
         x = bcrs_to_gcrs(pos, vel, v_earth, np.array([gm[b] for b in bodies]))
         n = len(self.names)
         return x[:, :n] / TDB_TO_TT_SCALE - pos[:, :n]
@@ -78,11 +82,13 @@ class EphemerisPositions:
 _GRID_S = 3600.0
 
 
-def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=(), gcrs: bool = True) -> ThirdBodies:
+def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=(), gcrs: bool = True,
+                 gms=None) -> ThirdBodies:
     """Third-body term for ``names`` (default: all of
     :data:`tqdyn.astro.ephemeris.BODIES`) with positions from ``ephemeris``
     (``None``: the shipped DE421, :func:`tqdyn.astro.ephemeris.default_ephemeris`)
-    and GMs [m^3/s^2] from ``data/gm_de431.tpc``; the bodies named in
+    and GMs [m^3/s^2, TDB-compatible] from ``gms`` ({body: GM}, the
+    scenario's ``forces.gm_*``; None: ``data/gm_de431.tpc``); the bodies named in
     ``extended`` (and in ``names``) are evaluated in extended precision.
     ``gcrs``: positions and GMs in the TT-compatible GCRS (the GMs times
     :data:`tqdyn.astro.geocentric.TDB_TO_TT_SCALE`); False: as the ephemeris
@@ -101,13 +107,15 @@ def third_bodies(ephemeris: Ephemeris | None = None, names=BODIES, extended=(), 
     if len(set(names)) != len(names):
         raise ValueError(f"third bodies: a body is listed twice in {names}")
     eph.validate_bodies(names)
-    gm = planetary_gm()
+    gm = planetary_gm() if gms is None else dict(gms)
+    used = names + tuple(b for b in ("sun", "moon") if b not in names)
     return ThirdBodies(
         names=names,
         gms=tuple(gm[n] * (TDB_TO_TT_SCALE if gcrs else 1.0) for n in names),
-        position=EphemerisPositions(eph, names, gcrs),
-        source=(f"JPL {eph.name} ({eph.path}) via jplephem; GM: tqdyn/data/gm_de431.tpc "
-                f"(DE430/DE431; planets as systems at their barycenters)"
+        position=EphemerisPositions(eph, names, gcrs, tuple((b, float(gm[b])) for b in used)),
+        source=(f"JPL {eph.name} ({eph.path}) via jplephem; GM: "
+                + ("tqdyn/data/gm_de431.tpc" if gms is None else "the scenario's forces.gm_* (default gm_de431.tpc)")
+                + " (DE430/DE431; planets as systems at their barycenters)"
                 + ("; BCRS -> TT-compatible GCRS (1PN)" if gcrs else "; BCRS differences, TDB-compatible")),
         extended=tuple(n for n in names if n in extended),
     )

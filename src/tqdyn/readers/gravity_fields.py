@@ -66,6 +66,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 __all__ = [
+    "EGM2008_FILE",
+    "GL0660B_FILE",
     "GravityModel",
     "read_icgem_gfc",
     "read_shadr",
@@ -82,8 +84,9 @@ EGM2008_C20_ZERO_TIDE = -0.484169317366974e-03
 #: Tide systems a model can declare.
 TIDE_SYSTEMS = ("tide_free", "zero_tide", "mean_tide", "unknown")
 
-_EGM2008_FILE = "EGM2008_90.gfc"
-_GL0660B_FILE = "jggrx_0660b_sha_deg20.tab"
+#: The shipped coefficient files (in ``tqdyn/data``): EGM2008 to degree 90 and the lunar GL0660B.
+EGM2008_FILE = "EGM2008_90.gfc"
+GL0660B_FILE = "jggrx_0660b_sha_deg20.tab"
 
 
 @dataclass(frozen=True, eq=False)
@@ -330,7 +333,7 @@ def _data(name: str):
 
 @functools.lru_cache(maxsize=None)
 def _egm2008_full() -> GravityModel:
-    return read_icgem_gfc(_data(_EGM2008_FILE))
+    return read_icgem_gfc(_data(EGM2008_FILE))
 
 
 @functools.lru_cache(maxsize=None)
@@ -376,4 +379,4 @@ def gl0660b(nmax: int = 7) -> GravityModel:
 
 @functools.lru_cache(maxsize=None)
 def _gl0660b_full() -> GravityModel:
-    return read_shadr(_data(_GL0660B_FILE), name="GL0660B", tide_system="tide_free")
+    return read_shadr(_data(GL0660B_FILE), name="GL0660B", tide_system="tide_free")

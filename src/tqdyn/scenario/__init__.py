@@ -28,7 +28,9 @@ TOML layout (every section and key optional except at least one
                     max_steps (default 1e9: the most steps a run may have)
     [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
                     tableau ("corrected" | "published"), rtol
-    [forces]        earth_monopole, gm_earth [m^3/s^2]
+    [forces]        earth_monopole, gm_earth [m^3/s^2], the force-model switches,
+                    gm_sun, gm_earth_tdb, gm_moon, gm_mercury .. gm_neptune
+                    [m^3/s^2, TDB-compatible; default DE430/DE431]
     [constellation] pointing ("none" | "global" | "taylor1" | "taylor2" |
                     "iterative"), control ("on" | "off"), free_tms (bool),
                     tm_gravity ("differential" | "direct")
@@ -36,14 +38,17 @@ TOML layout (every section and key optional except at least one
                     self_gravity ("table-iv" | "off" | array (2, 3) or
                     (3, 2, 3) [m/s^2] in OA_l), self_gravity_common (array
                     (3,) or (3, 3) [m/s^2] in S, on both TMs of a satellite)
-    [[satellites]]  name, a_km, e, i_deg, raan_deg, argp_deg, nu_deg
+    [[satellites]]  name, a_km, e, i_deg, raan_deg, argp_deg, nu_deg (any number
+                    for point masses, exactly 3 for a coupled constellation)
 
 Errors are :class:`ScenarioError` (a ``ValueError``) with one line
 ``"<field>: <value> <problem>; allowed: <what is allowed>"``.
 
 Modules: :mod:`tqdyn.scenario.config` (the dataclasses, their validation,
 :meth:`Scenario.to_toml`), :mod:`tqdyn.scenario.loader` (TOML schema,
-overrides, ``extends``, built-in scenarios in ``tqdyn/scenario/builtin/``).
+overrides, ``extends``, built-in scenarios in ``tqdyn/scenario/builtin/``),
+:mod:`tqdyn.scenario.record` (the constants a run uses besides its keys, as
+a trajectory file records them).
 """
 
 from __future__ import annotations

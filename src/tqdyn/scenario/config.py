@@ -19,6 +19,7 @@ from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008
 from ..astro.eop_sources import DEFAULT_EOP_SOURCE, EOP_SOURCES, EOP_SOURCES_ALLOWED, normalize_eop_source
 from ..astro.timescales import Epoch
+from ..forces.body_gms import BODY_GM_KEYS, default_body_gm
 from .toml_text import toml_str, toml_value
 
 __all__ = [
@@ -123,6 +124,11 @@ MAX_OCEAN_TIDE_DEGREE = 100  # fes2004_Cnm-Snm.dat
 LIBRATION_MODELS = ("de421", "iau")
 
 
+def _gm_field(body: str):
+    """A [forces] GM key (:data:`BODY_GM_KEYS`), default the shipped DE430/DE431 value."""
+    return field(default_factory=lambda: default_body_gm(body))
+
+
 @dataclass(frozen=True)
 class ForcesConfig:
     """Force-model switches.  Every perturbation is off unless switched on
@@ -153,6 +159,12 @@ class ForcesConfig:
     ``earth_field_indirect``: the geocentre's acceleration by the Moon and
     Sun (those listed in third_bodies) acting on the Earth's non-central
     field (needs earth_degree >= 2).
+    ``gm_sun``, ``gm_earth_tdb``, ``gm_moon``, ``gm_mercury`` .. ``gm_neptune``
+    [m^3/s^2] (> 0): the GMs of the point-mass bodies, TDB-compatible (the
+    ephemerides'; default the exact DE430/DE431 values of
+    ``data/gm_de431.tpc``; planets as systems): every GM of a run but the
+    geocentric central body's comes from them (:mod:`tqdyn.forces.body_gms`);
+    ``gm_earth_tdb`` is the Earth's as a heliocentric third body.
     ``eop``: the source of polar motion, UT1-UTC and celestial-pole offsets,
     one of :data:`tqdyn.astro.eop_sources.EOP_SOURCES` (default "auto":
     measured, predicted, then the long-term model; true = "auto", false =
@@ -178,6 +190,17 @@ class ForcesConfig:
     relativity: bool = False
     earth_field_indirect: bool = False
     eop: str = DEFAULT_EOP_SOURCE
+    # GMs of the point-mass bodies (BODY_GM_KEYS), TDB-compatible
+    gm_sun: Decimal = _gm_field("sun")
+    gm_earth_tdb: Decimal = _gm_field("earth")
+    gm_moon: Decimal = _gm_field("moon")
+    gm_mercury: Decimal = _gm_field("mercury")
+    gm_venus: Decimal = _gm_field("venus")
+    gm_mars: Decimal = _gm_field("mars")
+    gm_jupiter: Decimal = _gm_field("jupiter")
+    gm_saturn: Decimal = _gm_field("saturn")
+    gm_uranus: Decimal = _gm_field("uranus")
+    gm_neptune: Decimal = _gm_field("neptune")
 
     def __post_init__(self) -> None:
         ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
@@ -207,6 +230,10 @@ class ForcesConfig:
         _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
         _require(not self.earth_field_indirect or self.earth_degree >= 2, "forces.earth_field_indirect", True,
                  "needs the Earth's non-central field", "false, or earth_degree >= 2")
+        for key in BODY_GM_KEYS.values():
+            _set(self, key, _to_decimal(getattr(self, key), f"forces.{key}"))
+            _require(getattr(self, key) > 0, f"forces.{key}", getattr(self, key), "is not positive",
+                     f"{key} > 0 m^3/s^2 (default: DE430/DE431, data/gm_de431.tpc)")
 
 
 POINTING_LAWS = ("none", "global", "taylor1", "taylor2", "iterative")
@@ -263,7 +290,10 @@ class Scenario:
     ``epoch_utc``: normalised UTC ``YYYY-MM-DDTHH:MM:SS[.fff]`` (the epoch of
     the satellite elements and t = 0 of the run); ``satellites``: tuple of
     :class:`SatelliteConfig` (elements relative to the central body, in the
-    frame of :attr:`reference`), at least one, unique names;
+    frame of :attr:`reference`), at least one, unique names: any number for
+    point-mass runs, exactly 3 when the run is coupled
+    (``constellation.pointing`` != "none") or pulls them toward their centre
+    (``spacecraft.self_gravity_center``);
     ``central_body``: the origin of the propagation (one of
     :data:`tqdyn.astro.reference.CENTRAL_BODIES`).
     In fixed mode ``run.duration_s`` is an exact multiple of
@@ -323,7 +353,7 @@ class Scenario:
         if self.initial.derived and not sats:
             from .initial import derived_satellites
 
-            sats = derived_satellites(self.initial, epoch, self.central_body)
+            sats = derived_satellites(self.initial, epoch, self.central_body, self.forces.gm_sun)
         _require(len(sats) >= 1, "satellites", list(sats), "is empty", "at least one satellite")
         seen: dict[str, int] = {}
         for k, sat in enumerate(sats, start=1):
@@ -332,12 +362,9 @@ class Scenario:
                 raise ScenarioError(f"satellites.{k}.name", sat.name, f"duplicates satellites.{seen[sat.name]}.name", "unique satellite names")
             seen[sat.name] = k
         _set(self, "satellites", sats)
+        self._check_satellite_count()
         if not self.allow_below_surface:
             check_above_surface(self.satellites, self.initial, self.central_body)
-        if self.constellation.coupled:
-            _require(len(sats) == 3, "constellation.pointing", self.constellation.pointing,
-                     f"needs exactly 3 satellites (the scenario has {len(sats)})",
-                     '"none" for other constellations')
         if self.integrator.step_s > self.run.duration_s:
             raise ScenarioError("integrator.step", self.integrator.step_s,
                                 f"s is longer than run.duration = {self.run.duration_s} s",
@@ -354,6 +381,26 @@ class Scenario:
                     "a duration that is a whole number of steps",
                 )
         self._check_steps()
+
+    def _check_satellite_count(self) -> None:
+        """Point-mass runs take any number of satellites; what couples them
+        (attitudes locked to the beams, TMs, drag-free control; the
+        self-gravity toward the constellation's centre) is defined for a
+        triangle of exactly 3."""
+        n = len(self.satellites)
+        if n == 3:
+            return
+        c = self.constellation
+        given = "satellite given" if n == 1 else "satellites given"
+        if c.coupled:
+            raise ScenarioError("satellites", n, f"{given}; a coupled run (constellation.pointing = "
+                                f"{c.pointing!r}) needs exactly 3",
+                                '3 satellites, or constellation.pointing = "none" and control = "off" '
+                                "(point masses: any number)")
+        if self.spacecraft.self_gravity_center is not None:
+            raise ScenarioError("satellites", n, f"{given}; spacecraft.self_gravity_center (the pull "
+                                "toward the centre of a triangle) needs exactly 3",
+                                "3 satellites, or no spacecraft.self_gravity_center (point masses: any number)")
 
     def _check_steps(self) -> None:
         """At most ``run.max_steps`` steps; the error names the step when it is
@@ -467,7 +514,9 @@ class Scenario:
                 f"pole_tides = {b(f.pole_tides)}", f"atmospheric_tides = {b(f.atmospheric_tides)}",
                 f"moon_degree = {f.moon_degree}", f"moon_libration = {toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
-                f"eop = {toml_str(f.eop)}", ""]
+                f"eop = {toml_str(f.eop)}",
+                *(f"{key} = {toml_value(getattr(f, key))}  # m^3/s^2, TDB-compatible" for key in BODY_GM_KEYS.values()),
+                ""]
         s = self.spacecraft
         out += ["[spacecraft]", f"architecture = {toml_str(s.architecture)}", f"dragfree = {toml_str(s.dragfree)}"]
         if s.architecture == "tianqin":

@@ -157,10 +157,12 @@ def _decimal_vector(values) -> tuple:
     return tuple(Decimal(str(x)) for x in values)
 
 
-def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) -> tuple[SatelliteConfig, ...]:
+def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str,
+                       gm_sun=None) -> tuple[SatelliteConfig, ...]:
     """Cartesian satellites [m, m/s; relative to the central body, ICRF
-    axes] at ``epoch`` from ``initial.design`` or ``initial.oem``; named
-    ``initial.names`` (default Sat1, Sat2, ...).  ScenarioError naming the
+    axes] at ``epoch`` from ``initial.design`` (with the Sun's GM ``gm_sun``
+    [m^3/s^2], the scenario's ``forces.gm_sun``; None: DE430) or
+    ``initial.oem``; named ``initial.names`` (default Sat1, Sat2, ...).  ScenarioError naming the
     key for a file that cannot be read or does not cover the epoch."""
     if initial.design == "keplerian":
         import mpmath
@@ -171,7 +173,8 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str) 
         with mpmath.workdps(40):
             try:
                 design = keplerian_constellation(initial.arm_length_m, initial.displacement_deg, initial.rotation,
-                                                 epoch.tdb, a=initial.semi_major_axis_m, gm=SunMonopole().gm)
+                                                 epoch.tdb, a=initial.semi_major_axis_m,
+                                                 gm=SunMonopole().gm if gm_sun is None else str(gm_sun))
             except ValueError as exc:
                 raise ScenarioError("initial.design", initial.design, f"cannot be built ({exc})",
                                     "arm_length, displacement_deg, rotation, semi_major_axis in range") from None

@@ -152,7 +152,8 @@ def export_lisa(trajectory, out_path, *, shapiro: bool | None = None, gm: float 
     if src and out.exists() and os.path.exists(src) and os.path.samefile(src, out):
         raise ValueError(f"output {str(out)!r} is the input trajectory; choose another output path")
     if traj.n_sat != 3:
-        raise ValueError(f"{src}: n_sat = {traj.n_sat}; a LISA orbit file needs 3 satellites")
+        raise ValueError(f"{src}: n_sat = {traj.n_sat}; a LISA orbit file needs 3 satellites (its six links); "
+                         f"allowed: a trajectory of 3 satellites (--format oem takes any number)")
     for f in ("t", "sat/r", "sat/v", "sat/a_gravity"):
         if f not in traj:
             raise ValueError(f"{src}: has no field {f!r} (needed for the LISA export)")

@@ -17,23 +17,12 @@ each file is written atomically.
 from __future__ import annotations
 
 import pathlib
-import tomllib
 
 from ..astro.timescales import tdb_after, tt_jd
 from ..formats import trajectory as _io
 from ..formats.oem import OemSegment, write_oem_files
 
 __all__ = ["export_oem"]
-
-
-def _names(attrs, n_sat: int) -> list[str]:
-    """Satellite names of the trajectory's resolved scenario (Sat1, ... if absent)."""
-    try:
-        sats = tomllib.loads(str(attrs.get("scenario", ""))).get("satellites", [])
-        names = [str(s.get("name")) for s in sats]
-    except (tomllib.TOMLDecodeError, AttributeError, TypeError):
-        names = []
-    return names if len(names) == n_sat else [f"Sat{k}" for k in range(1, n_sat + 1)]
 
 
 def export_oem(run_file, out_file) -> list[pathlib.Path]:
@@ -53,7 +42,7 @@ def export_oem(run_file, out_file) -> list[pathlib.Path]:
         raise ValueError(f"{run_file}: a format-version-1 trajectory (t labelled TDB); allowed: files of tqdyn 0.2")
     jd1, jd2 = jd(traj.epoch, *traj.dd("t"))
     r, v = traj["sat/r"], traj["sat/v"]  # (N, n_sat, 3) [m, m/s]: hi + lo, 16 digits as written
-    names = _names(traj.attrs, r.shape[1])
+    names = traj.satellite_names  # the scenario's [[satellites]] names (Sat1, ... if absent)
     segs = [make(name, jd1, jd2, r[:, k], v[:, k],
                  comments=(f"tqdyn trajectory {pathlib.Path(run_file).name}, satellite {k + 1} of {len(names)}",))
             for k, name in enumerate(names)]

@@ -35,7 +35,8 @@ from ..formats.checkpoint import read_checkpoint, write_checkpoint
 from .heap import bound_heap_retention
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
-           "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning"]
+           "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning", "load_run_scenario",
+           "scenario_of_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -134,7 +135,10 @@ def spacecraft_attrs(scen) -> dict:
 def output_attrs(scen, model=None) -> dict:
     """Root attributes of the trajectory file of ``scen`` (the EOP attributes
     from ``model``'s table if given, see :func:`eop_attrs`; the spacecraft
-    attributes of a coupled run, see :func:`spacecraft_attrs`)."""
+    attributes of a coupled run, see :func:`spacecraft_attrs`; the constants
+    record of :mod:`tqdyn.scenario.record`)."""
+    from ..scenario.record import constants_json, run_constants
+
     integ = scen.integrator
     c = scen.constellation
     ref = scen.reference
@@ -153,7 +157,61 @@ def output_attrs(scen, model=None) -> dict:
         "free_tms": int(c.free_tms),
         **spacecraft_attrs(scen),
         **eop_attrs(scen, model),
+        "constants": constants_json(run_constants(scen, model)),
     }
+
+
+def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
+    """(scenario, warnings) to run again what the trajectory file ``path``
+    records: its resolved scenario (root attribute ``scenario``) with
+    ``overrides`` (``"section.key=value"``, as ``--set``), and one line per
+    thing this tqdyn would do differently from the file's run, compared with
+    the file's constants record (root attribute ``constants``,
+    :func:`tqdyn.scenario.record.compare_constants`, for the scenario without
+    the overrides): none means the run reproduces the file bit for bit.
+    ``writes``: the run will write ``run.output``, which must not be ``path``.
+    Raises FileNotFoundError, ValueError (one line: not a trajectory, no
+    scenario, the output would replace ``path``) or ScenarioError."""
+    import os
+
+    from ..scenario import loads_scenario
+    from ..scenario.record import compare_constants, run_constants
+
+    attrs = io.read_attributes(path)
+    text = attrs.get("scenario")
+    src = f"{path} (attribute scenario)"
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError(f"{path}: the trajectory records no scenario; allowed: a trajectory file written by tqdyn run")
+    scen = loads_scenario(text, source=src)
+    notes = []
+    recorded = attrs.get("constants")
+    if recorded is None:
+        notes.append(f"{path} records no constants (written by tqdyn {attrs.get('tqdyn_version', '?')}): the run "
+                     "uses this tqdyn's constants and data files, and its defaults of keys the scenario lacks")
+    else:
+        diffs = compare_constants(recorded, run_constants(scen))
+        if diffs:
+            more = f" (and {len(diffs) - 1} more)" if len(diffs) > 1 else ""
+            notes.append(f"{path}: this tqdyn will not reproduce the file's run: {diffs[0]}{more}")
+    if overrides:
+        scen = loads_scenario(text, overrides, source=src)
+    out = os.path.abspath(os.path.expanduser(scen.run.output))
+    if writes and os.path.exists(out) and os.path.samefile(out, path):
+        raise ValueError(f"run.output: {scen.run.output!r} is the trajectory the scenario is read from; allowed: "
+                         "another file (-o OUT.h5, or --set run.output=OUT.h5)")
+    return scen, notes
+
+
+def load_run_scenario(scenario=None, overrides=(), *, writes: bool = False):
+    """(scenario, warnings) of ``scenario``: a trajectory file (HDF5: its
+    recorded run, :func:`scenario_of_trajectory`; ``writes`` as there), else
+    a built-in name or a TOML path (:func:`tqdyn.scenario.load_scenario`, no
+    warnings)."""
+    from ..scenario import load_scenario
+
+    if scenario is not None and io.is_trajectory_file(scenario):
+        return scenario_of_trajectory(scenario, overrides, writes=writes)
+    return load_scenario(scenario, overrides), []
 
 
 def checkpoint_path(output) -> Path:

@@ -16,7 +16,8 @@ Conventions (for every field, see :data:`FIELDS` for each one's unit/frame)
 * Frame: GCRS for inertial vectors; body frame S for the angular velocity;
   the optical-assembly frame OA_l for test-mass quantities.
 * Shapes: ``[time, satellite, tm, component]``; the satellite axis has length
-  ``n_sat`` in 1..3, the test-mass (= MOSA) axis length 2, components x, y, z.
+  ``n_sat`` (3 for coupled runs; point-mass runs any number >= 1), the
+  test-mass (= MOSA) axis length 2, components x, y, z.
 * Double-double ("dd") fields are HDF5 groups holding two float64 datasets
   ``hi`` and ``lo`` of equal shape; the value is the unevaluated sum
   ``hi + lo``.  "f8" fields are a single float64 dataset.

@@ -16,7 +16,8 @@ from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, Ref
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["SpacecraftRecord", "Trajectory", "read_trajectory", "run_is_complete"]
+__all__ = ["SpacecraftRecord", "Trajectory", "is_trajectory_file", "read_attributes", "read_trajectory",
+           "run_is_complete"]
 
 
 @dataclass(frozen=True)
@@ -228,8 +229,23 @@ class Trajectory:
 
     @property
     def n_sat(self) -> int:
-        """Length of the satellite axis (1..3; 0 if the file has no satellite field)."""
+        """Length of the satellite axis (>= 1; 0 if the file has no satellite field)."""
         return self._n_sat
+
+    @property
+    def satellite_names(self) -> tuple[str, ...]:
+        """The satellites' names in satellite-axis order: the ``name`` of each
+        ``[[satellites]]`` table of the file's resolved scenario (root attribute
+        ``scenario``), or ``Sat1``, ``Sat2``, ... when the scenario does not
+        name exactly :attr:`n_sat` satellites (no scenario, or a damaged one)."""
+        import tomllib
+
+        try:
+            sats = tomllib.loads(self.scenario_toml).get("satellites", [])
+            names = tuple(str(s["name"]) for s in sats)
+        except (tomllib.TOMLDecodeError, AttributeError, TypeError, KeyError):
+            names = ()
+        return names if len(names) == self._n_sat else tuple(f"Sat{k}" for k in range(1, self._n_sat + 1))
 
     @property
     def n_rows(self) -> int:
@@ -276,7 +292,8 @@ class Trajectory:
         """The trajectory as an ``xarray.Dataset``.
 
         Dimensions ``time`` (coordinate: float64 TT seconds since epoch,
-        hi + lo), ``sat`` (1..n_sat), ``tm`` (1, 2), ``comp`` ("x", "y", "z"),
+        hi + lo), ``sat`` (1..n_sat; the non-index coordinate ``sat_name``
+        along it holds :attr:`satellite_names`), ``tm`` (1, 2), ``comp`` ("x", "y", "z"),
         ``row`` ("X_S", "Y_S", "Z_S") and ``col`` ("x", "y", "z") for
         ``sat_T_S_I``.  Variables are named by path with "/" -> "_" (e.g.
         ``sat_r``); a dd field gives the float64 ``hi + lo`` in ``<name>`` and
@@ -302,6 +319,8 @@ class Trajectory:
                                                 "description": "residual of time: exact t = time + t_lo"})
         if self._n_sat:
             coords["sat"] = ("sat", np.arange(1, self._n_sat + 1))
+            coords["sat_name"] = ("sat", np.array(self.satellite_names, dtype=str),
+                                  {"description": "satellite name (the scenario's [[satellites]] name)"})
         for f in self.fields:
             if f == "t":
                 continue
@@ -373,23 +392,63 @@ def read_trajectory(path) -> Trajectory:
                                     f"re-create it (run again)") from None
 
 
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def is_trajectory_file(path) -> bool:
+    """True when ``path`` is an existing file that starts with the HDF5 signature
+    (a trajectory file, or another HDF5 file that :func:`read_attributes` refuses)."""
+    try:
+        with open(os.fspath(path), "rb") as fh:
+            return fh.read(8) == _HDF5_SIGNATURE
+    except (OSError, TypeError, ValueError):
+        return False
+
+
+def read_attributes(path) -> dict:
+    """The root attributes of a trajectory file (native str / int / float),
+    without reading its datasets; the same format and version checks as
+    :func:`read_trajectory` (FileNotFoundError, or a one-line
+    :class:`TrajectoryFormatError` naming the file)."""
+    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
+    fname = str(p)
+    if not p.is_file():
+        raise FileNotFoundError(f"trajectory file {fname!r} does not exist or is not a file")
+    try:
+        h5 = h5py.File(p, "r")
+    except OSError as exc:
+        raise TrajectoryFormatError(f"{fname}: not a readable HDF5 file ({exc})") from None
+    try:
+        with h5:
+            return _checked_attrs(h5, fname)
+    except (OSError, RuntimeError, KeyError) as exc:
+        raise TrajectoryFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
+                                    f"re-create it (run again)") from None
+
+
+def _checked_attrs(h5, fname) -> dict:
+    """The root attributes of an open file, after the format and version checks."""
+    attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
+    fmt = attrs.get("format")
+    ver = attrs.get("format_version")
+    if fmt != FORMAT:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format "
+            f"{FORMAT!r} with format_version <= {FORMAT_VERSION}")
+    if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; expected an "
+            f"int 1..{FORMAT_VERSION}")
+    if ver > FORMAT_VERSION:
+        raise TrajectoryFormatError(
+            f"{fname}: format = {fmt!r} format_version = {ver} is newer than this tqdyn "
+            f"({_TQDYN_VERSION}) supports (format_version <= {FORMAT_VERSION}); upgrade tqdyn")
+    return attrs
+
+
 def _read_open(h5, p, fname) -> Trajectory:
     with h5:
-        attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
-        fmt = attrs.get("format")
-        ver = attrs.get("format_version")
-        if fmt != FORMAT:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format "
-                f"{FORMAT!r} with format_version <= {FORMAT_VERSION}")
-        if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; expected an "
-                f"int 1..{FORMAT_VERSION}")
-        if ver > FORMAT_VERSION:
-            raise TrajectoryFormatError(
-                f"{fname}: format = {fmt!r} format_version = {ver} is newer than this tqdyn "
-                f"({_TQDYN_VERSION}) supports (format_version <= {FORMAT_VERSION}); upgrade tqdyn")
+        attrs = _checked_attrs(h5, fname)
         data: dict[str, tuple[np.ndarray, ...]] = {}
         for f, spec in FIELDS.items():
             if f not in h5:
@@ -422,9 +481,9 @@ def _read_open(h5, p, fname) -> Trajectory:
                 raise TrajectoryFormatError(f"{fname}: {f!r} has {shape[0]} rows but 't' has {n_rows}")
         if "sat" in spec.shape:
             ns = shape[lead + spec.shape.index("sat")]
-            if not 1 <= ns <= 3 or (n_sat and ns != n_sat):
+            if ns < 1 or (n_sat and ns != n_sat):
                 raise TrajectoryFormatError(f"{fname}: {f!r} has satellite axis length {ns}, expected "
-                                            f"{n_sat if n_sat else '1..3'}")
+                                            f"{n_sat if n_sat else '>= 1'}")
             n_sat = ns
         expected = shape[:lead] + spec.resolved_shape(n_sat)
         if shape != expected:

@@ -59,7 +59,8 @@ class FieldSpec:
         or ``"f8"`` (one float64 dataset).
     shape : tuple of (str | int)
         Trailing shape *without* the time axis; ``"sat"`` stands for the
-        satellite axis (length n_sat, 1..3), ``"tm"`` for the test-mass / MOSA
+        satellite axis (length n_sat >= 1: 3 in coupled runs, any number in
+        point-mass runs), ``"tm"`` for the test-mass / MOSA
         axis (length 2).  ``()`` for a scalar per time row.
     unit : str
         SI unit (``"1"`` for dimensionless).
@@ -183,6 +184,8 @@ ROOT_ATTRS: dict[str, str] = {
     "eop": 'str, the Earth-orientation source: "auto" | "finals" | "c04-20" | "c04-14" | "off" | "custom" (extension)',
     "eop_sources": "str, which EOP source covered which days of the run (extension)",
     "eop_data": "str, the EOP files and the leap-second table used (extension)",
+    "constants": "str, JSON: the fixed constants the run used (value, unit, source), the SHA-256 of the data files "
+                 "it read and of the compiled force model's numbers (tqdyn.scenario.record; extension)",
 }
 """Root attributes of format version 1 and their type / allowed values."""
 

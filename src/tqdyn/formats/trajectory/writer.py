@@ -166,7 +166,7 @@ class TrajectoryWriter:
         if any other time-dependent field is listed.  Static fields listed here
         must be given with :meth:`set_static` before :meth:`close`.
     n_sat : int
-        Length of the satellite axis, 1..3.
+        Length of the satellite axis (>= 1; 3 for coupled runs).
     expected_rows : int, optional
         Hint only: number of time rows expected.  Datasets are pre-allocated to
         it (and trimmed to :attr:`rows_written` on close) and the chunk size is
@@ -188,8 +188,8 @@ class TrajectoryWriter:
     def __init__(self, path, attrs: Mapping[str, Any], fields: Sequence[str], n_sat: int,
                  expected_rows: int | None = None, *, compression: str | None = None):
         self._path = check_writable(path)
-        if isinstance(n_sat, bool) or not isinstance(n_sat, (int, np.integer)) or not 1 <= n_sat <= 3:
-            raise ValueError(f"n_sat = {n_sat!r}; allowed: 1, 2 or 3")
+        if isinstance(n_sat, bool) or not isinstance(n_sat, (int, np.integer)) or not n_sat >= 1:
+            raise ValueError(f"n_sat = {n_sat!r}; allowed: an integer >= 1 (the number of satellites)")
         self._n_sat = int(n_sat)
         if isinstance(fields, str):
             raise ValueError("fields: must be a sequence of field paths, not a single str")
@@ -319,7 +319,7 @@ class TrajectoryWriter:
 
     @property
     def n_sat(self) -> int:
-        """Length of the satellite axis (1..3)."""
+        """Length of the satellite axis (>= 1)."""
         return self._n_sat
 
     @property

@@ -146,7 +146,8 @@ def report_runs(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike, 
                 rep.notes.append(f"{label}: no pointing comparison (needs the integrator grid, "
                                  f"run.output_every = 1; this run has {info['output_every']})")
         else:
-            rep.notes.append(f"{label}: {tr.n_sat} satellite(s): no breathing angles, light paths or pointing")
+            rep.notes.append(f"{label}: {tr.n_sat} satellite(s): no arm lengths, breathing angles, light paths or "
+                             "pointing (defined for the 3 satellites of a triangular constellation)")
     _generic_deviations(rep, trajs, labels)
     _finish(rep, "tqdyn report", [f"{lab}: {tr.path}" for lab, tr in zip(labels, trajs)])
     return rep
@@ -351,19 +352,25 @@ def _generic_deviations(rep, trajs, labels):
     ref_i = next((i for i, tr in enumerate(trajs) if "tm/r" not in tr and tr.attrs.get("control") == "off"), 0)
     ref = trajs[ref_i]
     series = []
+    n_runs = 0  # runs with a deviation so far: one colour per run
     for i, (tr, label) in enumerate(zip(trajs, labels)):
         if i == ref_i:
             continue
         if tr.attrs.get("epoch_utc") != ref.attrs.get("epoch_utc"):
             rep.notes.append(f"{label}: other epoch than the reference {labels[ref_i]}: no deviation")
             continue
+        if tr.n_sat != ref.n_sat:
+            rep.notes.append(f"{label}: {tr.n_sat} satellite(s), the reference {labels[ref_i]} {ref.n_sat}: "
+                             "no deviation")
+            continue
         dev = orbit_deviation(tr, ref)
         if dev is None:
             rep.notes.append(f"{label}: shares no time row with {labels[ref_i]}: no deviation")
             continue
         for s in range(tr.n_sat):
-            series.append((f"{label} Sat{s + 1}", dev.t, dev.norm[:, s], f"C{len(series) // 3 % 10}",
-                           ("-", "--", ":")[s % 3]))
+            series.append((f"{label} Sat{s + 1}", dev.t, dev.norm[:, s], f"C{n_runs % 10}",
+                           ("-", "--", ":", "-.")[s % 4] if tr.n_sat > 3 else ("-", "--", ":")[s % 3]))
+        n_runs += 1
         rep.values[f"{label}/deviation_max"] = dev.norm.max(axis=0)
         rep.rows.append(SummaryRow(f"{label}: max orbit deviation from {labels[ref_i]} over "
                                    f"{float(dev.t[-1] - dev.t[0]) / 86400:.3g} d", "-",

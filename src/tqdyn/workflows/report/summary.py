@@ -85,7 +85,10 @@ def _e(x, unit="", digits=2) -> str:
 
 
 def _per_sat(values, unit, fmt="{:.2f}") -> str:
-    return " / ".join(fmt.format(v) for v in values) + f" {unit} (Sat1/2/3)"
+    """One value per satellite: "v1 / v2 / v3 unit (Sat1/2/3)" (as many as there are satellites)."""
+    values = list(values)
+    return " / ".join(fmt.format(v) for v in values) + f" {unit} (Sat" + "/".join(
+        str(k) for k in range(1, len(values) + 1)) + ")"
 
 
 def _order_ok(value, paper, factor=10 ** 0.5 * 3) -> bool:
