@@ -5,7 +5,7 @@ iterative pointing, ESA's OEM initial states and self-gravity ramp, the Sun,
 the Earth, the Moon and the planets) and a geocentric one (`tianqin`, 6 h:
 the full force model of the paper's Table II, coupled) are written; then the
 package's default GMs (``data/gm_de431.tpc``, through the functions every
-default goes through: ``tqdyn.readers.pck._shipped_gm`` and
+default goes through: ``tqdyn.readers.pck.shipped_gm`` and
 ``tqdyn.astro.ephemeris._planetary_gm``) are changed by 1 part in 1e6.  A run
 of the built-in scenario now differs from the file (so the GMs do enter the
 run: measured 1.8e4 m for `lisa` after 30 d, 2.8e-3 m for `tianqin` after
@@ -48,13 +48,13 @@ def _patch_default_gms(monkeypatch):
     from tqdyn.astro import ephemeris
     from tqdyn.readers import pck
 
-    changed = {k: v * _SCALE for k, v in pck._shipped_gm(exact=True).items()}
+    changed = {k: v * _SCALE for k, v in pck.shipped_gm(exact=True).items()}
     planetary = tuple((name, float(changed[naif])) for name, naif in ephemeris.NAIF_ID.items())
 
     def shipped_gm(exact_values: bool = False, *, exact: bool | None = None) -> dict:
         return changed if (exact_values or exact) else {k: float(v) for k, v in changed.items()}
 
-    monkeypatch.setattr(pck, "_shipped_gm", shipped_gm)
+    monkeypatch.setattr(pck, "shipped_gm", shipped_gm)
     monkeypatch.setattr(ephemeris, "_planetary_gm", lambda: planetary)
     assert tqdyn.load_scenario("lisa").forces.gm_sun == changed[10].normalize()
 
