@@ -142,7 +142,8 @@ def _esa_files():
     """ESA's three CReMA 2.0 files (TDB), heliocentric, their "EME2000" axes read as ICRF (as the built-in
     scenarios read them: docs/lisa-orbits.md)."""
     if "orbits" not in _ESA_CACHE:
-        from ...readers.oem import esa_lisa_orbit_files, read_oem, to_heliocentric
+        from ...astro.oem_states import to_heliocentric
+        from ...readers.oem import esa_lisa_orbit_files, read_oem
 
         _ESA_CACHE["orbits"] = [to_heliocentric(read_oem(p), eme2000_frame_bias=False)
                                 for p in esa_lisa_orbit_files("TDB")]
@@ -152,7 +153,7 @@ def _esa_files():
 def _esa_on_grid(tr) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ESA's files interpolated (Hermite, as they say) on the rows of ``tr`` inside their span:
     (row indices (M,), R (M, 3, 3) [m], V (M, 3, 3) [m/s])."""
-    from ...readers.oem import states_at
+    from ...astro.oem_states import states_at
 
     esa = _esa_files()
     ep = tr.epoch.tdb
