@@ -2,7 +2,7 @@
 
 Reference: ESA's CReMA 2.0 trailing orbits shipped in tqdyn/data/esa-lisa-orbits (esa/lisa-orbit-files,
 commit bf87d55; data/SOURCES.md), read by tqdyn.readers.oem and interpolated as the files say (Hermite 7,
-``states_at``).  The scenario starts from their first record (2036-12-09 TDB) with ESA's force model
+tqdyn.astro.oem_states.states_at).  The scenario starts from their first record (2036-12-09 TDB) with ESA's force model
 (Newtonian Sun, Earth, Moon, planetary barycentres; DE421 positions, DE430 GMs) and ESA's self-gravity,
 ``spacecraft.self_gravity_center = [-2e-9, 2e-9]`` (m/s^2 toward the centroid, linear over the files' span).
 ESA integrated with tolerances 1e-9: its files are not exact, and their velocities are rounded to 0.1 mm/s.
@@ -25,11 +25,12 @@ import pytest
 
 from tqdyn import dynamics
 from tqdyn.analysis.metrics import breathing_angles_of
+from tqdyn.astro.oem_states import frame_bias_matrix, states_at, to_heliocentric
 from tqdyn.constellation import geometry
 from tqdyn.forces.heliocentric import SunMonopole
 from tqdyn.forces.model import ForceModel, build_force_model
 from tqdyn.formats.trajectory import read_trajectory
-from tqdyn.readers.oem import esa_lisa_orbit_files, frame_bias_matrix, read_oem, states_at, to_heliocentric
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem
 from tqdyn.scenario import load_scenario
 from tqdyn.workflows.run import run_to_file
 

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from cli_support import run_cli
+from tqdyn.astro.oem_states import to_heliocentric
 from tqdyn.astro.reference import HELIOCENTRIC
 from tqdyn.astro.timescales import Epoch
 from tqdyn.dynamics.initial import initial_state, satellite_states
-from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, to_heliocentric
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem
 from tqdyn.scenario import load_scenario, loads_scenario
 
 BASE = """

@@ -27,8 +27,9 @@ import pytest
 from cli_support import run_cli
 from tqdyn.analysis import lisa_estimates as le
 from tqdyn.analysis.metrics import orbit_deviation
+from tqdyn.astro.oem_states import states_at, to_heliocentric
 from tqdyn.formats.trajectory import read_trajectory
-from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, states_at, to_heliocentric
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem
 from tqdyn.scenario import load_scenario
 from tqdyn.workflows import studies as st
 from tqdyn.workflows import studies_lisa as sl

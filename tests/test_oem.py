@@ -1,4 +1,5 @@
-"""Tests of the CCSDS OEM reader (tqdyn.readers.oem) and writer (tqdyn.formats.oem).
+"""Tests of the CCSDS OEM reader (tqdyn.readers.oem), the states from it (tqdyn.astro.oem_states) and the
+writer (tqdyn.formats.oem).
 
 Input: ESA's LISA science orbits shipped in tqdyn/data/esa-lisa-orbits (CReMA 2.0,
 TDB files and the copies with TCB time tags; data/SOURCES.md), and OEM files
@@ -26,6 +27,8 @@ import erfa
 import numpy as np
 import pytest
 
+from tqdyn.astro import oem_states as st
+from tqdyn.astro import timescales as ts
 from tqdyn.astro.constants import AU_M, L_B
 from tqdyn.formats import oem as fo
 from tqdyn.formats.trajectory import OutputError
@@ -150,7 +153,7 @@ def test_frame_bias_is_the_iau2006_rotation():
     (sqrt(xi0^2 + eta0^2 + da0^2)); the rotation vector of B is (-eta0, xi0, da0) (sign: r_EME = B r_ICRS)."""
     xi0, eta0, da0 = -16.617 * MAS, -6.8192 * MAS, -14.6 * MAS
     b_ref = erfa.rx(-eta0, erfa.ry(xi0, erfa.rz(da0, np.eye(3))))
-    B = ro.frame_bias_matrix()
+    B = st.frame_bias_matrix()
     assert np.abs(B - b_ref).max() < 5e-12
     np.testing.assert_allclose(B @ B.T, np.eye(3), atol=1e-15)
     w = np.array([B[1, 2] - B[2, 1], B[2, 0] - B[0, 2], B[0, 1] - B[1, 0]]) / 2
@@ -164,7 +167,7 @@ def test_frame_bias_moves_esa_positions_by_up_to_17_km(esa):
     """EME2000 -> ICRF on ESA's lisa1: |r_ICRF - r_EME2000| <= angle |r| (23.147 mas = 16.79 km at 1 au);
     measured 5.0 .. 16.84 km over the 10.75 years (|r| up to 1.007 au); |r| unchanged to 1e-4 m."""
     tr = esa[0]
-    h = ro.to_heliocentric(tr)
+    h = st.to_heliocentric(tr)
     assert h.ref_frame == "ICRF" and h.time_system == "TDB" and h.center_name == "SUN"
     dr = np.linalg.norm(h.r - tr.r, axis=1)
     rn = np.linalg.norm(tr.r, axis=1)
@@ -172,7 +175,7 @@ def test_frame_bias_moves_esa_positions_by_up_to_17_km(esa):
     assert 16.7e3 < dr.max() < 16.9e3 and 4.9e3 < dr.min() < 5.1e3
     assert abs(23.147 * MAS * AU_M - 16.79e3) < 10
     assert np.abs(np.linalg.norm(h.r, axis=1) - rn).max() < 1e-4
-    np.testing.assert_allclose(h.r, tr.r @ ro.frame_bias_matrix(), rtol=0, atol=1e-4)  # r_ICRS = B^T r
+    np.testing.assert_allclose(h.r, tr.r @ st.frame_bias_matrix(), rtol=0, atol=1e-4)  # r_ICRS = B^T r
 
 
 # ------------------------------------------------------------------ interpolation
@@ -192,7 +195,7 @@ def _leave_one_out(tr, ks):
     for k in ks:
         keep = np.r_[0:k, k + 1:len(tr)]
         sub = tr.replace(jd1=tr.jd1[keep], jd2=tr.jd2[keep], r=tr.r[keep], v=tr.v[keep], a=None)
-        r, v = ro.states_at(sub, tr.jd1[k], tr.jd2[k])
+        r, v = st.states_at(sub, tr.jd1[k], tr.jd2[k])
         err_r.append(np.linalg.norm(r - tr.r[k]))
         err_v.append(np.linalg.norm(v - tr.v[k]))
     return np.array(err_r), np.array(err_v)
@@ -201,12 +204,12 @@ def _leave_one_out(tr, ks):
 def test_interpolation_returns_the_records_at_their_epochs(esa):
     """At a record's epoch, the record itself (exactly), first and last included; array shapes."""
     tr = esa[0]
-    r, v = ro.states_at(tr, tr.jd1, tr.jd2)
+    r, v = st.states_at(tr, tr.jd1, tr.jd2)
     assert r.shape == v.shape == (N_RECORDS, 3)
     assert np.array_equal(r, tr.r) and np.array_equal(v, tr.v)
-    r1, v1 = ro.states_at(tr, tr.jd1[5], tr.jd2[5])
+    r1, v1 = st.states_at(tr, tr.jd1[5], tr.jd2[5])
     assert r1.shape == v1.shape == (3,)
-    r2, _ = ro.states_at(tr, np.full((2, 3), tr.jd1[7]), tr.jd2[7])
+    r2, _ = st.states_at(tr, np.full((2, 3), tr.jd1[7]), tr.jd2[7])
     assert r2.shape == (2, 3, 3) and np.array_equal(r2[1, 2], tr.r[7])
 
 
@@ -224,14 +227,14 @@ def test_hermite_on_an_exact_orbit_at_esa_epochs(esa):
     er, _ = _leave_one_out(exact, ks)
     assert er.max() < 0.05
     tm = 0.5 * (t[:-1] + t[1:])
-    rm, vm = ro.states_at(exact, tr.jd1[:-1], tr.jd2[:-1] + 0.5 * np.diff(t) / 86400.0)
+    rm, vm = st.states_at(exact, tr.jd1[:-1], tr.jd2[:-1] + 0.5 * np.diff(t) / 86400.0)
     rt, vt = _circular(tm)
     assert np.linalg.norm(rm - rt, axis=1).max() < 3e-3
     assert np.linalg.norm(vm - vt, axis=1).max() < 2e-8
     rounded = tr.replace(r=np.round(r / 1e3, 6) * 1e3, v=np.round(v / 1e3, 7) * 1e3, a=None)
     er2, _ = _leave_one_out(rounded, ks)
     assert 1.0 < er2.max() < 100.0
-    rm2, _ = ro.states_at(rounded, tr.jd1[:-1], tr.jd2[:-1] + 0.5 * np.diff(t) / 86400.0)
+    rm2, _ = st.states_at(rounded, tr.jd1[:-1], tr.jd2[:-1] + 0.5 * np.diff(t) / 86400.0)
     assert np.linalg.norm(rm2 - rt, axis=1).max() < 30.0
 
 
@@ -265,7 +268,7 @@ def test_interpolation_agrees_with_the_oem_package(esa):
     for k in range(5, len(tr) - 5, 37):
         j1 = tr.jd1[k]
         j2 = tr.jd2[k] + 0.5 * ((tr.jd1[k + 1] - tr.jd1[k]) + (tr.jd2[k + 1] - tr.jd2[k]))
-        r, v = ro.states_at(tr, j1, j2)
+        r, v = st.states_at(tr, j1, j2)
         s = seg(Time(j1, j2, format="jd", scale="tdb"))
         dr.append(np.linalg.norm(s.position * 1e3 - r))
         dv.append(np.linalg.norm(s.velocity * 1e3 - v))
@@ -273,7 +276,7 @@ def test_interpolation_agrees_with_the_oem_package(esa):
     last = seg._state_data[0][-1]
     with pytest.raises(ValueError):
         seg(last)
-    r, v = ro.states_at(tr, tr.jd1[-1], tr.jd2[-1])
+    r, v = st.states_at(tr, tr.jd1[-1], tr.jd2[-1])
     assert np.array_equal(r, tr.r[-1])
 
 
@@ -286,11 +289,11 @@ def test_lagrange_and_linear(esa):
     poly = np.stack([1e11 + 3e9 * tt - 2e7 * tt**2 + 1e5 * tt**3 - 40 * tt**4 + 0.1 * tt**5] * 3, -1)
     lag = tr.replace(r=poly, v=poly * 1e-7, a=None)
     j2 = tr.jd2[10:20] + 0.37 * np.diff(t)[10:20] / 86400.0
-    r, _ = ro.states_at(lag, tr.jd1[10:20], j2, method="LAGRANGE", degree=5)
+    r, _ = st.states_at(lag, tr.jd1[10:20], j2, method="LAGRANGE", degree=5)
     ts = _sec(tr.jd1[10:20], j2, tr.jd1[0], tr.jd2[0]) / 1e6
     ref = 1e11 + 3e9 * ts - 2e7 * ts**2 + 1e5 * ts**3 - 40 * ts**4 + 0.1 * ts**5
     assert np.abs(r[:, 0] - ref).max() < 1e-6 * 1e3  # 1 mm on 1e11 m (measured ~1e-5 m)
-    r, v = ro.states_at(tr, tr.jd1[3], tr.jd2[3] + 0.5 * np.diff(t)[3] / 86400.0, method="LINEAR")
+    r, v = st.states_at(tr, tr.jd1[3], tr.jd2[3] + 0.5 * np.diff(t)[3] / 86400.0, method="LINEAR")
     np.testing.assert_allclose(r, 0.5 * (tr.r[3] + tr.r[4]), rtol=1e-15)
 
 
@@ -309,22 +312,22 @@ def test_tcb_files_are_the_tdb_orbits_with_tcb_tags(esa, esa_tcb):
         assert 2.2e3 < L_B * np.linalg.norm(a.r, axis=1).max() < 2.4e3
         raw = _sec(b.jd1, b.jd2, a.jd1, a.jd2)
         assert 29.3 < raw[0] < 29.4 and 34.5 < raw[-1] < 34.6  # TCB - TDB grows by L_B ~ 0.49 s/yr
-        h = ro.to_heliocentric(b)
+        h = st.to_heliocentric(b)
         assert h.time_system == "TDB" and h.ref_frame == "ICRF"
         d = _sec(h.jd1, h.jd2, a.jd1, a.jd2)
         assert np.abs(d).max() < 1.5e-6
-        assert np.abs(d - 2 * ro.TDB0_S).max() > 1e-4
-        r, _ = ro.states_at(a, h.jd1[1:-1], h.jd2[1:-1])
+        assert np.abs(d - 2 * ts.TDB0_S).max() > 1e-4
+        r, _ = st.states_at(a, h.jd1[1:-1], h.jd2[1:-1])
         assert np.linalg.norm(r - b.r[1:-1], axis=1).max() < 0.05
         # scaled conversion, if asked for: r (1 - L_B)
-        hs = ro.to_heliocentric(b, tcb_scaled_coordinates=True)
+        hs = st.to_heliocentric(b, tcb_scaled_coordinates=True)
         np.testing.assert_allclose(hs.r, h.r * (1 - L_B), rtol=1e-15)
 
 
 def test_tcb_to_tdb_against_erfa(esa_tcb):
     """Reference (4): erfa.tcbtdb at the 1169 TCB tags: measured 4.8e-12 s -> bound 5e-11 s."""
     b = esa_tcb[0]
-    j1, j2 = ro.tcb_to_tdb(b.jd1, b.jd2)
+    j1, j2 = ts.tcb_to_tdb(b.jd1, b.jd2)
     e1, e2 = erfa.tcbtdb(b.jd1, b.jd2)
     assert np.abs(_sec(j1, j2, e1, e2)).max() < 5e-11
 
@@ -338,7 +341,7 @@ def test_writer_round_trip_heliocentric(esa, tmp_path):
     1e-17 m/s^2; metadata as written."""
     from oem import OrbitEphemerisMessage
 
-    h = ro.to_heliocentric(esa[0])
+    h = st.to_heliocentric(esa[0])
     seg = fo.OemSegment.heliocentric("LISA1", h.jd1, h.jd2, h.r, h.v, a=h.a)
     p = fo.write_oem(tmp_path / "lisa1.oem", seg, creation_date="2025-01-01T00:00:00")
     back = ro.read_oem(p)
@@ -361,8 +364,8 @@ def test_writer_round_trip_heliocentric(esa, tmp_path):
     ep = msg.segments[0]._state_data[0]
     assert max(abs(_sec(e.jd1, e.jd2, a, b)) for e, a, b in zip(ep, h.jd1, h.jd2)) < 1e-10
     # our interpolation of the written file = of the original
-    r0, v0 = ro.states_at(h, h.jd1[100], h.jd2[100] + 1.1)
-    r1, v1 = ro.states_at(back, h.jd1[100], h.jd2[100] + 1.1)
+    r0, v0 = st.states_at(h, h.jd1[100], h.jd2[100] + 1.1)
+    r1, v1 = st.states_at(back, h.jd1[100], h.jd2[100] + 1.1)
     assert np.abs(r1 - r0).max() < 1e-3 and np.abs(v1 - v0).max() < 1e-8
 
 
@@ -383,9 +386,9 @@ def test_writer_round_trip_geocentric_and_epoch_rounding(tmp_path):
     assert np.abs(d).max() < 6e-10 and np.abs(d).max() > 1e-11
     np.testing.assert_allclose(back.r, r, rtol=1e-15, atol=1e-9)
     np.testing.assert_allclose(back.v, v, rtol=1e-15, atol=1e-12)
-    assert ro.to_geocentric(back).ref_frame == "GCRF"
+    assert st.to_geocentric(back).ref_frame == "GCRF"
     with pytest.raises(ValueError, match="CENTER_NAME = 'EARTH'"):
-        ro.to_heliocentric(back)
+        st.to_heliocentric(back)
 
 
 def test_reader_reads_xml_and_compressed_files(esa, tmp_path):
@@ -414,15 +417,18 @@ def test_writer_segments_one_object_per_file(esa, tmp_path):
     file each."""
     from oem import OrbitEphemerisMessage
 
-    h = ro.to_heliocentric(esa[0])
+    h = st.to_heliocentric(esa[0])
     s1 = fo.OemSegment.heliocentric("LISA1", h.jd1[:600], h.jd2[:600], h.r[:600], h.v[:600])
     s2 = fo.OemSegment.heliocentric("LISA1", h.jd1[600:], h.jd2[600:], h.r[600:], h.v[600:])
     p = fo.write_oem(tmp_path / "two.oem", [s1, s2])
     segs = ro.read_oem_segments(p)
     assert [len(s) for s in segs] == [600, N_RECORDS - 600]
     assert len(OrbitEphemerisMessage.open(p).segments) == 2
-    with pytest.raises(ValueError, match="ephemeris segments"):
+    with pytest.raises(ValueError) as ei:  # record 600 follows record 599 a step later: a gap, not one trajectory
         ro.read_oem(p)
+    assert ("segments 1 (2036-12-09T00:00:00.000000940 .. 2042-06-13T14:04:41.723110970 TDB) and 2 "
+            "(2042-06-16T22:57:49.820945880 .. 2047-09-09T13:04:48.000001110 TDB) are not continuous: a gap of "
+            "291188.098 s (3.37023 d)") in _one_line_error(ei, p)
     with pytest.raises(ValueError, match="segments must follow each other"):
         fo.write_oem(tmp_path / "x.oem", [s2, s1])
     sats = [fo.OemSegment.heliocentric(f"LISA{i + 1}", t.jd1, t.jd2, t.r, t.v) for i, t in enumerate(esa)]
@@ -438,7 +444,7 @@ def test_writer_segments_one_object_per_file(esa, tmp_path):
 def test_writer_is_atomic(esa, tmp_path, monkeypatch):
     """A NaN position raises before anything is written; an existing file stays untouched; a failure
     mid-write (fsync raising) leaves neither a partial file nor the temporary file."""
-    h = ro.to_heliocentric(esa[0])
+    h = st.to_heliocentric(esa[0])
     r = h.r.copy()
     r[17, 1] = np.nan
     bad = fo.OemSegment.heliocentric("LISA1", h.jd1, h.jd2, r, h.v)
@@ -562,11 +568,11 @@ def test_non_monotonic_epochs(tmp_path):
 def test_epoch_outside_span_and_other_caller_errors(esa, tmp_path):
     tr = esa[0]
     with pytest.raises(ValueError) as ei:
-        ro.states_at(tr, tr.jd1[0], tr.jd2[0] - 1e-6)
+        st.states_at(tr, tr.jd1[0], tr.jd2[0] - 1e-6)
     msg = _one_line_error(ei, tr.source)
     assert "is outside the span 2036-12-09T00:00:00.000000940 .. 2047-09-09T13:04:48.000001110 TDB" in msg
     with pytest.raises(ValueError, match="outside the span"):
-        ro.states_at(tr, tr.jd1[-1] + 1.0, tr.jd2[-1])
+        st.states_at(tr, tr.jd1[-1] + 1.0, tr.jd2[-1])
     with pytest.raises(ValueError, match="CENTER_NAME = 'SUN', but 'EARTH' is required"):
         ro.require_center(tr, "EARTH")
     assert ro.require_center(tr) is tr
@@ -574,4 +580,4 @@ def test_epoch_outside_span_and_other_caller_errors(esa, tmp_path):
         ro.read_oem(TDB_FILES[0], object_name="LISA2")
     p = _edit(tmp_path, "INTERPOLATION_DEGREE = 7", "INTERPOLATION_DEGREE = 6", "deg6.oem")
     with pytest.raises(ValueError, match="INTERPOLATION_DEGREE = 6 for HERMITE must be odd"):
-        ro.states_at(ro.read_oem(p), tr.jd1[5], tr.jd2[5])
+        st.states_at(ro.read_oem(p), tr.jd1[5], tr.jd2[5])

@@ -8,7 +8,8 @@ References:
 * the LISA arm length: ESA's design value 2.5e9 m (2.5e6 km; Martens & Joffre 2021, "Trajectory design for
   the ESA LISA mission", arXiv:2101.03040) for the mean, and ESA's CReMA 2.0 orbit files shipped in
   tqdyn/data/esa-lisa-orbits (the `lisa` scenario's initial states; read by tqdyn.readers.oem and
-  interpolated as the files say) for the arm lengths, their rates and the breathing angles on the run's grid;
+  interpolated as the files say by tqdyn.astro.oem_states) for the arm lengths, their rates and the
+  breathing angles on the run's grid;
 * the drag-free acceleration: the scenario's input, ESA's self-gravity ramp -2e-9 -> +2e-9 m/s^2 along +X_S,
   linear over the files' span 2036-12-09 .. 2047-09-09T13:04:48 TDB, which the satellite must follow;
 * the suspension along the sensitive axes: zero by the LISA scheme's condition e_l . A_l = 0 (round-off).
@@ -28,11 +29,12 @@ import numpy as np
 import pytest
 
 from tqdyn import cli
+from tqdyn.astro.oem_states import states_at, to_heliocentric
 from tqdyn.cli.report import report as report_command
 from tqdyn.constellation import geometry
 from tqdyn.constellation.spacecraft import Spacecraft
 from tqdyn.formats import trajectory as io
-from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, states_at, to_heliocentric
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem
 from tqdyn.scenario import load_scenario
 from tqdyn.workflows import report as rp
 from tqdyn.workflows.run import run_to_file

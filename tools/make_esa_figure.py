@@ -42,10 +42,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tqdyn import dynamics  # noqa: E402
+from tqdyn.astro.oem_states import states_at, to_heliocentric  # noqa: E402
 from tqdyn.constellation import geometry  # noqa: E402
 from tqdyn.forces.heliocentric import SunMonopole  # noqa: E402
 from tqdyn.forces.model import ForceModel, build_force_model  # noqa: E402
-from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem, states_at, to_heliocentric  # noqa: E402
+from tqdyn.readers.oem import esa_lisa_orbit_files, read_oem  # noqa: E402
 from tqdyn.scenario import load_scenario  # noqa: E402
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "docs" / "figures" / "esa-lisa-comparison.png"
@@ -85,7 +86,7 @@ def esa_orbits(paths=None, file_axes_icrf: bool = False):
 
 def full_digit_y0(file_axes_icrf: bool) -> np.ndarray:
     """dd initial states (3, 6, 2) [m, m/s] from :data:`FULL_DIGIT_STATES_KM`."""
-    from tqdyn.readers.oem import frame_bias_matrix
+    from tqdyn.astro.oem_states import frame_bias_matrix
 
     y = np.zeros((3, 6, 2))
     rot = np.eye(3) if file_axes_icrf else frame_bias_matrix().T

@@ -3,7 +3,7 @@
 ESA's three CReMA 2.0 orbit files (shipped in ``tqdyn/data/esa-lisa-orbits``,
 :func:`tqdyn.readers.oem.esa_lisa_orbit_files`), TDB, read as Sun-centred
 states with their "EME2000" axes taken as ICRF, as the built-in scenarios
-read them (docs/lisa-orbits.md; :func:`tqdyn.readers.oem.to_heliocentric`
+read them (docs/lisa-orbits.md; :func:`tqdyn.astro.oem_states.to_heliocentric`
 without the frame bias).  SI units; times in TDB seconds since a run's epoch.
 """
 
@@ -22,7 +22,8 @@ def esa_orbits():
     """ESA's three orbits (:class:`tqdyn.readers.oem.OemTrajectory`, satellites 1, 2, 3), Sun-centred, ICRF
     axes, TDB; read once per process (the result is shared: do not modify it)."""
     if "orbits" not in _CACHE:
-        from ..readers.oem import esa_lisa_orbit_files, read_oem, to_heliocentric
+        from ..astro.oem_states import to_heliocentric
+        from ..readers.oem import esa_lisa_orbit_files, read_oem
 
         _CACHE["orbits"] = [to_heliocentric(read_oem(p), eme2000_frame_bias=False)
                             for p in esa_lisa_orbit_files("TDB")]
@@ -32,7 +33,7 @@ def esa_orbits():
 def esa_states_on_grid(traj) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ESA's orbits interpolated (Hermite, as the files say) at the rows of a heliocentric trajectory ``traj``
     that lie inside the files' span: (row indices (M,), R (M, 3, 3) [m], V (M, 3, 3) [m/s])."""
-    from ..readers.oem import states_at
+    from ..astro.oem_states import states_at
 
     esa = esa_orbits()
     ep = traj.epoch.tdb

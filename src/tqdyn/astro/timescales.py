@@ -1,4 +1,4 @@
-"""Time scales for tqdyn: UTC -> TAI -> TT -> TDB at the geocenter (pyerfa/SOFA).
+"""Time scales for tqdyn: UTC -> TAI -> TT -> TDB at the geocenter (pyerfa/SOFA), and TCB -> TDB.
 
 Conventions
 -----------
@@ -59,10 +59,15 @@ from ..numerics.lagrange import MARGIN, grid_interp
 from ..readers.leap_seconds import LeapSeconds, read_leap_seconds
 from .constants import DAY_S, J2000_JD, L_B
 
-__all__ = ["TCB_ORIGINS", "TCB_PER_TDB", "TCB_SCALE", "TCB_SCALE_MINUS_1", "Epoch", "UTCFields",
+__all__ = ["TCB_ORIGINS", "TCB_PER_TDB", "TCB_SCALE", "TCB_SCALE_MINUS_1", "TCB_T0_JD", "TDB0_S", "Epoch", "UTCFields",
            "geocentre_tdb_grid", "install_leap_seconds", "installed_leap_seconds", "leap_seconds_note", "parse_utc",
-           "tcb_jd_of_epoch", "tcb_origin_offset", "tdb_after", "tdb_jd", "tdb_minus_tt", "tdb_to_tcb", "tt_jd",
-           "unix_of_tcb"]
+           "tcb_jd_of_epoch", "tcb_origin_offset", "tcb_to_tdb", "tdb_after", "tdb_jd", "tdb_minus_tt", "tdb_to_tcb",
+           "tt_jd", "unix_of_tcb"]
+
+#: T0 of IAU 2006 Resolution B3: 1977-01-01T00:00:32.184 TAI as a JD in TCB (and TDB, TT) [d].
+TCB_T0_JD = 2443144.5003725
+#: TDB0 of IAU 2006 Resolution B3 [s]: TDB = TCB - L_B (JD_TCB - T0) 86400 + TDB0.
+TDB0_S = -6.55e-5
 
 _ISO_FORMAT = "YYYY-MM-DDTHH:MM:SS[.fff] (UTC; 'T' or a space between date and time; optional trailing 'Z')"
 
@@ -500,3 +505,15 @@ def geocentre_tdb_grid(epoch: Epoch, t) -> tuple[tuple, tuple, np.ndarray]:
     Tl = np.where(Th + Tl < lo_t, lo_t - Th, np.where(Th + Tl > hi_t, hi_t - Th, Tl))
     ddt = (dtdb(Th + _DIFF_S, Tl) - dtdb(Th - _DIFF_S, Tl)) / (2 * _DIFF_S)
     return (bh, bl), (Th, Tl), -ddt / (1.0 + ddt)
+
+
+def tcb_to_tdb(jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
+    """TDB (jd1, jd2) of TCB instants (jd1, jd2) [d] (IAU 2006 Resolution B3):
+    TDB = TCB - L_B ((jd1 - T0) + jd2) 86400 s + TDB0; jd1 kept, the
+    correction (~ -30 s in 2037) added to jd2 (error ~1e-17 d; against
+    ``erfa.tcbtdb``: 4.8e-12 s, tests/test_oem.py)."""
+    day = float(DAY_S)
+    jd1 = np.asarray(jd1, dtype=np.float64)
+    jd2 = np.asarray(jd2, dtype=np.float64)
+    corr = (-L_B * ((jd1 - TCB_T0_JD) + jd2) * day + TDB0_S) / day
+    return jd1.copy(), jd2 + corr

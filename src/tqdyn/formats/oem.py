@@ -26,8 +26,12 @@ files written here are valid (tests/test_oem.py).
 
 An OEM holds "orbit data for a single object" (CCSDS 502.0-B-2, 5.1.3; the
 ``oem`` package enforces it): several segments in one file must share
-OBJECT_NAME, OBJECT_ID and TIME_SYSTEM and follow each other in time.  A
-constellation is written one file per satellite (:func:`write_oem_files`).
+OBJECT_NAME, OBJECT_ID and TIME_SYSTEM and follow each other in time.
+:func:`tqdyn.readers.oem.read_oem` reads them back as one trajectory when
+each starts where the previous one stops (same centre and frame, states
+agreeing there: :func:`tqdyn.astro.oem_states.require_continuous`), else
+:func:`tqdyn.readers.oem.read_oem_segments` one by one.  A constellation is
+written one file per satellite (:func:`write_oem_files`).
 
 Writing is atomic: a hidden temporary file in the destination directory is
 renamed into place when complete; on any error it is removed and an existing
@@ -48,7 +52,8 @@ import numpy as np
 
 from .._version import __version__
 
-from ..readers.oem import GEOCENTRIC, HELIOCENTRIC, INTERPOLATIONS, REF_FRAMES, TIME_SYSTEMS
+from ..astro.oem_states import GEOCENTRIC, HELIOCENTRIC, INTERPOLATIONS
+from ..readers.oem import REF_FRAMES, TIME_SYSTEMS
 from . import trajectory as _io
 from .atomic import replacing
 
@@ -202,7 +207,7 @@ def _check_single_object(parts: list[dict]) -> None:
             if meta[key] != first[key]:
                 raise ValueError(f"segments[{k}]: {key} = {meta[key]!r} differs from segments[0]'s {first[key]!r}; "
                                  "an OEM holds a single object in one time system (CCSDS 502.0-B-2, 5.1.3): "
-                                 "write one file per object with write_oem_files()")
+                                 "write one file per object")
         a1, a2, _, _ = part["span"]
         _, _, b1, b2 = parts[k - 1]["span"]
         if ((a1 - b1) + (a2 - b2)) < 0:

@@ -6,7 +6,7 @@ Gravity fields (:mod:`.gravity_fields`: ICGEM, SHADR), FES2004 ocean tides
 EOP 14 / 20 C04 series (:mod:`.eop_c04`), finals2000A (:mod:`.eop_finals`), the
 leap-second table (:mod:`.leap_seconds`; these three from the
 ``astropy-iers-data`` package), NAIF kernels (:mod:`.naif`, :mod:`.pck`), CCSDS orbit ephemeris messages
-(:mod:`.oem`: OEM files, their interpolation, EME2000 -> ICRF and TCB -> TDB),
+(:mod:`.oem`: OEM files as arrays and segments; their states are :mod:`tqdyn.astro.oem_states`),
 the Doodson notation (:mod:`.doodson`) and the shipped data (:mod:`.files`).
 This layer imports nothing of tqdyn but :mod:`tqdyn.astro.constants`.
 """

@@ -1,11 +1,24 @@
-"""Reader of CCSDS Orbit Ephemeris Messages (OEM 1.0 / 2.0, KVN or XML) and
-their interpolation (CCSDS 502.0-B-2, "Orbit Data Messages", section 5).
+"""Reader of CCSDS Orbit Ephemeris Messages (OEM 1.0 / 2.0, KVN or XML):
+text -> arrays in SI units, segments and metadata (CCSDS 502.0-B-2, "Orbit
+Data Messages", section 5).  Nothing else: the interpolation of the states,
+the continuity of several segments, the EME2000 frame bias, TCB -> TDB and
+tqdyn's heliocentric / geocentric systems are :mod:`tqdyn.astro.oem_states`.
 
 Parsing is done by the PyPI package ``oem`` (``OrbitEphemerisMessage.open``
 checks the file against the standard; ``oem.parsers`` gives the text of
-every field); this module turns one ephemeris segment into arrays in SI
-units, interpolates them as the file says (:func:`states_at`) and converts
-them to tqdyn's systems (:func:`to_heliocentric`, :func:`to_geocentric`).
+every field); this module turns the ephemeris segments into arrays.
+:func:`read_oem_segments` gives every segment as it is; :func:`read_oem`
+gives the file as one :class:`OemTrajectory`: its only segment, or its
+segments joined (every record, in file order, with :class:`SegmentSpan`
+saying which rows are which segment) when they can be one trajectory.  A
+valid OEM already holds one object (OBJECT_NAME, OBJECT_ID) in one
+TIME_SYSTEM, with the segments' usable spans (USEABLE_START_TIME ..
+USEABLE_STOP_TIME, else their records) in time order and not overlapping --
+their records may overlap outside them (CCSDS 502.0-B-2; the ``oem``
+package checks it, this module first, for messages naming the segments);
+joined, they must also share CENTER_NAME and REF_FRAME and leave no gap:
+each starts where the previous one stops.  Whether the states agree there
+needs the interpolation, hence :func:`tqdyn.astro.oem_states.require_continuous`.
 
 Epochs: kept as two-part Julian dates (jd1, jd2) [d] in the file's
 TIME_SYSTEM, converted from the epoch *text* with exact decimal arithmetic:
@@ -19,26 +32,20 @@ puts the last record of ESA's LISA files, 1.1e-7 s after the truncated
 STOP_TIME, outside the segment: this module uses the full-precision text.
 
 Frames and time systems accepted: REF_FRAME EME2000 (J2000 mean equator and
-equinox), ICRF, GCRF; TIME_SYSTEM TDB, TCB, TT.  EME2000 -> ICRF axes: the
-IAU 2006 frame bias, r_ICRS = B^T r_EME2000 with B = ``erfa.bp06(...)[0]``
-(the bias matrix rb: ICRS -> mean J2000; a rotation by 23.1 mas, i.e. up
-to 16.8 km at 1 au).  TCB -> TDB (IAU 2006 Resolution B3):
-TDB = TCB - L_B (JD_TCB - T0) 86400 s + TDB0, T0 = 2443144.5003725,
-TDB0 = -6.55e-5 s.  ESA's TCB LISA files (``data/esa-lisa-orbits/tcb``) carry
-the same numbers as their TDB files, only the time tags differ: their
-coordinates are TDB-compatible (not scaled by 1 + L_B), which is the default
-of :func:`to_heliocentric` (``tcb_scaled_coordinates=False``).
+equinox), ICRF, GCRF; TIME_SYSTEM TDB, TCB, TT.
 
 Errors: one-line ``ValueError`` messages naming the file, the field and the
 value (malformed file, unsupported frame or time system, non-monotonic
-epochs, epoch outside the span); no exception of the ``oem`` package leaks.
-This layer imports nothing of tqdyn but :mod:`tqdyn.astro.constants`.
+epochs, segments that cannot be one trajectory); no exception of the ``oem``
+package leaks, and no message names a Python function.  This layer imports
+nothing of tqdyn but :mod:`tqdyn.astro.constants`.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import os
 import re
 import warnings
@@ -47,62 +54,84 @@ from fractions import Fraction
 import erfa
 import numpy as np
 
-from ..astro.constants import DAY_S, L_B
+from ..astro.constants import DAY_S
 
 __all__ = [
-    "GEOCENTRIC",
-    "HELIOCENTRIC",
-    "INTERPOLATIONS",
+    "JOIN_RULE",
     "REF_FRAMES",
-    "TCB_T0_JD",
-    "TDB0_S",
     "TIME_SYSTEMS",
     "OemTrajectory",
+    "SegmentSpan",
+    "epoch_text",
     "esa_lisa_orbit_files",
-    "frame_bias_matrix",
     "read_oem",
     "read_oem_segments",
     "require_center",
-    "states_at",
-    "tcb_to_tdb",
-    "to_geocentric",
-    "to_heliocentric",
 ]
 
 REF_FRAMES = ("EME2000", "ICRF", "GCRF")
-"""REF_FRAME values read (EME2000 is rotated to ICRF / GCRF axes by the frame bias)."""
+"""REF_FRAME values read (EME2000: see :func:`tqdyn.astro.oem_states.to_heliocentric`)."""
 TIME_SYSTEMS = ("TDB", "TCB", "TT")
 """TIME_SYSTEM values read."""
-INTERPOLATIONS = ("HERMITE", "LAGRANGE", "LINEAR")
-"""INTERPOLATION methods that :func:`states_at` implements."""
-
-HELIOCENTRIC = ("SUN", "ICRF", "TDB")
-"""(CENTER_NAME, REF_FRAME, TIME_SYSTEM) of tqdyn's heliocentric system: Sun-centred, ICRF axes, TDB."""
-GEOCENTRIC = ("EARTH", "GCRF", "TT")
-"""(CENTER_NAME, REF_FRAME, TIME_SYSTEM) of tqdyn's geocentric system: the GCRS (ICRF axes), TT."""
-
-#: T0 of IAU 2006 Resolution B3: 1977-01-01T00:00:32.184 TAI as a JD in TCB (and TDB, TT) [d].
-TCB_T0_JD = 2443144.5003725
-#: TDB0 of IAU 2006 Resolution B3 [s]: TDB = TCB - L_B (JD_TCB - T0) 86400 + TDB0.
-TDB0_S = -6.55e-5
 
 _DAY = float(DAY_S)
 _EPOCH = re.compile(r"^(\d{4})-(?:(\d{2})-(\d{2})|(\d{3}))T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
 _KM = 1000.0
 
 
+@dataclasses.dataclass(frozen=True)
+class SegmentSpan:
+    """One segment of a joined multi-segment :class:`OemTrajectory`.
+
+    rows : (first, end) -- its records are rows first .. end - 1 of the
+    trajectory's arrays (end exclusive); start, stop : (jd1, jd2) [d] -- its
+    usable span (USEABLE_START/STOP_TIME if given, else its first and last
+    records; a stop from which the next segment's start differs by no more
+    than half a unit of the two epochs' last printed decimal -- the same
+    epoch written with other digits -- is moved to that start),
+    in the trajectory's ``time_system``; start_text, stop_text :
+    str -- the same two epochs as the file writes them, with the file's
+    TIME_SYSTEM (e.g. ``"2048-03-04T23:11:53.47537616 TDB"``: for messages,
+    unchanged by time-scale conversions); interpolation, interpolation_degree
+    -- its INTERPOLATION (upper case) and INTERPOLATION_DEGREE, or None;
+    r_unit [m], v_unit [m/s] -- one unit of the last digit the file prints
+    for its positions and velocities (the largest over its records: the
+    digits' rounding is at most half of it per component).
+    """
+
+    rows: tuple[int, int]
+    start: tuple[float, float]
+    stop: tuple[float, float]
+    start_text: str
+    stop_text: str
+    interpolation: str | None
+    interpolation_degree: int | None
+    r_unit: float
+    v_unit: float
+
+    @property
+    def label(self) -> str:
+        """``"start .. stop TS"`` as in the file (for messages)."""
+        return _label((self.start_text, self.stop_text))
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class OemTrajectory:
-    """One ephemeris segment of an OEM file, in SI units.
+    """The states of an OEM file (one segment, or several joined), in SI units.
 
     source : str -- the file (for messages); object_name, object_id,
     center_name, ref_frame, time_system : str -- the metadata (upper case for
     the last three); jd1, jd2 : (N,) float64 -- epochs, two-part JD [d] in
-    ``time_system`` (strictly increasing); r : (N, 3) [m], v : (N, 3) [m/s],
-    a : (N, 3) [m/s^2] or None -- the states; interpolation : str or None and
-    interpolation_degree : int or None -- as the file says; start, stop :
+    ``time_system`` (strictly increasing within each segment); r : (N, 3)
+    [m], v : (N, 3) [m/s], a : (N, 3) [m/s^2] or None (None also when a
+    segment has none) -- the states; interpolation : str or None and
+    interpolation_degree : int or None -- as the file says (a joined file:
+    the segments' common value, None if they differ); start, stop :
     (jd1, jd2) -- the usable span (USEABLE_START/STOP_TIME if given, else the
-    first and last records); header : dict of the header's text fields.
+    first and last records; a joined file: its segments' union); header :
+    dict of the header's text fields; segments : () for one segment (the
+    whole arrays), else one :class:`SegmentSpan` per segment of the file, in
+    file order (:func:`read_oem`).
     """
 
     source: str
@@ -121,6 +150,7 @@ class OemTrajectory:
     start: tuple[float, float]
     stop: tuple[float, float]
     header: dict = dataclasses.field(default_factory=dict)
+    segments: tuple[SegmentSpan, ...] = ()
 
     def __len__(self) -> int:
         return int(self.jd1.shape[0])
@@ -177,7 +207,9 @@ def _dsec(a1, a2, b1, b2):
     return ((a1 - b1) + (a2 - b2)) * _DAY
 
 
-def _jd_text(jd1, jd2) -> str:
+def epoch_text(jd1, jd2) -> str:
+    """A two-part JD [d] as a CCSDS epoch text with 9 decimals (1 ns), in the
+    time scale of the JD (for messages)."""
     iy, im, iday, ihmsf = erfa.d2dtf("TT", 9, jd1, jd2)
     h, mi, s, f = (int(ihmsf[key]) for key in "hmsf")
     return f"{int(iy):04d}-{int(im):02d}-{int(iday):02d}T{h:02d}:{mi:02d}:{s:02d}.{f:09d}"
@@ -246,25 +278,45 @@ def _metadata(src: str, k: int, nseg: int, meta: dict, rows) -> dict:
             raise ValueError(f"{where}: INTERPOLATION_DEGREE = {degree!r} is not an integer") from None
     start = (float(jd1[0]), float(jd2[0]))
     stop = (float(jd1[-1]), float(jd2[-1]))
+    texts = [str(rows[0][0]).strip(), str(rows[-1][0]).strip()]
     for key in ("USEABLE_START_TIME", "USEABLE_STOP_TIME"):
         val = field(key, required=False)
         if val is not None:
             u = _epoch_jd(val, where, key)
-            if key == "USEABLE_START_TIME":
-                start = u if _dsec(*u, *start) > 0 else start
-            else:
-                stop = u if _dsec(*u, *stop) < 0 else stop
+            if key == "USEABLE_START_TIME" and _dsec(*u, *start) > 0:
+                start, texts[0] = u, val
+            elif key == "USEABLE_STOP_TIME" and _dsec(*u, *stop) < 0:
+                stop, texts[1] = u, val
     if not _dsec(*stop, *start) >= 0:
         raise ValueError(f"{where}: USEABLE_START_TIME .. USEABLE_STOP_TIME leave no usable span")
     return dict(where=where, rows=rows, source=src, object_name=field("OBJECT_NAME"), object_id=field("OBJECT_ID"),
                 center_name=field("CENTER_NAME").upper(), ref_frame=frame, time_system=tsys, jd1=jd1, jd2=jd2,
                 interpolation=interp.upper() if interp else None, interpolation_degree=degree,
-                start=start, stop=stop)
+                start=start, stop=stop, texts=(f"{texts[0]} {tsys}", f"{texts[1]} {tsys}"))
 
 
-def _segment(md: dict, states, header: dict) -> OemTrajectory:
+def _significant_digits(x: float) -> int:
+    """Significant digits of the shortest decimal that gives the float ``x`` back (trailing zeros dropped)."""
+    return len(repr(x).split("e")[0].replace(".", "").lstrip("-0").rstrip("0"))
+
+
+def _last_digit_unit(x: np.ndarray) -> float:
+    """One unit of the last digit printed for the values ``x`` (parsed from the text, any shape), in
+    their unit: 10**(e - S + 1), e the decimal exponent of the largest |x|, S the most significant
+    digits of any value.  Exact for fixed decimals ("%.6f": 1e-6); for a fixed number of significant
+    digits ("%.15e") the unit of the largest value, the coarsest; 0 if every value is 0."""
+    mag = np.abs(np.asarray(x, dtype=np.float64)).ravel()
+    mag = mag[mag > 0]
+    if not mag.size:
+        return 0.0
+    digits = max(_significant_digits(float(m)) for m in mag.tolist())
+    return 10.0 ** (math.floor(math.log10(float(mag.max()))) - digits + 1)
+
+
+def _segment(md: dict, states, header: dict) -> tuple[OemTrajectory, dict]:
+    """One segment as an :class:`OemTrajectory` (SI), and what joining segments needs (texts, digits)."""
     md = dict(md)
-    where, rows, jd1 = md.pop("where"), md.pop("rows"), md["jd1"]
+    where, rows, jd1, texts = md.pop("where"), md.pop("rows"), md["jd1"], md.pop("texts")
     vals = np.array([s.vector for s in states], dtype=np.float64)
     if vals.shape[0] != jd1.shape[0] or vals.shape[1] not in (6, 9):
         raise ValueError(f"{where}: the oem package read {vals.shape[0]} states of {vals.shape[1:]} values, "
@@ -272,19 +324,16 @@ def _segment(md: dict, states, header: dict) -> OemTrajectory:
     if not np.all(np.isfinite(vals)):
         i = int(np.argwhere(~np.isfinite(vals))[0, 0])
         raise ValueError(f"{where}: record {i + 1} (epoch {str(rows[i][0])!r}) has a non-finite value")
+    extra = dict(texts=texts, r_unit=_last_digit_unit(vals[:, 0:3]) * _KM, v_unit=_last_digit_unit(vals[:, 3:6]) * _KM)
     vals = vals * _KM
-    return OemTrajectory(r=np.ascontiguousarray(vals[:, 0:3]), v=np.ascontiguousarray(vals[:, 3:6]),
+    traj = OemTrajectory(r=np.ascontiguousarray(vals[:, 0:3]), v=np.ascontiguousarray(vals[:, 3:6]),
                          a=np.ascontiguousarray(vals[:, 6:9]) if vals.shape[1] == 9 else None,
                          header=dict(header), **md)
+    return traj, extra
 
 
-def read_oem_segments(path) -> list[OemTrajectory]:
-    """Every ephemeris segment of the OEM file ``path`` (KVN or XML, optionally
-    gzip/bz2/xz-compressed), as :class:`OemTrajectory` in SI units.
-
-    Raises ``FileNotFoundError`` (no such file) or a one-line ``ValueError``
-    naming the file (and the segment, the field and its value).
-    """
+def _read(path) -> list[tuple[OemTrajectory, dict]]:
+    """Every segment of the file, with its texts and digits (:func:`_segment`)."""
     src = os.fspath(path)
     if not os.path.isfile(src):
         raise FileNotFoundError(f"OEM file not found: {src}")
@@ -304,6 +353,7 @@ def read_oem_segments(path) -> list[OemTrajectory]:
             raise ValueError(f"{src}: segments of {len(names)} objects (OBJECT_NAME = "
                              f"{', '.join(repr(n) for n in names)}); an OEM holds a single object "
                              "(CCSDS 502.0-B-2, 5.1.3)")
+        _check_order(src, metas)
         try:
             message = _open(src)
             segments = list(message.segments)
@@ -322,23 +372,112 @@ def read_oem_segments(path) -> list[OemTrajectory]:
     return out
 
 
+def _same_epoch(a: str, b: str) -> float:
+    """How far apart [s] two epoch texts may be and still write one epoch: half a unit of the coarser last
+    decimal (``"...:53.47537616 TDB"``: 1e-8 s, ``"...:53.475376 TCB"``: 1e-6 s)."""
+    def unit(text):
+        sec = text.split()[0].rsplit(":", 1)[-1]
+        return 10.0 ** -(len(sec.split(".")[1]) if "." in sec else 0)
+    return 0.5 * max(unit(a), unit(b))
+
+
+def _label(texts) -> str:
+    """``"start .. stop TS"`` from the (start, stop) texts with their time system."""
+    return f"{texts[0].rsplit(' ', 1)[0]} .. {texts[1]}"
+
+
+def _check_order(src: str, metas: list[dict]) -> None:
+    """What CCSDS 502.0-B-2 asks of the segments of one OEM (and the ``oem`` package checks): one OBJECT_ID
+    and TIME_SYSTEM, usable spans in time order, not overlapping; one line naming both segments' spans."""
+    for k in range(1, len(metas)):
+        a, b = metas[k - 1], metas[k]
+        where = f"{src}: segments {k} ({_label(a['texts'])}) and {k + 1} ({_label(b['texts'])})"
+        for key in ("object_id", "time_system"):
+            if a[key] != b[key]:
+                raise ValueError(f"{where} differ in {key.upper()} ({a[key]!r}, {b[key]!r}); allowed: one object in "
+                                 "one time system per file (CCSDS 502.0-B-2, 5.1.3)")
+        if _dsec(*b["start"], *a["stop"]) < -_same_epoch(a["texts"][1], b["texts"][0]):
+            raise ValueError(f"{where} overlap: segment {k + 1} starts before segment {k} stops; allowed: usable "
+                             "spans in time order, not overlapping (records may overlap outside "
+                             "USEABLE_START_TIME .. USEABLE_STOP_TIME; CCSDS 502.0-B-2)")
+
+
+def read_oem_segments(path) -> list[OemTrajectory]:
+    """Every ephemeris segment of the OEM file ``path`` (KVN or XML, optionally
+    gzip/bz2/xz-compressed), as :class:`OemTrajectory` in SI units, each on
+    its own (``segments == ()``), in file order, whether or not they could be
+    one trajectory.
+
+    Raises ``FileNotFoundError`` (no such file) or a one-line ``ValueError``
+    naming the file (and the segment, the field and its value).
+    """
+    return [traj for traj, _ in _read(path)]
+
+
+#: What :func:`read_oem` joins (the "allowed" of its messages).
+JOIN_RULE = ("segments of one CENTER_NAME and REF_FRAME, each starting where the previous one stops (records "
+             "may overlap outside USEABLE_START_TIME .. USEABLE_STOP_TIME), whose states agree there")
+
+
+def _join(src: str, parts: list[tuple[OemTrajectory, dict]]) -> OemTrajectory:
+    """The segments as one trajectory (every record, file order), or a one-line ValueError.  A segment
+    that starts before or after the previous one stops by no more than half a unit of the coarser of
+    the two epochs' last printed decimals (the same epoch, written with other digits) starts where it
+    stops (the previous segment's stop moves there)."""
+    segs = [t for t, _ in parts]
+    spans, row = [], 0
+    for t, x in parts:
+        spans.append(SegmentSpan(rows=(row, row + len(t)), start=t.start, stop=t.stop, start_text=x["texts"][0],
+                                 stop_text=x["texts"][1], interpolation=t.interpolation,
+                                 interpolation_degree=t.interpolation_degree, r_unit=x["r_unit"], v_unit=x["v_unit"]))
+        row += len(t)
+    for k in range(1, len(segs)):
+        a, b = spans[k - 1], spans[k]
+        why = None
+        for key in ("center_name", "ref_frame"):
+            if getattr(segs[k], key) != getattr(segs[k - 1], key):
+                why = f"{key.upper()} = {getattr(segs[k - 1], key)!r} and {getattr(segs[k], key)!r} differ"
+        gap = _dsec(*b.start, *a.stop)  # >= -_same_epoch: _check_order
+        if why is None and gap > _same_epoch(a.stop_text, b.start_text):
+            why = f"a gap of {gap:.9g} s ({gap / _DAY:.6g} d) between them"
+        if why is not None:
+            raise ValueError(f"{src}: segments {k} ({a.label}) and {k + 1} ({b.label}) are not continuous: {why}; "
+                             f"allowed: {JOIN_RULE}")
+        if gap != 0:
+            spans[k - 1] = dataclasses.replace(a, stop=b.start)
+    first, last = segs[0], segs[-1]
+    methods = {(t.interpolation, t.interpolation_degree) for t in segs}
+    interp, degree = methods.pop() if len(methods) == 1 else (None, None)
+    cat = np.concatenate
+    return OemTrajectory(source=src, object_name=first.object_name, object_id=first.object_id,
+                         center_name=first.center_name, ref_frame=first.ref_frame, time_system=first.time_system,
+                         jd1=cat([t.jd1 for t in segs]), jd2=cat([t.jd2 for t in segs]), r=cat([t.r for t in segs]),
+                         v=cat([t.v for t in segs]),
+                         a=None if any(t.a is None for t in segs) else cat([t.a for t in segs]),
+                         interpolation=interp, interpolation_degree=degree, start=first.start, stop=last.stop,
+                         header=dict(first.header), segments=tuple(spans))
+
+
 def read_oem(path, object_name: str | None = None) -> OemTrajectory:
-    """The ephemeris segment of the OEM file ``path``: the only one, or (a
-    file of several segments) the one of ``object_name``, which must be
-    unique.  See :func:`read_oem_segments` for the errors."""
-    every = read_oem_segments(path)
-    segs = every
-    if object_name is not None:
-        segs = [s for s in every if s.object_name == object_name]
-        if not segs:
-            names = sorted({s.object_name for s in every})
-            raise ValueError(f"{os.fspath(path)}: OBJECT_NAME = {object_name!r} not in the file "
-                             f"(it has: {', '.join(repr(n) for n in names)})")
-    if len(segs) != 1:
-        raise ValueError(f"{os.fspath(path)}: {len(segs)} ephemeris segments"
-                         + (f" of OBJECT_NAME = {object_name!r}" if object_name else "")
-                         + "; use read_oem_segments() to read them all")
-    return segs[0]
+    """The OEM file ``path`` as one trajectory: its only segment, or its
+    segments joined (:class:`SegmentSpan`; every record in file order) when
+    they can be one trajectory: one CENTER_NAME and REF_FRAME (one object
+    and time system, usable spans in order and not overlapping: any valid
+    OEM), each segment's usable span starting where the previous one stops
+    (to the digits of the two epochs: they may differ by half a unit of the
+    coarser last decimal).  The agreement of the states there needs the
+    interpolation (:func:`tqdyn.astro.oem_states.require_continuous`).
+    ``object_name``: the OBJECT_NAME required (an OEM holds one object).
+    Errors: see :func:`read_oem_segments`, and one line naming the file, the
+    two segments' spans (as the file writes them) and what is allowed.
+    """
+    parts = _read(path)
+    if object_name is not None and parts[0][0].object_name != object_name:
+        raise ValueError(f"{os.fspath(path)}: OBJECT_NAME = {object_name!r} not in the file "
+                         f"(it has: {parts[0][0].object_name!r})")
+    if len(parts) == 1:
+        return parts[0][0]
+    return _join(os.fspath(path), parts)
 
 
 def esa_lisa_orbit_files(time_system: str = "TDB") -> tuple[str, str, str]:
@@ -369,193 +508,3 @@ def require_center(traj: OemTrajectory, center: str = "SUN") -> OemTrajectory:
         raise ValueError(f"{traj.source}: CENTER_NAME = {traj.center_name!r}, but {center.upper()!r} is required "
                          f"here (object {traj.object_name!r})")
     return traj
-
-
-# ------------------------------------------------------------------ interpolation
-
-def _nodes(method: str, degree: int, where: str) -> int:
-    if method == "HERMITE":
-        if degree < 1 or degree % 2 == 0:
-            raise ValueError(f"{where}: INTERPOLATION_DEGREE = {degree} for HERMITE must be odd and >= 1 "
-                             "(n records with position and velocity give degree 2n - 1)")
-        return (degree + 1) // 2
-    if method == "LINEAR":
-        if degree not in (None, 1):
-            raise ValueError(f"{where}: INTERPOLATION_DEGREE = {degree} for LINEAR must be 1")
-        return 2
-    if degree < 1:
-        raise ValueError(f"{where}: INTERPOLATION_DEGREE = {degree} for LAGRANGE must be >= 1")
-    return degree + 1
-
-
-def _lagrange_basis(tau, d):
-    """l_i(t) and l_i'(t) for nodes t_i: tau (M, n) = t - t_i [s], d (M, n, n) = t_i - t_j."""
-    n = tau.shape[1]
-    l = np.ones_like(tau)
-    dl = np.zeros_like(tau)
-    for i in range(n):
-        others = [j for j in range(n) if j != i]
-        for j in others:
-            l[:, i] *= tau[:, j] / d[:, i, j]
-        for k in others:
-            term = 1.0 / d[:, i, k]
-            for j in others:
-                if j != k:
-                    term = term * tau[:, j] / d[:, i, j]
-            dl[:, i] += term
-    return l, dl
-
-
-def states_at(traj: OemTrajectory, jd1, jd2=0.0, *, method: str | None = None,
-              degree: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Interpolated position [m] and velocity [m/s] at the epochs jd1 + jd2
-    [d] (in ``traj.time_system``; arrays, broadcast to shape S) -> r, v of
-    shape S + (3,).
-
-    Method and degree: the file's INTERPOLATION / INTERPOLATION_DEGREE unless
-    given.  HERMITE of degree 2n - 1: the polynomial through the positions and
-    velocities of n records (degree 7: 4 records), velocity its derivative;
-    LAGRANGE of degree n - 1 (and LINEAR, n = 2): positions and velocities
-    interpolated separately through n records.  The records: n consecutive
-    ones with as many on each side of the epoch as possible (n // 2 at or
-    before it), shifted inwards at the ends; at a record's epoch the record
-    itself is returned.  Epochs outside the usable span (``traj.start``
-    .. ``traj.stop``, ends included): one-line ValueError naming the file.
-    """
-    where = traj.source
-    m = (method or traj.interpolation or "").upper()
-    if not m:
-        raise ValueError(f"{where}: the file gives no INTERPOLATION; pass method= "
-                         f"(allowed: {', '.join(INTERPOLATIONS)})")
-    if m not in INTERPOLATIONS:
-        raise ValueError(f"{where}: INTERPOLATION = {m!r} is not supported (allowed: {', '.join(INTERPOLATIONS)})")
-    deg = degree if degree is not None else (traj.interpolation_degree if method is None or m == traj.interpolation
-                                             else None)
-    if deg is None:
-        if m != "LINEAR":
-            raise ValueError(f"{where}: no INTERPOLATION_DEGREE for {m}; pass degree=")
-        deg = 1
-    n = _nodes(m, int(deg), where)
-    N = len(traj)
-    if N < n:
-        raise ValueError(f"{where}: {m} of degree {deg} needs {n} records, the segment has {N}")
-    q1, q2 = np.broadcast_arrays(np.asarray(jd1, dtype=np.float64), np.asarray(jd2, dtype=np.float64))
-    shape = q1.shape
-    q1, q2 = q1.ravel(), q2.ravel()
-    if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(q2))):
-        raise ValueError(f"{where}: epoch must be finite")
-    before = _dsec(q1, q2, *traj.start) < 0
-    after = _dsec(q1, q2, *traj.stop) > 0
-    if np.any(before | after):
-        i = int(np.flatnonzero(before | after)[0])
-        raise ValueError(f"{where}: epoch {_jd_text(q1[i], q2[i])} {traj.time_system} "
-                         f"(JD {float(q1[i])!r} + {float(q2[i])!r}) is outside the span "
-                         f"{_jd_text(*traj.start)} .. {_jd_text(*traj.stop)} {traj.time_system} of the file")
-    # window: records k - n//2 .. k - n//2 + n - 1, k = records at or before the epoch
-    t_rec = _dsec(traj.jd1, traj.jd2, traj.jd1[0], traj.jd2[0])
-    t_q = _dsec(q1, q2, traj.jd1[0], traj.jd2[0])
-    k = np.searchsorted(t_rec, t_q, side="right")
-    first = np.clip(k - n // 2, 0, N - n)
-    idx = first[:, None] + np.arange(n)[None, :]                     # (M, n)
-    n1, n2 = traj.jd1[idx], traj.jd2[idx]
-    tau = _dsec(q1[:, None], q2[:, None], n1, n2)                    # t - t_i [s]
-    d = _dsec(n1[:, :, None], n2[:, :, None], n1[:, None, :], n2[:, None, :])  # t_i - t_j [s]
-    np.einsum("mii->mi", d)[...] = 1.0                               # unused diagonal
-    x, xd = traj.r[idx], traj.v[idx]                                 # (M, n, 3)
-    l, dl = _lagrange_basis(tau, d)
-    if m == "HERMITE":
-        inv = 1.0 / d
-        np.einsum("mii->mi", inv)[...] = 0.0
-        c = inv.sum(axis=2)                                          # l_i'(t_i)
-        g = 1.0 - 2.0 * tau * c
-        H = g * l * l
-        K = tau * l * l
-        dH = -2.0 * c * l * l + 2.0 * g * l * dl
-        dK = l * l + 2.0 * tau * l * dl
-        r = np.einsum("mi,mik->mk", H, x) + np.einsum("mi,mik->mk", K, xd)
-        v = np.einsum("mi,mik->mk", dH, x) + np.einsum("mi,mik->mk", dK, xd)
-    else:
-        r = np.einsum("mi,mik->mk", l, x)
-        v = np.einsum("mi,mik->mk", l, xd)
-    hit_m, hit_i = np.nonzero(tau == 0.0)
-    r[hit_m] = x[hit_m, hit_i]
-    v[hit_m] = xd[hit_m, hit_i]
-    return r.reshape(shape + (3,)), v.reshape(shape + (3,))
-
-
-# ------------------------------------------------------------------ conversions
-
-@functools.lru_cache(maxsize=1)
-def frame_bias_matrix() -> np.ndarray:
-    """The IAU 2006 frame-bias matrix B (ICRS -> mean equator and equinox of
-    J2000, "EME2000"): r_EME2000 = B r_ICRS, r_ICRS = B^T r_EME2000.
-    ``erfa.bp06(2451545, 0)[0]`` (the bias does not depend on the date)."""
-    rb = np.array(erfa.bp06(2451545.0, 0.0)[0], dtype=np.float64)
-    rb.setflags(write=False)
-    return rb
-
-
-def tcb_to_tdb(jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
-    """TDB (jd1, jd2) of TCB instants (jd1, jd2) [d] (IAU 2006 Resolution B3):
-    TDB = TCB - L_B ((jd1 - T0) + jd2) 86400 s + TDB0; jd1 kept, the
-    correction (~ -30 s in 2037) added to jd2 (error ~1e-17 d)."""
-    jd1 = np.asarray(jd1, dtype=np.float64)
-    jd2 = np.asarray(jd2, dtype=np.float64)
-    corr = (-L_B * ((jd1 - TCB_T0_JD) + jd2) * _DAY + TDB0_S) / _DAY
-    return jd1.copy(), jd2 + corr
-
-
-def _to_icrf_axes(traj: OemTrajectory, name: str, frame_bias: bool = True) -> OemTrajectory:
-    if traj.ref_frame == "EME2000" and frame_bias:
-        bt = frame_bias_matrix().T
-        return traj.replace(r=traj.r @ bt.T, v=traj.v @ bt.T, a=None if traj.a is None else traj.a @ bt.T,
-                            ref_frame=name)
-    return traj.replace(ref_frame=name)
-
-
-def to_heliocentric(traj: OemTrajectory, *, tcb_scaled_coordinates: bool = False,
-                    eme2000_frame_bias: bool = True) -> OemTrajectory:
-    """``traj`` in tqdyn's heliocentric system: CENTER_NAME SUN, ICRF axes, TDB.
-
-    REF_FRAME EME2000 is rotated by the frame bias (ICRF kept) -- unless
-    ``eme2000_frame_bias`` is False: then EME2000 is taken as a label of
-    ICRF axes (ESA's CReMA 2.0 LISA files, whose "EME2000" states fit
-    ICRF-axes dynamics: tests/test_esa_lisa.py, docs/lisa-orbits.md); TIME_SYSTEM
-    TCB tags become TDB (:func:`tcb_to_tdb`; TDB kept).  With
-    ``tcb_scaled_coordinates`` the file's coordinates are taken as
-    TCB-compatible and scaled to TDB-compatible ones: r (1 - L_B), a / (1 - L_B)
-    (v unchanged); ESA's TCB LISA files are not scaled (their states equal
-    those of the TDB files), hence the default False.  Raises ValueError
-    (naming the file) for another centre, GCRF or TT.
-    """
-    require_center(traj, "SUN")
-    if traj.ref_frame not in ("EME2000", "ICRF"):
-        raise ValueError(f"{traj.source}: REF_FRAME = {traj.ref_frame!r} is not heliocentric "
-                         "(allowed here: EME2000, ICRF)")
-    if traj.time_system not in ("TDB", "TCB"):
-        raise ValueError(f"{traj.source}: TIME_SYSTEM = {traj.time_system!r} for a heliocentric trajectory "
-                         "(allowed here: TDB, TCB)")
-    out = _to_icrf_axes(traj, "ICRF", eme2000_frame_bias)
-    if traj.time_system == "TCB":
-        j1, j2 = tcb_to_tdb(traj.jd1, traj.jd2)
-        (s1,), (s2,) = tcb_to_tdb([traj.start[0]], [traj.start[1]])
-        (e1,), (e2,) = tcb_to_tdb([traj.stop[0]], [traj.stop[1]])
-        out = out.replace(jd1=j1, jd2=j2, start=(float(s1), float(s2)), stop=(float(e1), float(e2)),
-                          time_system="TDB")
-        if tcb_scaled_coordinates:
-            out = out.replace(r=out.r * (1.0 - L_B), a=None if out.a is None else out.a / (1.0 - L_B))
-    return out
-
-
-def to_geocentric(traj: OemTrajectory) -> OemTrajectory:
-    """``traj`` in tqdyn's geocentric system: CENTER_NAME EARTH, GCRF (ICRF
-    axes; EME2000 rotated by the frame bias), TT.  Raises ValueError (naming
-    the file) for another centre, ICRF or a time system other than TT."""
-    require_center(traj, "EARTH")
-    if traj.ref_frame not in ("EME2000", "GCRF"):
-        raise ValueError(f"{traj.source}: REF_FRAME = {traj.ref_frame!r} is not geocentric "
-                         "(allowed here: EME2000, GCRF)")
-    if traj.time_system != "TT":
-        raise ValueError(f"{traj.source}: TIME_SYSTEM = {traj.time_system!r} for a geocentric trajectory "
-                         "(allowed here: TT)")
-    return _to_icrf_axes(traj, "GCRF")

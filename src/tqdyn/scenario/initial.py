@@ -181,7 +181,7 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str,
             states = list(zip(design.r, design.v))
             rv = [(_decimal_vector(r), _decimal_vector(v)) for r, v in states]
     else:
-        from ..readers.oem import states_at
+        from ..astro.oem_states import states_at
 
         rv = []
         for k, path in enumerate(initial.oem, start=1):
@@ -189,8 +189,7 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str,
                 r, v = states_at(_heliocentric_oem(path, initial.oem_eme2000), *epoch.tdb)
             except (OSError, ValueError) as exc:
                 raise ScenarioError(f"initial.oem.{k}", path, f"cannot give a state at {epoch.iso} ({exc})",
-                                    "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB) covering "
-                                    "the epoch") from None
+                                    f"{_OEM_ALLOWED} covering the epoch") from None
             rv.append((_decimal_vector(r), _decimal_vector(v)))
     names = list(initial.names) + [f"Sat{k}" for k in range(len(initial.names) + 1, len(rv) + 1)]
     if len(names) > len(rv):
@@ -208,8 +207,7 @@ def oem_first_common_epoch(paths, eme2000: str = "frame-bias") -> str:
             traj = _heliocentric_oem(path, eme2000)
             firsts.append((traj.start, _tdb_text(traj.start)))
         except (OSError, ValueError) as exc:
-            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
-                                "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
+            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})", _OEM_ALLOWED) from None
     return max(firsts, key=lambda x: x[0][0] + x[0][1])[1]
 
 
@@ -223,16 +221,20 @@ def oem_common_span(paths, eme2000: str = "frame-bias") -> tuple[str, str]:
             traj = _heliocentric_oem(path, eme2000)
             spans.append(((traj.start, _tdb_text(traj.start)), (traj.stop, _tdb_text(traj.stop))))
         except (OSError, ValueError) as exc:
-            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})",
-                                "a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB)") from None
+            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})", _OEM_ALLOWED) from None
     first = max((s[0] for s in spans), key=lambda x: x[0][0] + x[0][1])
     last = min((s[1] for s in spans), key=lambda x: x[0][0] + x[0][1])
     return f"{first[1]} TDB", f"{last[1]} TDB"
 
 
+#: What ``initial.oem`` reads (the "allowed" of its messages).
+_OEM_ALLOWED = ("a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB; several segments: continuous, "
+                "one starting where the previous one stops or inside it)")
+
+
 def _heliocentric_oem(path: str, eme2000: str = "frame-bias"):
-    """An OEM file's single segment as Sun-centred ICRF/TDB states
-    (:func:`tqdyn.readers.oem.to_heliocentric`; ``eme2000``: see
+    """An OEM file (its segment, or its continuous segments joined) as Sun-centred ICRF/TDB states
+    (:func:`tqdyn.astro.oem_states.to_heliocentric`; ``eme2000``: see
     :class:`InitialConfig`); ValueError naming the file.  Cached per file
     (absolute path, size, modification time) and reading: resolving one
     scenario reads its OEM files several times (epoch, span, states), a
@@ -247,7 +249,8 @@ def _heliocentric_oem(path: str, eme2000: str = "frame-bias"):
         key = (os.path.abspath(path), st.st_size, st.st_mtime_ns, eme2000)
     if key is not None and key in _OEM_CACHE:
         return _OEM_CACHE[key]
-    from ..readers.oem import read_oem, to_heliocentric
+    from ..astro.oem_states import to_heliocentric
+    from ..readers.oem import read_oem
 
     traj = to_heliocentric(read_oem(path), eme2000_frame_bias=eme2000 == "frame-bias")
     if key is not None:
