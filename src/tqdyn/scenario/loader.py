@@ -101,7 +101,7 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "forces": {"earth_monopole": _BOOL, "sun_monopole": _BOOL, "gm_earth": _NUM, "earth_degree": _INT, "earth_degree2_extended": _BOOL, "ephemeris": _STR,
                "third_bodies": _STRLIST, "third_bodies_extended": _STRLIST, "third_bodies_gcrs": _BOOL, "solid_tides": _BOOL, "ocean_tides_degree": _INT, "pole_tides": _BOOL,
                "atmospheric_tides": _BOOL, "moon_degree": _INT, "moon_libration": _STR, "sun_j2": _BOOL, "relativity": _BOOL,
-               "earth_field_indirect": _BOOL, "eop": _BOOL_OR_STR},
+               "earth_field_indirect": _BOOL, "eop": _BOOL_OR_STR, "relativity_model": _STR},
     "spacecraft": {"d_tm": _NUM, "d_p": _NUM, "tm_axis": _STR, "self_gravity": _ANY, "self_gravity_common": _ANY,
                    "self_gravity_center": _ANY, "self_gravity_center_span": _ANY, "architecture": _STR,
                    "dragfree": _STR, "tm_distance": _NUM, "housing_centers": _ANY, "pivots": _ANY,
