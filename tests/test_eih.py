@@ -31,7 +31,7 @@ from tqdyn.forces.eih import HeliocentricEIH
 from tqdyn.forces.eih_gcrs import GeocentricEIH, _fill_geocentric, geocentric_eih_accel
 from tqdyn.forces.model import ForceModel, build_force_model, gravity
 from tqdyn.numerics.dd import mp_from_dd
-from tqdyn.scenario import ScenarioError, load_scenario
+from tqdyn.scenario import ScenarioError, load_scenario, loads_scenario
 
 AU = 149597870700.0
 
@@ -288,6 +288,7 @@ def test_relativity_model_key():
     in the GCRS is one ScenarioError naming the key."""
     scen = load_scenario("tianqin-gravity", ["forces.relativity_model=eih"])
     assert scen.forces.relativity_model == "eih" and 'relativity_model = "eih"' in scen.to_toml()
+    assert loads_scenario(scen.to_toml()) == scen
     assert "relativity_model" not in load_scenario("tianqin-gravity").to_toml()
     for bad, words in ((["forces.relativity_model=eih2"], "is not a valid choice"),
                        (["forces.relativity_model=eih", 'forces.third_bodies=["sun"]'], "lacks ['moon']"),

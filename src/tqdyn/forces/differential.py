@@ -16,7 +16,8 @@ cancellation and at a fraction of the cost:
 * **point masses** -- the central monopole and every third body (Battin's
   geocentric form and the heliocentric one alike: the indirect term is the
   same at both points and drops out): the exact difference of GM D/|D|^3
-  between two points D and D + e (:func:`tqdyn.forces.third_body.pm_difference`), written so that
+  between two points D and D + e
+  (:func:`tqdyn.forces.third_body.pm_difference`), written so that
   nothing cancels -- relative error <= ~1e-15 of the result (1e-25 m/s^2
   for the monopole's 8e-11 at TianQin, measured against mpmath), and exact
   to all orders in |e| / |D| (the monopole's second-order term is ~5e-19
@@ -33,8 +34,8 @@ cancellation and at a fraction of the cost:
   the Sun's Schwarzschild or EIH term 1.8e-10 at 1 au) bound the
   round-off of the difference by ~3e-26 m/s^2; the GCRS EIH terms
   (2e-13 m/s^2) sum float64 pieces of up to 1.2e-9 m/s^2 and barycentric
-  velocities of 30 km/s, ~1e-24 m/s^2 of round-off.  The Earth field at the satellite is the value
-  the satellite's own evaluation already formed
+  velocities of 30 km/s, ~1e-24 m/s^2 of round-off.  The Earth field at
+  the satellite is the value the satellite's own evaluation already formed
   (:func:`tqdyn.forces.model.gravity_split`), and the Moon's field is
   truncated at degree :data:`MOON_DEGREE_DG` = 4: its degree-n part of dg is
   ~(n + 2) |a_n| |d| / D; at the Moon's perigee distance from a TianQin

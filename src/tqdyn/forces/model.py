@@ -19,7 +19,10 @@ with the same interface:
 
 The compiled side is :func:`gravity`: a fixed list of slots, one per term
 kind, each switched on by the ``layout`` table built here.  Adding a term
-means adding its module, a slot constant and one branch in ``gravity``.
+means adding its module, a slot constant and one branch in
+:func:`gravity_split` or, for a float64 term evaluated at the point alone,
+in :func:`float64_terms` (the one list of those, which the test masses'
+differential gravity differences too).
 """
 
 from __future__ import annotations
