@@ -27,7 +27,7 @@ W = W_E + W_tidal, W^a = W^a_E + W^a_tidal + W^a_iner, a satellite's 1PN acceler
   and the geodetic precession by the Moon and the planets, which eq. (10.12) leaves out: estimated
   3 v_rel (GM_M/D^2) V/c^2 ~ 2e-15 m/s^2 for the Moon (v_rel = 1 km/s).
 
-Measured (tests/test_eih.py): their sum is 4e-14 .. 2.2e-13 m/s^2 at 1e5 km (random states, 2004 and
+Measured (tests/test_eih.py): their sum is 4.0e-14 .. 1.8e-13 m/s^2 at 1e5 km (random states, 2004 and
 2035; 1.4e-13 .. 1.8e-13 on TianQin's orbits over one orbit from 2004-06-06), nearly all of it the
 Sun's; the Moon's part 2.4e-15 .. 1.6e-14, the planets' ~1e-16 m/s^2.
 
@@ -70,7 +70,7 @@ float64 round-off is that of its largest pieces: the bracket's 2 b S / c^2 (1.2e
 Earth's EIH terms on the satellite, sums of barycentric velocities of 30 km/s (4e-10 m/s^2): ~1e-24
 m/s^2.  Its 1PN truncation -- terms O(c^-4), which the 1PN transformation leaves undetermined, e.g.
 3 b S^2/c^4 = 2.5e-17 m/s^2 -- separates it from the transformed EIH equations differentiated exactly:
-by 3e-17 .. 5e-17 m/s^2 (tests/test_eih.py).
+by 3.5e-17 .. 5.1e-17 m/s^2 (tests/test_eih.py).
 
 **Units.**  The dynamics are TT-compatible (positions and GMs of the model times K = (1 - L_G)/(1 -
 L_B)); this term is evaluated in TDB-compatible units at X/K (GMs divided by K), and the result
