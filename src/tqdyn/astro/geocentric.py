@@ -33,9 +33,10 @@ acts like moving each body to lambda X, lambda = K (1 + f U_sun/c^2), f = 1
 velocity terms: the Moon's 1.2e-5 m/s^2 change by 5.2e-8 .. 8.7e-8 of
 themselves (up to 8.1e-13 m/s^2) and the Sun's 6.0e-6 m/s^2 by 7.3e-8 (up to
 4.4e-13 m/s^2) (tests/test_geocentric.py).
-Not modelled: the 1PN corrections of the tidal field itself, of the same
-relative order (v^2/c^2 ~ 1e-8 of the tidal acceleration; IERS 2010 eq.
-10.12 leaves them out too), and O(c^-4).
+The 1PN corrections of the tidal field itself, of the same relative order
+(v^2/c^2 ~ 1e-8 of the tidal acceleration; IERS 2010 eq. 10.12 leaves them
+out too), are the force term :mod:`tqdyn.forces.eih_gcrs` (optional);
+O(c^-4) is not modelled.
 
 The other way, GCRS -> BCRS (the LISA export of geocentric runs):
 :func:`gcrs_to_bcrs_offsets` inverts the transformation to O(c^-2) and

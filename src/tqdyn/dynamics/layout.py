@@ -96,7 +96,9 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta
     relative to the central body, are 6 tdat columns each from
     ``tdat_offset``); j2k = 1.5 J2 GM R^2 [m^5/s^2] of the Earth (0 = absent);
     gm_relativity : GM [m^3/s^2] of the central body's Schwarzschild term
-    in the jerk model (0 = off; heliocentric runs with relativity);
+    in the jerk model (0 = off; heliocentric runs with relativity, also
+    with relativity_model = "eih", whose further terms, <= 1.1e-13 m/s^2,
+    have a jerk of ~1e-13 x the orbital rate 2e-7 rad/s ~ 2e-20 m/s^3);
     tdat_offset : column of the system's time-only inputs in tdat, -1 if none;
     centre_column : column in tdat of the magnitude [m/s^2] of the
     self-gravity toward the constellation centre (positive toward it), -1 if off;

@@ -16,7 +16,8 @@ cancellation and at a fraction of the cost:
 * **point masses** -- the central monopole and every third body (Battin's
   geocentric form and the heliocentric one alike: the indirect term is the
   same at both points and drops out): the exact difference of GM D/|D|^3
-  between two points D and D + e (:func:`pm_difference`), written so that
+  between two points D and D + e
+  (:func:`tqdyn.forces.third_body.pm_difference`), written so that
   nothing cancels -- relative error <= ~1e-15 of the result (1e-25 m/s^2
   for the monopole's 8e-11 at TianQin, measured against mpmath), and exact
   to all orders in |e| / |D| (the monopole's second-order term is ~5e-19
@@ -26,12 +27,15 @@ cancellation and at a fraction of the cost:
   r + d/2 applied to d (:func:`quadrupole_jacobian_product`).  The midpoint
   rule is exact to second order; its error is |d^3 a| |d|^3 / 24 with
   |d^3 a| ~ 120 |a_2| / r^3, i.e. 2e-32 m/s^2 at 1e8 m (|a_2| = 4.9e-7);
-* **every other term** (the Earth's degrees >= 3 with their tides, the
-  Moon's field, the Sun's J2, the central J2, relativity): float64 at both
+* **every other term** (the Earth's degrees >= 3 with their tides, and the
+  list of :func:`tqdyn.forces.model.float64_terms`: the Moon's field, the
+  Sun's J2, relativity, the central J2, the EIH terms): float64 at both
   points and subtracted.  Their magnitudes (<= 3e-10 m/s^2 at TianQin,
-  the Sun's Schwarzschild term 1.7e-10 at 1 au) bound the round-off of the
-  difference by ~3e-26 m/s^2.  The Earth field at the satellite is the value
-  the satellite's own evaluation already formed
+  the Sun's Schwarzschild or EIH term 1.8e-10 at 1 au) bound the
+  round-off of the difference by ~3e-26 m/s^2; the GCRS EIH terms
+  (2e-13 m/s^2) sum float64 pieces of up to 1.2e-9 m/s^2 and barycentric
+  velocities of 30 km/s, ~1e-24 m/s^2 of round-off.  The Earth field at
+  the satellite is the value the satellite's own evaluation already formed
   (:func:`tqdyn.forces.model.gravity_split`), and the Moon's field is
   truncated at degree :data:`MOON_DEGREE_DG` = 4: its degree-n part of dg is
   ~(n + 2) |a_n| |d| / D; at the Moon's perigee distance from a TianQin
@@ -43,7 +47,8 @@ cancellation and at a fraction of the cost:
 Overall dg is exact to ~4e-25 m/s^2 geocentric: the float64 round-off of
 the Earth's degrees >= 3 (2.7e-10 m/s^2 at TianQin) and of the planets,
 which the direct difference (the whole model again at r + d) carries too;
-both agree to 4.2e-25 m/s^2 (tests/test_differential_gravity.py, which
+both agree to 4.2e-25 m/s^2 (1.5e-24 with the GCRS EIH terms;
+tests/test_differential_gravity.py, which
 also checks each part against mpmath or double-double).  The float64 terms
 are evaluated at r and at fl(r + d): the rounding of r + d (<= 7.5e-9 m at
 1e8 m) moves their difference by <= |grad a_{>=3}| 7.5e-9 m ~ 1e-25 m/s^2,
@@ -61,34 +66,14 @@ from numba import njit
 
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
-from .heliocentric import central_j2_accel
-from .model import (SLOT_CENTRAL_J2, SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_MOON_FIELD, SLOT_RELATIVITY,
-                    SLOT_SUN_J2, SLOT_THIRD_BODY)
-from .moon import moon_field_direct
-from .relativity import relativity_accel
-from .sun import sun_j2_accel
+from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, float64_terms
+from .third_body import pm_difference
 
 __all__ = ["pm_difference", "quadrupole_jacobian_product", "direct_terms", "differential_gravity",
            "MOON_DEGREE_DG"]
 
 #: Highest degree of the Moon's field in the differential gravity (see the module docstring).
 MOON_DEGREE_DG = 4
-
-
-@njit(cache=True, inline="always")
-def pm_difference(gm, Dx, Dy, Dz, ex, ey, ez):
-    """gm [(D + e) / |D + e|^3 - D / |D|^3] [m/s^2 for gm in m^3/s^2, D, e
-    in m], without cancellation: with |D + e|^2 = |D|^2 + delta, delta =
-    e.(2 D + e), the difference of the inverse cubes is -delta (|D|^2 +
-    |D| |D + e| + |D + e|^2) / ((|D| + |D + e|) |D|^3 |D + e|^3).  float64
-    scalars, any frame; returns (x, y, z)."""
-    r2 = Dx * Dx + Dy * Dy + Dz * Dz
-    dl = ex * (2.0 * Dx + ex) + ey * (2.0 * Dy + ey) + ez * (2.0 * Dz + ez)
-    p2 = r2 + dl
-    r, p = math.sqrt(r2), math.sqrt(p2)
-    r3, p3 = r2 * r, p2 * p
-    w = -dl * (r2 + r * p + p2) / ((r + p) * r3 * p3)
-    return gm * (ex / p3 + Dx * w), gm * (ey / p3 + Dy * w), gm * (ez / p3 + Dz * w)
 
 
 @njit(cache=True, inline="always")
@@ -126,28 +111,12 @@ def quadrupole_jacobian_product(k, mxx, myy, mzz, mxy, mxz, myz, x, y, z, dx, dy
 @njit(cache=True)
 def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     """Sum [m/s^2] of the terms whose differences :func:`differential_gravity`
-    takes directly in float64, apart from the Earth field: the Moon's field
-    (degrees 2 .. MOON_DEGREE_DG), the Sun's J2, the central J2 and
-    relativity, at the position r [m] and velocity v [m/s] of the force
-    model's frame.  float64; returns (x, y, z)."""
-    ax, ay, az = 0.0, 0.0, 0.0
-    if layout[SLOT_MOON_FIELD, 0]:
-        o, c = layout[SLOT_MOON_FIELD, 1], layout[SLOT_MOON_FIELD, 2]
-        gx, gy, gz = moon_field_direct(rx, ry, rz, tdat[c:], params[o:], MOON_DEGREE_DG)
-        ax, ay, az = ax + gx, ay + gy, az + gz
-    if layout[SLOT_SUN_J2, 0]:
-        o, c = layout[SLOT_SUN_J2, 1], layout[SLOT_SUN_J2, 2]
-        gx, gy, gz = sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
-        ax, ay, az = ax + gx, ay + gy, az + gz
-    if layout[SLOT_RELATIVITY, 0]:
-        o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
-        gx, gy, gz = relativity_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
-        ax, ay, az = ax + gx, ay + gy, az + gz
-    if layout[SLOT_CENTRAL_J2, 0]:
-        o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = central_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
-        ax, ay, az = ax + gx, ay + gy, az + gz
-    return ax, ay, az
+    takes directly in float64, apart from the Earth field: the list of
+    :func:`tqdyn.forces.model.float64_terms` (the Moon's field truncated at
+    degree :data:`MOON_DEGREE_DG`, without its term on the Earth), at the
+    position r [m] and velocity v [m/s] of the force model's frame.
+    float64; returns (x, y, z)."""
+    return float64_terms(0.0, 0.0, 0.0, rx, ry, rz, vx, vy, vz, tdat, params, layout, MOON_DEGREE_DG)
 
 
 @njit(cache=True)

@@ -20,8 +20,10 @@ Terms (each switchable in ``[forces]``):
   origin; :class:`CentralJ2`; ~4e-14 m/s^2 at 1 au);
 * relativity: the Sun's post-Newtonian (Schwarzschild, PPN beta = gamma =
   1) term of IERS 2010 eq. (10.12) with GM_S (:func:`sun_schwarzschild`;
-  ~2e-10 m/s^2 at 1 au, 30 km/s).  The planets' 1PN terms and the Sun's
-  Lense-Thirring term are not modelled: their sizes are measured in
+  ~2e-10 m/s^2 at 1 au, 30 km/s), or with ``relativity_model = "eih"`` the
+  full 1PN n-body acceleration, the Sun's motion and the planets' terms
+  included (:class:`tqdyn.forces.eih.HeliocentricEIH`).  The Sun's
+  Lense-Thirring term is not modelled: its size is measured in
   tests/test_heliocentric.py and stated in docs/force-model.md.
 
 Which terms need extended precision at 1 au is measured in

@@ -19,7 +19,10 @@ with the same interface:
 
 The compiled side is :func:`gravity`: a fixed list of slots, one per term
 kind, each switched on by the ``layout`` table built here.  Adding a term
-means adding its module, a slot constant and one branch in ``gravity``.
+means adding its module, a slot constant and one branch in
+:func:`gravity_split` or, for a float64 term evaluated at the point alone,
+in :func:`float64_terms` (the one list of those, which the test masses'
+differential gravity differences too).
 """
 
 from __future__ import annotations
@@ -35,13 +38,15 @@ from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import EarthField, degree2_accel_ext, earth_field_accel
 from .earth_indirect import EarthFieldIndirect, earth_field_indirect_accel
+from .eih import HeliocentricEIH, heliocentric_eih_accel
+from .eih_gcrs import GeocentricEIH, geocentric_eih_accel
 from .heliocentric import CentralJ2, SunMonopole, central_j2_accel
-from .moon import MoonField, moon_field_accel
+from .moon import MoonField, moon_field_accel, moon_field_direct
 from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
 
-__all__ = ["ForceModel", "build_force_model", "describe_terms", "gravity", "gravity_split", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity", "gravity_split", "SLOTS"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -52,15 +57,18 @@ SLOT_SUN_J2 = 4
 SLOT_EARTH_FIELD = 5
 SLOT_EARTH_FIELD_INDIRECT = 6
 SLOT_CENTRAL_J2 = 7
+SLOT_EIH = 8
+SLOT_EIH_GCRS = 9
 #: The central body's monopole (the Earth's or, heliocentric, the Sun's) uses the first slot.
 SLOT_CENTRAL_MONOPOLE = SLOT_EARTH_MONOPOLE
 SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "central_j2": SLOT_CENTRAL_J2, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY,
          "moon_field": SLOT_MOON_FIELD, "sun_j2": SLOT_SUN_J2, "earth_field": SLOT_EARTH_FIELD,
-         "earth_field_indirect": SLOT_EARTH_FIELD_INDIRECT}
+         "earth_field_indirect": SLOT_EARTH_FIELD_INDIRECT, "relativity_eih": SLOT_EIH,
+         "relativity_eih_gcrs": SLOT_EIH_GCRS}
 _TERM_SLOT = {EarthMonopole: SLOT_EARTH_MONOPOLE, ThirdBodies: SLOT_THIRD_BODY, Relativity: SLOT_RELATIVITY,
               MoonField: SLOT_MOON_FIELD, SunJ2: SLOT_SUN_J2, EarthField: SLOT_EARTH_FIELD,
               EarthFieldIndirect: SLOT_EARTH_FIELD_INDIRECT, SunMonopole: SLOT_CENTRAL_MONOPOLE,
-              CentralJ2: SLOT_CENTRAL_J2}
+              CentralJ2: SLOT_CENTRAL_J2, HeliocentricEIH: SLOT_EIH, GeocentricEIH: SLOT_EIH_GCRS}
 
 
 class ForceModel:
@@ -220,6 +228,9 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
         terms.append(SunJ2(ephemeris=eph, gm=gms["sun"]))
     if forces.relativity:
         terms.append(Relativity(ephemeris=eph, gm_earth=float(forces.gm_earth), gm_sun=gms["sun"]))
+        if forces.relativity_model == "eih":
+            terms.append(GeocentricEIH(names=forces.third_bodies, ephemeris=eph, gm_earth=float(forces.gm_earth),
+                                       gms=tuple(gms.items())))
     return ForceModel(terms, reference, eop=eop, eop_source=source if eop is not None else "off")
 
 
@@ -232,13 +243,16 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     if forces.sun_monopole:
         gm_sun = getattr(forces, "gm_sun", None)  # the exact decimal for the extended-precision monopole
         terms.append(SunMonopole() if gm_sun is None else SunMonopole(gm=str(gm_sun)))
-    eph = ephemeris_named(forces.ephemeris) if forces.third_bodies else None
+    eih = forces.relativity and forces.relativity_model == "eih"
+    eph = ephemeris_named(forces.ephemeris) if forces.third_bodies or eih else None
     if forces.third_bodies:
         terms.append(heliocentric_third_bodies(eph, forces.third_bodies, extended=forces.third_bodies_extended,
                                                gms=gms))
     if forces.sun_j2:
         terms.append(CentralJ2(gm=gms["sun"]))
-    if forces.relativity:
+    if eih:  # the full 1PN acceleration, which contains the Sun's Schwarzschild term
+        terms.append(HeliocentricEIH(names=forces.third_bodies, ephemeris=eph, gms=tuple(gms.items())))
+    elif forces.relativity:
         terms.append(sun_schwarzschild(gm=gms["sun"]))
     return ForceModel(terms, reference)
 
@@ -289,7 +303,8 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
             ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
     # perturbations: float64 kernels at the float64-rounded state (~1e-16
     # relative); each has the signature (rx, ry, rz, vx, vy, vz, tdat, params)
-    # -> (ax, ay, az) on its own slices of tdat and params
+    # -> (ax, ay, az) on its own slices of tdat and params; those after the
+    # Earth-field indirect term are the list of float64_terms
     rx, ry, rz = to_f64(x), to_f64(y), to_f64(z)
     ux, uy, uz = to_f64(vx), to_f64(vy), to_f64(vz)
     px, py, pz = 0.0, 0.0, 0.0
@@ -306,20 +321,48 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
         o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
         gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
+    px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, -1)
+    return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
+
+
+@njit(cache=True)
+def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon_degree):
+    """(px, py, pz) plus the force terms evaluated in float64 at the point itself [m/s^2], in this
+    order: the Moon's field, the Sun's J2, relativity (IERS 2010 eq. 10.12), the central body's J2,
+    the heliocentric EIH term, the GCRS EIH terms -- the one list of these terms, for the
+    satellites' acceleration (:func:`gravity_split`) and for the test masses' differential gravity
+    (:func:`tqdyn.forces.differential.direct_terms`, which differences them between two points).
+
+    r [m], v [m/s]: float64 position and velocity in the force model's frame; tdat, params, layout:
+    the model's.  moon_degree < 0: the Moon's whole field on the satellite minus that on the Earth
+    (:func:`~tqdyn.forces.moon.moon_field_accel`); >= 0: its degrees 2 .. moon_degree on the point
+    alone (:func:`~tqdyn.forces.moon.moon_field_direct`; the Earth's term drops out of a
+    difference).  float64; returns (x, y, z)."""
     if layout[SLOT_MOON_FIELD, 0]:
         o, c = layout[SLOT_MOON_FIELD, 1], layout[SLOT_MOON_FIELD, 2]
-        gx, gy, gz = moon_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        if moon_degree < 0:
+            gx, gy, gz = moon_field_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        else:
+            gx, gy, gz = moon_field_direct(rx, ry, rz, tdat[c:], params[o:], moon_degree)
         px, py, pz = px + gx, py + gy, pz + gz
     if layout[SLOT_SUN_J2, 0]:
         o, c = layout[SLOT_SUN_J2, 1], layout[SLOT_SUN_J2, 2]
-        gx, gy, gz = sun_j2_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        gx, gy, gz = sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if layout[SLOT_RELATIVITY, 0]:
         o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
-        gx, gy, gz = relativity_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        gx, gy, gz = relativity_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if layout[SLOT_CENTRAL_J2, 0]:
         o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = central_j2_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        gx, gy, gz = central_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
+    if layout[SLOT_EIH, 0]:
+        o, c = layout[SLOT_EIH, 1], layout[SLOT_EIH, 2]
+        gx, gy, gz = heliocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    if layout[SLOT_EIH_GCRS, 0]:
+        o, c = layout[SLOT_EIH_GCRS, 1], layout[SLOT_EIH_GCRS, 2]
+        gx, gy, gz = geocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        px, py, pz = px + gx, py + gy, pz + gz
+    return px, py, pz

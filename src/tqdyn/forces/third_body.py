@@ -35,7 +35,24 @@ from numba import njit
 
 from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
 
-__all__ = ["ThirdBodies", "third_body_accel", "third_bodies_accel", "third_body_accel_ext", "third_body_jerk"]
+__all__ = ["ThirdBodies", "pm_difference", "third_body_accel", "third_bodies_accel", "third_body_accel_ext",
+           "third_body_jerk"]
+
+
+@njit(cache=True, inline="always")
+def pm_difference(gm, Dx, Dy, Dz, ex, ey, ez):
+    """gm [(D + e) / |D + e|^3 - D / |D|^3] [m/s^2 for gm in m^3/s^2, D, e
+    in m], without cancellation: with |D + e|^2 = |D|^2 + delta, delta =
+    e.(2 D + e), the difference of the inverse cubes is -delta (|D|^2 +
+    |D| |D + e| + |D + e|^2) / ((|D| + |D + e|) |D|^3 |D + e|^3).  float64
+    scalars, any frame; returns (x, y, z)."""
+    r2 = Dx * Dx + Dy * Dy + Dz * Dz
+    dl = ex * (2.0 * Dx + ex) + ey * (2.0 * Dy + ey) + ez * (2.0 * Dz + ez)
+    p2 = r2 + dl
+    r, p = math.sqrt(r2), math.sqrt(p2)
+    r3, p3 = r2 * r, p2 * p
+    w = -dl * (r2 + r * p + p2) / ((r + p) * r3 * p3)
+    return gm * (ex / p3 + Dx * w), gm * (ey / p3 + Dy * w), gm * (ez / p3 + Dz * w)
 
 
 @njit(cache=True)

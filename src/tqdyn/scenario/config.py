@@ -122,6 +122,8 @@ MAX_EARTH_DEGREE = 90  # EGM2008_90.gfc
 MAX_MOON_DEGREE = 20  # jggrx_0660b_sha_deg20.tab
 MAX_OCEAN_TIDE_DEGREE = 100  # fes2004_Cnm-Snm.dat
 LIBRATION_MODELS = ("de421", "iau")
+#: Values of forces.relativity_model: IERS 2010 eq. 10.12 alone, or with the 1PN n-body (EIH) terms.
+RELATIVITY_MODELS = ("iers2010", "eih")
 
 
 def _gm_field(body: str):
@@ -156,6 +158,13 @@ class ForcesConfig:
     ``sun_j2``: the Sun's J2 with its IAU pole.
     ``relativity``: IERS 2010 eq. 10.12 (geocentric: Schwarzschild,
     Lense-Thirring, de Sitter; heliocentric: the Sun's Schwarzschild term).
+    ``relativity_model``: what ``relativity = true`` applies: "iers2010"
+    (that alone, the default) or "eih": the first post-Newtonian n-body
+    (Einstein-Infeld-Hoffmann) terms of the Sun and the third bodies too
+    (heliocentric: the full 1PN acceleration in place of the Sun's
+    Schwarzschild term; geocentric: the 1PN terms of the third bodies in
+    the GCRS that eq. 10.12 leaves out, which need the Sun and the Moon
+    among the third bodies, in the GCRS).
     ``earth_field_indirect``: the geocentre's acceleration by the Moon and
     Sun (those listed in third_bodies) acting on the Earth's non-central
     field (needs earth_degree >= 2).
@@ -201,6 +210,7 @@ class ForcesConfig:
     gm_saturn: Decimal = _gm_field("saturn")
     gm_uranus: Decimal = _gm_field("uranus")
     gm_neptune: Decimal = _gm_field("neptune")
+    relativity_model: str = "iers2010"
 
     def __post_init__(self) -> None:
         ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
@@ -234,6 +244,7 @@ class ForcesConfig:
             _set(self, key, _to_decimal(getattr(self, key), f"forces.{key}"))
             _require(getattr(self, key) > 0, f"forces.{key}", getattr(self, key), "is not positive",
                      f"{key} > 0 m^3/s^2 (default: DE430/DE431, data/gm_de431.tpc)")
+        _require_choice(self.relativity_model, "forces.relativity_model", RELATIVITY_MODELS)
 
 
 POINTING_LAWS = ("none", "global", "taylor1", "taylor2", "iterative")
@@ -427,7 +438,13 @@ class Scenario:
                 v = getattr(f, key)
                 _require(not v, f"forces.{key}", v, 'belongs to the geocentric model (scenario.central_body = "sun")',
                          "0 / false for a heliocentric run")
-        else:
+        elif f.relativity and f.relativity_model == "eih":  # the GCRS terms subtract the model's GCRS third bodies
+            need = [b for b in ("sun", "moon") if b not in f.third_bodies]
+            _require(not need and f.third_bodies_gcrs, "forces.relativity_model", f.relativity_model,
+                     f"needs the Sun and the Moon as third bodies in the GCRS (third_bodies lacks {need})" if need
+                     else "needs the third bodies in the GCRS (third_bodies_gcrs = false)",
+                     '"iers2010", or "sun" and "moon" in third_bodies with third_bodies_gcrs = true')
+        if body != "sun":
             _require(self.initial.design == "none", "initial.design", self.initial.design,
                      "is a heliocentric constellation design", '"none" for a geocentric run')
             _require(not self.initial.oem, "initial.oem", list(self.initial.oem),
@@ -515,8 +532,10 @@ class Scenario:
                 f"moon_degree = {f.moon_degree}", f"moon_libration = {toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
                 f"eop = {toml_str(f.eop)}",
-                *(f"{key} = {toml_value(getattr(f, key))}  # m^3/s^2, TDB-compatible" for key in BODY_GM_KEYS.values()),
-                ""]
+                *(f"{key} = {toml_value(getattr(f, key))}  # m^3/s^2, TDB-compatible" for key in BODY_GM_KEYS.values())]
+        if f.relativity_model != "iers2010":  # the default is left implicit
+            out += [f"relativity_model = {toml_str(f.relativity_model)}"]
+        out += [""]
         s = self.spacecraft
         out += ["[spacecraft]", f"architecture = {toml_str(s.architecture)}", f"dragfree = {toml_str(s.dragfree)}"]
         if s.architecture == "tianqin":
