@@ -293,6 +293,8 @@ def _parse_override_value(text: str, kind: str) -> Any:
         return text.strip()
     if kind in (_STR, _EPOCH) and not isinstance(value, str) and not (kind == _EPOCH and isinstance(value, _dt.date)):
         return text.strip()  # e.g. --set scenario.name=123 means the string "123"
+    if kind == _EPOCH and isinstance(value, _dt.datetime) and value.tzinfo is None:
+        return text.strip()  # the text keeps every decimal of the seconds; a TOML date-time keeps microseconds
     return value
 
 
