@@ -1,7 +1,81 @@
-"""Shared test set-up: no test may change mpmath's global working precision; the README's default run."""
+"""Shared test set-up: no test may change mpmath's global working precision; the README's default run; the
+recording of measured numbers (``record_number``) that docs/*.md and README.md quote (docs/numbers.md)."""
+
+import os
 
 import mpmath
 import pytest
+
+#: Environment variable naming the JSON record of ``--record-numbers`` (the option wins).
+RECORD_ENV = "TQDYN_RECORD_NUMBERS"
+
+
+def pytest_addoption(parser):
+    parser.addoption("--record-numbers", metavar="PATH", default=None,
+                     help="write the numbers the tests measure with the record_number fixture into this JSON record "
+                          f"(entries of the tests that ran are replaced, the others kept; also ${RECORD_ENV}); "
+                          "docs/numbers.md")
+    parser.addoption("--numbers-only", action="store_true",
+                     help="run only the tests that record numbers (those using the record_number fixture)")
+
+
+def pytest_collection_modifyitems(config, items):
+    """``--numbers-only``: keep only the tests that record numbers (those using ``record_number``)."""
+    if not config.getoption("--numbers-only"):
+        return
+    keep = [it for it in items if "record_number" in getattr(it, "fixturenames", ())]
+    drop = [it for it in items if "record_number" not in getattr(it, "fixturenames", ())]
+    if drop:
+        config.hook.pytest_deselected(items=drop)
+    items[:] = keep
+
+
+def _record_path(config):
+    return config.getoption("--record-numbers") or os.environ.get(RECORD_ENV) or None
+
+
+def pytest_configure(config):
+    config._tqdyn_numbers = {}
+
+
+@pytest.fixture
+def record_number(request):
+    """``record_number(key, value, unit="")``: the test measured ``value``
+    (a number, a list of numbers, or a short text) in ``unit``; written to the
+    JSON record of ``pytest --record-numbers PATH`` (or ``$TQDYN_RECORD_NUMBERS``)
+    under ``key`` with the test's node id, and ignored otherwise.  The pages
+    render it through ``tools/render_docs.py`` as ``tests:<key>``.  A key
+    recorded by two tests of one session is an error."""
+    store = request.config._tqdyn_numbers
+    recording = _record_path(request.config) is not None
+
+    def record(key: str, value, unit: str = ""):
+        if not recording:
+            return value
+        from tqdyn.workflows.numbers import to_json
+
+        if "/" in key or not key:
+            raise ValueError(f"record_number: {key!r}: a key is a non-empty name without '/'")
+        old = store.get(key)
+        if old is not None and old["test"] != request.node.nodeid:
+            raise ValueError(f"record_number: {key!r} is recorded by {old['test']} and {request.node.nodeid}")
+        store[key] = {"value": to_json(value), "unit": unit, "test": request.node.nodeid}
+        return value
+
+    return record
+
+
+def pytest_sessionfinish(session, exitstatus):
+    path = _record_path(session.config)
+    store = getattr(session.config, "_tqdyn_numbers", {})
+    if path is None or not store:
+        return
+    from tqdyn.workflows.numbers import merge_section, provenance
+
+    prov = provenance("pytest --record-numbers", "pytest " + " ".join(session.config.invocation_params.args))
+    entries = {k: {**v, "date": prov["date"], "tqdyn_version": prov["tqdyn_version"]} for k, v in store.items()}
+    merge_section(path, "numbers", entries, {**prov, "description": "numbers measured by the tests (record_number "
+                                                                   "in tests/), one entry per key with its test"})
 
 
 @pytest.fixture(autouse=True)
