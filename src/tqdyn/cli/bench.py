@@ -21,7 +21,8 @@ from ._common import fail as _fail
 __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
 #: Every model, in the order they run.
-MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels", "default-run", "tianqin-5y", "lisa-10y")
+MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels", "default-run", "startup", "tianqin-5y",
+          "lisa-10y")
 #: What ``--model all`` runs (the mission-length commands are asked for by name).
 ALL_MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels")
 
@@ -57,7 +58,8 @@ def _check_json_path(path) -> Path:
                    "lisa-esa scenario (ESA's orbits and force model, point masses); lisa-coupled: the coupled "
                    "lisa scenario (LISA architecture and drag-free scheme, one year); kernels: the time-only inputs "
                    "of one chunk, term by term, and the compiled kernels per evaluation; default-run: the command "
-                   "`tqdyn run` (10 days); tianqin-5y: `tqdyn run tianqin` for five years; lisa-10y: `tqdyn run "
+                   "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with an empty kernel cache, then "
+                   "with it filled; tianqin-5y: `tqdyn run tianqin` for five years; lisa-10y: `tqdyn run "
                    "lisa` for ten years; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
 @click.option("--json", "json_path", metavar="PATH",
               help="Also write the results to this JSON record: the entries of the models run are replaced, "
@@ -108,6 +110,7 @@ def bench(duration, step, no_heyoka, which, json_path):
                                                        scenario="lisa"), _bench.format_lisa_report),
         "kernels": lambda: (_kernels.kernels_benchmark(), _kernels.format_kernels_report),
     }
+    runners["startup"] = lambda: (_mission.startup_benchmark(duration), _mission.format_startup_report)
     for name in _mission.MISSION_RUNS:
         runners[name] = lambda name=name: (_mission.mission_benchmark(name, duration), _mission.format_mission_report)
     for model in models:

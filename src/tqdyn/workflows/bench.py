@@ -98,6 +98,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
         finals[name] = r_final
         report["runs"][f"tqdyn {name}"] = {
             "wall_s": res.wall_s, "compile_s": compile_s, "us_per_step": res.wall_s / res.n_steps * 1e6,
+            "steps_per_s": res.n_steps / res.wall_s,
             "err_vs_analytic_m": _max_dist(r_final, ref),
             "grid_rows": int(sum(len(r) for r in rows)),
         }
@@ -180,7 +181,7 @@ def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
     for name, scen, precision in (("full model, dd", full, "dd"), ("full model, float64", full, "float64"),
                                   ("reduced model, dd", reduced, "dd")):
         wall, rss, res = _timed_run(scen, precision)
-        report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss}
+        report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss, "steps_per_s": res.n_steps / wall}
         if name == "reduced model, dd":
             report["reduced_final"] = res.y_final
     if heyoka:
@@ -242,7 +243,7 @@ def coupled_benchmark(duration: str = "90d", overrides=()) -> dict:
                                 ("gravity only, dd", gravity, "dd")):
         wall, rss, res = _timed_run(sc, precision)
         report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss, "cpu_inputs_s": res.cpu_inputs_s,
-                                "cpu_loop_s": res.cpu_loop_s}
+                                "cpu_loop_s": res.cpu_loop_s, "steps_per_s": res.n_steps / wall}
     # the machine's yardstick, measured in the same invocation: the Kepler run
     # of the same span and step in float64 (its ratio is robust to a loaded machine)
     kepler = load_scenario("tianqin-kepler", [f"run.duration={duration}", f"integrator.step={scen.integrator.step_s}"])

@@ -19,6 +19,11 @@ kernels, so the measured run starts as every run after the first does.
   run.output_every=72`` (five years, a row per hour);
 * ``lisa-10y``: ``tqdyn run lisa --duration 3653d`` (ten years at 6 h).
 
+:func:`startup_benchmark` (``tqdyn bench --model startup``): ``tqdyn run
+--duration 1h`` with an empty kernel cache (``$TQDYN_CACHE_DIR`` a new
+directory: the first run after an install or a change of the sources
+compiles the kernels) and then again with the cache it filled.
+
 ``duration`` replaces the span (to check the pipeline quickly); the
 report records the span that ran.
 """
@@ -33,7 +38,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["MISSION_RUNS", "MissionRun", "mission_benchmark", "format_mission_report", "SAMPLE_S"]
+__all__ = ["MISSION_RUNS", "MissionRun", "mission_benchmark", "format_mission_report", "startup_benchmark",
+           "format_startup_report", "SAMPLE_S"]
 
 #: Interval of the resident-set samples [s].
 SAMPLE_S = 0.5
@@ -140,6 +146,65 @@ def mission_benchmark(name: str, duration: str | None = None) -> dict:
             "rss_run_min_mb": min(late) if late else None, "rss_run_max_mb": max(late) if late else None,
             "rss_samples": [[round(t, 1), round(r, 1)] for t, r in samples[::keep]],
             "file_mb": file_mb, "transcript": transcript}
+
+
+def _timed_command(args, cwd, env) -> dict:
+    """Run ``tqdyn ARGS`` in ``cwd``: wall time [s], peak resident set [MB], the parsed summary."""
+    import subprocess
+
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-c", _ENTRY, *args], cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    out, err = proc.communicate()
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        last = (err.strip().splitlines() or ["no message"])[-1]
+        raise RuntimeError(f"tqdyn {' '.join(args)} failed (exit {proc.returncode}): {last}")
+    return {"wall_s": wall, **_parse(out)}
+
+
+def startup_benchmark(duration: str | None = None) -> dict:
+    """``tqdyn run --duration 1h`` (or ``duration``) with a new, empty kernel
+    cache and then with the cache filled: wall time [s] of each command, the
+    JIT time the command reports, and the peak resident set [MB] of the
+    compiling one (children's ``ru_maxrss``, measured from a fresh helper
+    process so that no earlier child counts)."""
+    import json
+    import subprocess
+
+    duration = duration or "1h"
+    with tempfile.TemporaryDirectory(prefix="tqdyn-bench-startup-") as tmp:
+        env = {**os.environ, "TQDYN_CACHE_DIR": str(Path(tmp) / "cache")}
+        args = ["run", "--duration", duration, "--output", "startup.h5", "-q"]
+        probe = ("import json, resource, subprocess, sys, time\n"
+                 "t0 = time.perf_counter()\n"
+                 f"p = subprocess.run([sys.executable, '-c', {_ENTRY!r}, *{args!r}], capture_output=True, text=True)\n"
+                 "print(json.dumps({'wall_s': time.perf_counter() - t0, 'status': p.returncode, 'stdout': p.stdout, "
+                 "'stderr': p.stderr[-2000:], "
+                 "'peak_rss_mb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0}))\n")
+        out = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
+        try:
+            cold = json.loads(out.stdout)
+        except ValueError:
+            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {out.stderr[-300:]}") from None
+        if cold["status"] != 0:
+            last = (cold["stderr"].strip().splitlines() or ["no message"])[-1]
+            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {last}")
+        (Path(tmp) / "startup.h5").unlink(missing_ok=True)
+        warm = _timed_command(args, tmp, env)
+    return {"command": "tqdyn " + " ".join(args[:-3]), "cold": {"wall_s": cold["wall_s"],
+                                                               "peak_rss_mb": cold["peak_rss_mb"],
+                                                               **_parse(cold["stdout"])},
+            "warm": warm}
+
+
+def format_startup_report(report: dict) -> str:
+    """Human-readable lines of a :func:`startup_benchmark` report."""
+    c, w = report["cold"], report["warm"]
+    return (f"start-up: {report['command']}\n"
+            f"  empty kernel cache: {c['wall_s']:.1f} s (JIT {c.get('compile_s', float('nan')):.1f} s), peak resident "
+            f"set {c['peak_rss_mb']:.0f} MB\n"
+            f"  cache filled: {w['wall_s']:.1f} s (JIT {w.get('compile_s', float('nan')):.2f} s)")
 
 
 def format_mission_report(report: dict) -> str:
