@@ -38,6 +38,25 @@ def pytest_configure(config):
     config._tqdyn_numbers = {}
 
 
+def pytest_sessionstart(session):
+    import time
+
+    session.config._tqdyn_t0 = time.perf_counter()
+    session.config._tqdyn_files = {}
+
+
+def pytest_runtest_logreport(report):
+    """Per test file: wall time of its tests (setup, call, teardown) and their number, for the records."""
+    files = _FILES.setdefault("files", {})
+    name = report.nodeid.split("::")[0]
+    wall, tests = files.get(name, (0.0, set()))
+    tests.add(report.nodeid)
+    files[name] = (wall + report.duration, tests)
+
+
+_FILES: dict = {}
+
+
 @pytest.fixture
 def record_number(request):
     """``record_number(key, value, unit="")``: the test measured ``value``
@@ -65,14 +84,34 @@ def record_number(request):
     return record
 
 
+def _is_default_suite(config) -> bool:
+    """True when the run is the default suite: no paths, -k or -m of its own, not --numbers-only."""
+    paths = [a.rstrip("/") for a in config.args]
+    return (paths == list(config.getini("testpaths")) and not config.getoption("keyword") and config.getoption("markexpr") == "not slow"
+            and not config.getoption("--numbers-only"))
+
+
 def pytest_sessionfinish(session, exitstatus):
+    import time
+
     path = _record_path(session.config)
     store = getattr(session.config, "_tqdyn_numbers", {})
-    if path is None or not store:
+    if path is None:
         return
-    from tqdyn.workflows.numbers import merge_section, provenance
+    from tqdyn.workflows.numbers import machine, merge_section, provenance
 
     prov = provenance("pytest --record-numbers", "pytest " + " ".join(session.config.invocation_params.args))
+    if exitstatus == 0 and _is_default_suite(session.config):
+        where = machine()["summary"]
+        store["suite.default_wall_s"] = {"value": time.perf_counter() - session.config._tqdyn_t0, "unit": "s",
+                                         "test": "the default suite (pytest)", "tests": session.testscollected,
+                                         "machine": where}
+        for name, (wall, tests) in _FILES.get("files", {}).items():
+            key = "suite.file." + name.rsplit("/", 1)[-1].removesuffix(".py")
+            store[key] = {"value": {"wall_s": wall, "tests": len(tests)}, "unit": "s, tests",
+                          "test": f"{name} in the default suite", "machine": where}
+    if not store:
+        return
     entries = {k: {**v, "date": prov["date"], "tqdyn_version": prov["tqdyn_version"]} for k, v in store.items()}
     merge_section(path, "numbers", entries, {**prov, "description": "numbers measured by the tests (record_number "
                                                                    "in tests/), one entry per key with its test"})

@@ -18,15 +18,20 @@ Markers in the markdown (HTML comments: GitHub shows the value, not the marker):
   the key, its ``value``; the studies: from the record's top:
   ``values/pointing/global/per_beam``, ``runs/gravity-90d/file_mb``).  A path
   segment that is an integer indexes a list; ``@max``, ``@min``, ``@absmax``,
-  ``@sum`` reduce a list.  FORMAT (optional) is a Python format spec
-  (``.2f``, ``.1e``, ``.3g``, ``,d``, ``,.0f``) after optional scale steps
-  (``*1e3:``, ``/60:``), or one of ``date`` (the day of an ISO date),
-  ``text`` (the string as is), ``machine`` (the one-line machine summary).
+  ``@sum`` reduce a list; ``A // B`` is the ratio of two paths.  FORMAT
+  (optional) is a Python format spec (``.2f``, ``.1e``, ``.3g``, ``,d``,
+  ``,.0f``; ``~N``: N significant digits without an exponent) after optional
+  scale steps (``*1e3:``, ``/60:``, ``-1:``), or one of ``date`` (the day of an ISO date),
+  ``text`` (the string as is), ``machine`` (the one-line machine summary),
+  ``hm`` (hours as HH:MM).
   Exponents are written short (``5.9e-6``).  A list is formatted element by
   element and joined with `` / ``.
 * generated blocks (tables, transcripts): ``<!--gen:NAME-->`` ... ``<!--/gen-->``
   on lines of their own; NAME is a function of :data:`GENERATORS` (with an
   argument after a colon: ``<!--gen:transcript:default-run-->``).
+
+Markers inside fenced code blocks are examples and are left alone (a
+generated block may hold a fenced block: its markers sit outside it).
 
 A value missing from its record, or a marker that cannot be parsed, is an
 error naming the page and the marker.  ``tests/test_docs_numbers.py`` renders
@@ -87,7 +92,15 @@ def _step(node, seg: str):
 
 
 def lookup(records: dict, src: str, path: str):
-    """The value at ``path`` of source ``src`` (KeyError naming what is missing)."""
+    """The value at ``path`` of source ``src`` (KeyError naming what is missing); ``A // B``: the ratio of
+    the values at paths A and B (element by element for lists)."""
+    if " // " in path:
+        a, b = (lookup(records, src, p.strip()) for p in path.split(" // ", 1))
+        if isinstance(a, list) and isinstance(b, list):
+            return [x / y for x, y in zip(a, b)]
+        if isinstance(a, list):
+            return [x / b for x in a]
+        return a / b
     if src not in records:
         raise KeyError(f"unknown source {src!r}; allowed: {', '.join(SOURCES)}")
     segs = [s for s in path.split("/") if s != ""]
@@ -104,11 +117,19 @@ def lookup(records: dict, src: str, path: str):
             node = node["value"]
     else:
         node, rest = rec, segs
-    for seg in rest:
+    i = 0
+    while i < len(rest):
+        seg, used = rest[i], 1
+        if isinstance(node, dict):  # keys may hold "/" themselves ("deviation/dragfree-global-90d"): longest first
+            for j in range(len(rest), i, -1):
+                if "/".join(rest[i:j]) in node:
+                    seg, used = "/".join(rest[i:j]), j - i
+                    break
         try:
             node = _step(node, seg)
         except (KeyError, IndexError, ValueError, TypeError):
             raise KeyError(f"{src}:{path}: no {seg!r}") from None
+        i += used
     return node
 
 
@@ -128,6 +149,9 @@ def fmt_value(value, fmt: str | None) -> str:
         return str(value)
     if fmt == "date":
         return str(value)[:10]
+    if fmt == "hm":  # hours -> HH:MM
+        m = int(round(float(value) * 60)) % (24 * 60)
+        return f"{m // 60:02d}:{m % 60:02d}"
     if fmt == "machine":
         return str(value["summary"] if isinstance(value, dict) else value)
     if value is None:
@@ -141,12 +165,22 @@ def fmt_value(value, fmt: str | None) -> str:
             x = x * float(sc[1:])
         elif sc.startswith("/"):
             x = x / float(sc[1:])
+        elif sc.startswith("+"):
+            x = x + float(sc[1:])
+        elif sc.startswith("-"):
+            x = x - float(sc[1:])
         else:
-            raise ValueError(f"format {fmt!r}: {sc!r} is not a scale step (*X or /X)")
+            raise ValueError(f"format {fmt!r}: {sc!r} is not a scale step (*X, /X, +X or -X)")
     if isinstance(x, float) and not math.isfinite(x):
         return "n/a"
     if spec == "":
         return _short_exp(repr(x)) if isinstance(x, float) else str(x)
+    if spec.startswith("~"):  # N significant digits, never an exponent (1503, 682, 4.57, 0.00015)
+        n = int(spec[1:])
+        if x == 0:
+            return "0"
+        d = max(0, n - 1 - math.floor(math.log10(abs(x))))
+        return f"{x:.{d}f}"
     if spec.endswith("d") and isinstance(x, float):
         x = int(round(x))
     return _short_exp(format(x, spec))
@@ -291,12 +325,96 @@ def gen_kernels_table(records, arg=None) -> str:
     return "\n".join(rows)
 
 
+def gen_lisa_common_sg(records, arg=None) -> str:
+    """docs/lisa-coupled.md, section c: the common self-gravity runs on LISA (``tqdyn report --studies --mission lisa``)."""
+    v = records["lisa"]["values"]["common_sg"]
+    deg = 180.0 / math.pi
+    rows = ["| push (1e-9 m/s^2) | dL at 1 yr, arms 12 / 23 / 31 | max \\|dL\\| | max \\|dL/dt\\| | max \\|d alpha\\| | "
+            "Hill estimate (max \\|dL\\|; run/estimate) |", "| --- | --- | --- | --- | --- | --- |"]
+    for label in ("+x", "-x", "+y", "-y", "+z", "-z"):
+        r = v[label]
+        small = label[1] == "z"
+        km = "~2" if small else "~3"
+        if small:
+            hill = "0 at first order"
+        elif label[0] == "-":
+            hill = "same, sign reversed"
+        else:
+            hill = (f"{_f([x / 1e3 for x in r['est_max_dL']], '~3')} km; "
+                    f"{_f([a / b for a, b in zip(r['max_dL'], r['est_max_dL'])], '.3f')}")
+        rows.append(f"| {label[0]}{label[1].upper()}_S | {_f([x / 1e3 for x in r['dL_end']], km)} km | "
+                    f"{_f([x / 1e3 for x in r['max_dL']], km)} km | {_f([x * 1e3 for x in r['max_dLdot']], km)} mm/s | "
+                    f"{_f([x * deg for x in r['max_dalpha']], '.2g')} deg | {hill} |")
+    return "\n".join(rows)
+
+
+def gen_lisa_pointing(records, arg=None) -> str:
+    """docs/lisa-coupled.md, section d: the pointing laws on LISA."""
+    p = records["lisa"]["values"]["pointing"]
+    m, b = p["maxima"], p["bounds"]
+    rows = ["| law | per beam | X_S | opening angle theta | MOSA angle theta/2 | first-order bound |",
+            "| --- | --- | --- | --- | --- | --- |"]
+    for law, name, bound in (("global", "global (instantaneous)", f"v/c = {_f(b['global'], '.3e')}"),
+                             ("taylor1", "taylor1", f"v^2/(2c^2) = {_f(b['taylor'], '.3e')}"),
+                             ("taylor2", "taylor2", "v^2/(2c^2)")):
+        x = m[law]
+        rows.append(f"| {name} | {_f(x['per_beam'], '.3e')} rad | {_f(x['x_s'], '.3e')} | {_f(x['theta'], '.3e')} | "
+                    f"{_f(x['theta'] / 2, '.3e')} rad | {bound} |")
+    rows.append(f"| tau = L/c vs the light time | {_f(p['tau_error'], '.3e')} s | | | | L v / c^2 = {_f(b['tau'], '.3e')} s |")
+    return "\n".join(rows)
+
+
+def gen_lisa_esa_ramp(records, arg=None) -> str:
+    """docs/lisa-coupled.md, section e: coupled lisa - lisa-esa after one year and over ESA's span."""
+    vals = records["lisa"]["values"]
+    rows = ["| after | coupled `lisa` - `lisa-esa`: radial / along / cross (Sat1; Sat2; Sat3) | CW prediction | "
+            "parts (along): incentre vs centroid; aberration; nominal G |", "| --- | --- | --- | --- |"]
+    for key in ("ramp-1y", "ramp-span"):
+        r = vals[f"esa/{key}"]
+        days = r["t_end"] / 86400.0
+        when = f"{days:g} d" + (f" ({days / 365.25:.3g} yr)" if days > 400 else "")
+        meas = "; ".join(_f([r["radial_end"][s], r["along_end"][s], r["cross_end"][s]], "~3") for s in range(3))
+        pred = "; ".join(_f(r["pred_end"][s], "~3") for s in range(3))
+        parts = "; ".join(_f([r["parts_end"]["geometric"][s][1], r["parts_end"]["aberration"][s][1],
+                              r["parts_end"]["nominal"][s][1]], "~3") for s in range(3))
+        rows.append(f"| {when} | {meas} m | {pred} m | {parts} m |")
+    return "\n".join(rows)
+
+
+def gen_force_budget(records, arg) -> str:
+    """A ``tqdyn forces`` budget recorded by a test (``force-budget:KEY``): max and RMS per term, largest first."""
+    rows = records["tests"]["numbers"][arg]["value"]
+    out = ["| term | max | RMS |", "| --- | ---: | ---: |"]
+    for name, (mx, rms) in sorted(rows.items(), key=lambda kv: -kv[1][0]):
+        out.append(f"| {name} | {mx:.2e} | {rms:.2e} |")
+    return "\n".join(out)
+
+
 GENERATORS = {"readme-bench": gen_readme_bench, "bench-machines": gen_bench_machines,
               "precision-bench": gen_precision_bench, "transcript": gen_transcript,
-              "studies-table": gen_studies_table, "kernels-table": gen_kernels_table}
+              "studies-table": gen_studies_table, "kernels-table": gen_kernels_table,
+              "force-budget": gen_force_budget, "lisa-common-sg": gen_lisa_common_sg, "lisa-pointing": gen_lisa_pointing, "lisa-esa-ramp": gen_lisa_esa_ramp}
 
 
 # =========================================================================== rendering
+
+FENCE = re.compile(r"^```", re.M)
+
+
+def fenced(text: str) -> list[tuple[int, int]]:
+    """(start, end) offsets of the fenced code blocks of ``text`` (markers there are examples, not markers)."""
+    marks = [m.start() for m in FENCE.finditer(text)]
+    return [(a, b) for a, b in zip(marks[::2], marks[1::2])]
+
+
+def _outside(spans):
+    return lambda pos: not any(a <= pos < b for a, b in spans)
+
+
+def markers(rx, text):
+    """The matches of ``rx`` in ``text`` outside fenced code blocks."""
+    ok = _outside(fenced(text))
+    return [m for m in rx.finditer(text) if ok(m.start())]
 
 
 def render(text: str, records: dict, page: str = "page") -> str:
@@ -320,7 +438,10 @@ def render(text: str, records: dict, page: str = "page") -> str:
             raise RenderError(f"{page}: {marker_of(m)}: {exc}") from None
         return m.group(0)[: m.start("text") - m.start(0)] + out + "<!--/n-->"
 
-    return INLINE.sub(inline, BLOCK.sub(block, text))
+    ok = _outside(fenced(text))
+    text = BLOCK.sub(lambda m: block(m) if ok(m.start()) else m.group(0), text)
+    ok = _outside(fenced(text))
+    return INLINE.sub(lambda m: inline(m) if ok(m.start()) else m.group(0), text)
 
 
 def marker_of(m) -> str:
@@ -333,7 +454,7 @@ def differences(text: str, rendered: str) -> list[tuple[str, str, str]]:
     out = []
     pairs = [(BLOCK, lambda m: f"<!--gen:{m.group('name')}-->"), (INLINE, marker_of)]
     for rx, name in pairs:
-        a, b = list(rx.finditer(text)), list(rx.finditer(rendered))
+        a, b = markers(rx, text), markers(rx, rendered)
         for ma, mb in zip(a, b):
             if ma.group("text") != mb.group("text"):
                 out.append((name(ma), ma.group("text"), mb.group("text")))

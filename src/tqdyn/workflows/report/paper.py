@@ -323,6 +323,7 @@ def _study_common_sg(rep, runs):
     alpha_all = max(results[lab]["dalpha_max"] for lab in SG_DIRECTIONS)
     lo = min(results[lab]["alpha_range"][0] for lab in SG_DIRECTIONS)
     hi = max(results[lab]["alpha_range"][1] for lab in SG_DIRECTIONS)
+    rep.values["common_sg_theory"].update({"dalpha_max_all": alpha_all, "alpha_range_all": (lo, hi)})
     rep.rows += [
         SummaryRow(f"Sec. V.B.2: +flight ({fl} of S) 1e-9 m/s^2, deviation from gravity orbit at {span:.3g} d",
                    "~100 km (order of) over 3 months", _per_sat(results[fl]["dev_end"] / 1e3, "km", "{:.4g}"),
