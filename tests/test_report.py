@@ -216,6 +216,11 @@ def test_cli_report_runs(runs, tmp_path, capsys):
     assert "| quantity | paper | tqdyn | agreement / notes |" in out
     assert (tmp_path / "o" / "summary.md").is_file() and (tmp_path / "o" / "dragfree-control.pdf").is_file()
     assert err == ""
+    import json
+
+    rec = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert rec["written_by"] == "tqdyn report" and rec["rows"] and "dragfree/control" in rec["values"]
+    assert rec["runs"][str(runs["dragfree"])]["file_mb"] > 0
 
 
 @pytest.mark.parametrize("args, match", [
@@ -261,8 +266,23 @@ def test_cli_one_study_quick_in_process(tmp_path, capsys):
     assert "\n| Fig. 9: extreme case, breathing angles over 1 d" in out
     assert {p.name for p in (tmp_path / "s").glob("fig9*")} == {"fig9-extreme-breathing.png",
                                                                "fig9-extreme-breathing.pdf"}
+    # summary.json: every number of the table with its provenance, the runs with their size and wall time
+    import json
+
+    rec = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert rec["written_by"] == "tqdyn report" and rec["command"].startswith("tqdyn report --studies --quick")
+    assert rec["machine"]["cores"] >= 1 and rec["libraries"]["numpy"] and rec["date"].endswith("Z")
+    assert rec["mission"] == "tianqin" and rec["duration_scale"] == pytest.approx(1 / 90)
+    assert [r["quantity"] for r in rec["rows"]][0].startswith("Fig. 9: extreme case, breathing angles over 1 d")
+    assert rec["values"]["extreme"]["range"][0] < 60 < rec["values"]["extreme"]["range"][1]
+    assert set(rec["runs"]) == {"gravity-90d", "sg-extreme-90d"}
+    assert all(r["status"] == "ran" and r["file_mb"] > 0 and r["wall_s"] > 0 and r["rows"] > 1
+               for r in rec["runs"].values())
+    assert rec["timing"]["n_runs"] == 2 and rec["timing"]["total_wall_s"] > 0
     code, out, err = _cli(args, capsys)
     assert code == 0 and "2 reused, 0 to run" in err
+    rec = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert all(r["status"] == "reused" and r["wall_s"] is None for r in rec["runs"].values())
 
 
 @pytest.mark.slow

@@ -18,7 +18,8 @@ Markers in the markdown (HTML comments: GitHub shows the value, not the marker):
   the key, its ``value``; the studies: from the record's top:
   ``values/pointing/global/per_beam``, ``runs/gravity-90d/file_mb``).  A path
   segment that is an integer indexes a list; ``@max``, ``@min``, ``@absmax``,
-  ``@sum`` reduce a list; ``A // B`` is the ratio of two paths.  FORMAT
+  ``@sum`` reduce a list; ``A // B`` is the ratio of two paths; a ``tests``
+  key may hold ``*`` (the values of every matching key, in one list).  FORMAT
   (optional) is a Python format spec (``.2f``, ``.1e``, ``.3g``, ``,d``,
   ``,.0f``; ``~N``: N significant digits without an exponent) after optional
   scale steps (``*1e3:``, ``/60:``, ``-1:``), or one of ``date`` (the day of an ISO date),
@@ -110,6 +111,16 @@ def lookup(records: dict, src: str, path: str):
         rest = segs[1:]
         if rest and isinstance(node.get("result"), dict) and rest[0] in node["result"]:
             node = node["result"]
+    elif src == "tests" and "*" in segs[0]:  # every key matching the pattern: their values, flattened once
+        import fnmatch
+
+        keys = sorted(k for k in rec.get("numbers", {}) if fnmatch.fnmatchcase(k, segs[0]))
+        if not keys:
+            raise KeyError(f"{src}:{path}: no key matches {segs[0]!r}")
+        node, rest = [], segs[1:]
+        for k in keys:
+            v = rec["numbers"][k]["value"]
+            node += v if isinstance(v, list) else [v]
     elif src == "tests":
         node = rec.get("numbers", {})[segs[0]]
         rest = segs[1:]
@@ -390,10 +401,37 @@ def gen_force_budget(records, arg) -> str:
     return "\n".join(out)
 
 
+def gen_helio_roundoff(records, arg=None) -> str:
+    """docs/force-model.md: float64 round-off per heliocentric term (``tests/test_heliocentric.py``, three epochs)."""
+    import fnmatch
+
+    nums = records["tests"]["numbers"]
+    tables = [nums[k]["value"] for k in sorted(nums) if fnmatch.fnmatchcase(k, "heliocentric.roundoff.*")]
+    year2 = (365.25 * 86400.0) ** 2 / 2
+
+    def span(name, key):
+        return [t[name][key] for t in tables]
+
+    rows = ["| term | float64 round-off [m/s^2] | err T^2/2 over one year |", "| --- | ---: | ---: |",
+            f"| Sun monopole (float64) | {_f(min(span('sun_monopole', 'float64')), '.2g')} .. "
+            f"{_f(max(span('sun_monopole', 'float64')), '.2g')} | {_f(min(span('sun_monopole', 'year_m')), '.2g')} .. "
+            f"{_f(max(span('sun_monopole', 'year_m')), '.2g')} m |",
+            f"| Sun monopole (dd) | <= {_f(max(span('sun_monopole', 'dd')), '.2g')} | "
+            f"{_f(max(span('sun_monopole', 'dd')) * year2, '.1g')} m |"]
+    named = ("earth", "jupiter", "venus")
+    for body in named:
+        rows.append(f"| {body.capitalize()} | <= {_f(max(span(body, 'float64')), '.2g')} | "
+                    f"<= {_f(max(span(body, 'year_m')), '.2g')} m |")
+    others = [n for n in tables[0] if n not in ("sun_monopole", *named)]
+    rows.append(f"| every other term | <= {_f(max(max(span(n, 'float64')) for n in others), '.1g')} | "
+                f"<= {_f(max(max(span(n, 'year_m')) for n in others), '.1g')} m |")
+    return "\n".join(rows)
+
+
 GENERATORS = {"readme-bench": gen_readme_bench, "bench-machines": gen_bench_machines,
               "precision-bench": gen_precision_bench, "transcript": gen_transcript,
               "studies-table": gen_studies_table, "kernels-table": gen_kernels_table,
-              "force-budget": gen_force_budget, "lisa-common-sg": gen_lisa_common_sg, "lisa-pointing": gen_lisa_pointing, "lisa-esa-ramp": gen_lisa_esa_ramp}
+              "force-budget": gen_force_budget, "helio-roundoff": gen_helio_roundoff, "lisa-common-sg": gen_lisa_common_sg, "lisa-pointing": gen_lisa_pointing, "lisa-esa-ramp": gen_lisa_esa_ramp}
 
 
 # =========================================================================== rendering
