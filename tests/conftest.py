@@ -101,11 +101,12 @@ def pytest_sessionfinish(session, exitstatus):
     from tqdyn.workflows.numbers import machine, merge_section, provenance
 
     prov = provenance("pytest --record-numbers", "pytest " + " ".join(session.config.invocation_params.args))
-    if exitstatus == 0 and _is_default_suite(session.config):
+    if exitstatus in (0, 1) and _is_default_suite(session.config) and not session.config.getoption("maxfail"):
+        # the whole default suite ran (failures included: a failing test records no number of its own)
         where = machine()["summary"]
         store["suite.default_wall_s"] = {"value": time.perf_counter() - session.config._tqdyn_t0, "unit": "s",
                                          "test": "the default suite (pytest)", "tests": session.testscollected,
-                                         "machine": where}
+                                         "failed": session.testsfailed, "machine": where}
         for name, (wall, tests) in _FILES.get("files", {}).items():
             key = "suite.file." + name.rsplit("/", 1)[-1].removesuffix(".py")
             store[key] = {"value": {"wall_s": wall, "tests": len(tests)}, "unit": "s, tests",

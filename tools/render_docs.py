@@ -244,8 +244,9 @@ def gen_readme_bench(records, arg=None) -> str:
                 f"CPU per simulated day {_f(cd['cpu_inputs_per_day_s'], '.2f')} s of time-only inputs + "
                 f"{_f(cd['cpu_loop_per_day_s'], '.2f')} s of compiled loop) | {_f(cf['wall_s'], '.3g')} s | - |")
     rows.append(f"| coupled TianQin, {_span(t5)} (`--model tianqin-5y`: `{t5['command']}`, "
-                f"{_f(t5.get('n_steps'), ',d')} steps, {_f(t5['file_mb'], '.0f')} MB file) | "
-                f"{_f(t5['wall_s'], '.0f')} s ({_f(t5['wall_s'] / 60, '.0f')} min), {_f(t5['peak_rss_mb'], '.0f')} MB "
+                f"{_f(t5.get('n_steps'), ',d')} steps, {_f(t5['file_mb'], '.2g')} MB file) | "
+                f"{_f(t5['wall_s'], '.0f')} s" + (f" ({_f(t5['wall_s'] / 60, '.0f')} min)" if t5["wall_s"] > 120 else "")
+                + f", {_f(t5['peak_rss_mb'], '.0f')} MB "
                 f"peak; resident set {_f(t5['rss_run_min_mb'], '.0f')}-{_f(t5['rss_run_max_mb'], '.0f')} MB after "
                 f"the first 10 % of the run | - | - |")
     ld, lf = li["runs"]["lisa, dd"], li["runs"]["lisa, float64"]
@@ -257,7 +258,7 @@ def gen_readme_bench(records, arg=None) -> str:
                 f"{lc['step_s'] / 3600:g} h, {_f(lc['n_steps'], ',d')} steps (`--model lisa-coupled`) | "
                 f"{_f(cd['wall_s'], '.2f')} s ({_f(cd['peak_rss_mb'], '.0f')} MB) | {_f(cf['wall_s'], '.2f')} s | - |")
     rows.append(f"| LISA coupled, {_span(l10)} (`--model lisa-10y`: `{l10['command']}`, "
-                f"{_f(l10.get('n_steps'), ',d')} steps of {l10['step_s'] / 3600:g} h, {_f(l10['file_mb'], '.0f')} MB "
+                f"{_f(l10.get('n_steps'), ',d')} steps of {l10['step_s'] / 3600:g} h, {_f(l10['file_mb'], '.2g')} MB "
                 f"file) | {_f(l10.get('propagation_wall_s'), '.2g')} s ({_f(l10['wall_s'], '.2g')} s with start-up and "
                 f"output; {_f(l10['peak_rss_mb'], '.0f')} MB peak) | - | - |")
     return "\n".join(rows)

@@ -150,6 +150,9 @@ def write_record(path, data: dict) -> Path:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary file (mkstemp makes it private)
         os.replace(tmp, p)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
