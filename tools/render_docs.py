@@ -270,7 +270,9 @@ def gen_bench_machines(records, arg=None) -> str:
     for model in (arg.split(",") if arg else records["bench"]["models"]):
         e = _bench(records, model)
         lib = e["libraries"]
-        lines.append(f"- `{e['command'].split(' --json')[0]}`: {e['machine']['summary']}, {e['date'][:10]}, "
+        load = e["machine"].get("load_average")
+        lines.append(f"- `{e['command'].split(' --json')[0]}`: {e['machine']['summary']}"
+                     + (f" (load average {load[0]:g} at the start)" if load else "") + f", {e['date'][:10]}, "
                      f"tqdyn {e['tqdyn_version']}, numba {lib.get('numba', '?')}, numpy {lib.get('numpy', '?')}"
                      + (f", heyoka {lib['heyoka']}" if "heyoka" in lib and model in ("kepler", "full") else ""))
     return "\n".join(lines)
