@@ -399,9 +399,9 @@ def test_tianqin_kepler_magnitudes(tq_y):
     assert res < 1e-15 * np.abs(on.g).max(), res
 
 
-def test_vectorised_shapes_and_speed():
-    """(N, 3, ...) inputs with N = 100000: shapes as documented (docs/trajectory-format.md) and < 2 s; per-slice equality."""
-    import time
+def test_vectorised_shapes():
+    """(N, 3, ...) inputs with N = 100000: shapes as documented (docs/trajectory-format.md); per-slice equality.
+    Its cost is measured by ``tqdyn bench --model kernels``."""
     rng = np.random.default_rng(5)
     N = 100_000
     T = np.broadcast_to(np.eye(3), (N, 3, 3, 3))
@@ -410,12 +410,8 @@ def test_vectorised_shapes_and_speed():
     th = rng.uniform(1.0, 1.1, size=(N, 3))
     wm, wmd = mosa_angular_rates(rng.normal(size=(N, 3)) * 1e-9, rng.normal(size=(N, 3)) * 1e-14)
     dg = rng.normal(size=(N, 3, 2, 3)) * 1e-10
-    t0 = time.perf_counter()
     out = nominal_control(T, w, wd, th, wm, wmd, dg)
-    dt = time.perf_counter() - t0
-    print(f"\nnominal_control, N = {N}: {dt:.3f} s")
     assert out.g.shape == out.a_suspension.shape == out.alpha_suspension.shape == (N, 3, 2, 3)
     assert out.a_dragfree.shape == out.a_dragfree_S.shape == (N, 3, 3)
-    assert dt < 2.0
     one = nominal_control(T[7], w[7], wd[7], th[7], wm[7], wmd[7], dg[7])
     np.testing.assert_array_equal(one.a_suspension, out.a_suspension[7])

@@ -83,7 +83,7 @@ TOL_ROWS = {"T_S_I": 5e-16, "omega": 5e-20, "omega_dot": 1e-24, "mosa": 5e-16, "
 
 
 @pytest.mark.parametrize("row", [0, 77, 144])
-def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
+def test_coupled_rows_match_numpy_pipeline(table_iv_run, row, record_number):
     """Attitude, differential gravity, suspension, G and TM angular
     acceleration of an output row, recomputed with the numpy modules from
     the row's states and gravity evaluated separately at the TM positions."""
@@ -127,9 +127,10 @@ def test_coupled_rows_match_numpy_pipeline(table_iv_run, row):
         assert x <= TOL_ROWS[k], (k, x)
     assert np.all(tr["tm/a_suspension"][row][..., 0] == 0.0)                         # (b) no x actuation
     np.testing.assert_array_equal(tr["tm/a_suspension"][row][:, 0, 2], -tr["tm/a_suspension"][row][:, 1, 2])  # (c)
+    record_number(f"coupled.rows_vs_numpy.row{row}", err)
 
 
-def test_frames_and_pointing_on_trajectory(table_iv_run):
+def test_frames_and_pointing_on_trajectory(table_iv_run, record_number):
     _, tr, _ = table_iv_run
     T = tr["sat/T_S_I"]
     err = {"orthonormal": np.abs(T @ np.swapaxes(T, -1, -2) - np.eye(3)).max(),
@@ -150,15 +151,16 @@ def test_frames_and_pointing_on_trajectory(table_iv_run):
         err["mosa"] = max(err["mosa"], np.abs(tr["mosa/angle"][:, i, 0] - alpha / 2).max())        # rad
         np.testing.assert_array_equal(tr["mosa/angle"][:, i, 1], -tr["mosa/angle"][:, i, 0])
     print("\nframes on the trajectory: " + ", ".join(f"{k} {x:.1e}" for k, x in err.items()))
-    # README: "< 1e-15", asserted as quoted (measured 7.8e-16, 8.9e-16, 4.4e-16, 2.2e-16: a few ulp of O(1))
+    # docs/coupled-dynamics.md; measured 7.8e-16, 8.9e-16, 4.4e-16, 2.2e-16: a few ulp of O(1)
     for key in ("orthonormal", "det", "bisect", "normal"):
         assert err[key] < 1e-15, (key, err[key])
+    record_number("coupled.frames_on_trajectory", max(err[k] for k in ("orthonormal", "det", "bisect", "normal")))
     # rad; measured 4.4e-16 (breathing angle, arccos of float64 unit vectors) and 2.2e-16 (MOSA angle)
     assert err["alpha"] < 2e-15 and err["mosa"] < 1e-15, err
 
 
 @pytest.mark.parametrize("law", ["global", "taylor2", "iterative"])
-def test_rates_agree_with_finite_differences(no_sg_run, tmp_path, law):
+def test_rates_agree_with_finite_differences(no_sg_run, tmp_path, law, record_number):
     """omega from 5-point differences of T_S_I (50 s grid) and omega_dot from
     5-point differences of omega, along one day of the propagated orbit.
     Truncation h^4 w^5 / 30 ~ 1e-19 rad/s and h^4 n^4 |w_dot| / 30 < 1e-26
@@ -180,24 +182,25 @@ def test_rates_agree_with_finite_differences(no_sg_run, tmp_path, law):
     err_w = np.abs(w_fd - tr["sat/omega"][2:-2]).max()
     err_wd = np.abs(d5(tr["sat/omega"]) - tr["sat/omega_dot"][2:-2]).max()
     print(f"\n{law}: omega vs 5-point FD {err_w:.1e} rad/s, omega_dot {err_wd:.1e} rad/s^2")
-    # the README's "< 1e-17 / < 2e-21" (the bound derived above) is asserted as quoted; measured global /
-    # taylor2 / iterative: 5.8e-18 / 7.6e-18 / 6.3e-18 rad/s and 3.1e-22 / 1.5e-21 / 1.5e-21 rad/s^2
+    # the bound derived above; measured global / taylor2 / iterative: 5.8e-18 / 7.6e-18 / 6.3e-18 rad/s and
+    # 3.1e-22 / 1.5e-21 / 1.5e-21 rad/s^2
     assert err_w < 1e-17, err_w
     assert err_wd < 2e-21, err_wd
+    record_number(f"coupled.rates_vs_fd.{law}", [err_w, err_wd], "rad/s, rad/s^2")
 
 
 # ---------------------------------------------------------------------------
 # magnitudes (paper sec. V.B)
 
 
-def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_run):
+def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_run, record_number):
     _, tr0, _ = no_sg_run
     A0 = np.abs(tr0["tm/a_suspension"]).max()
     G0 = np.linalg.norm(tr0["sat/a_dragfree"], axis=-1).max()
     al0 = np.abs(tr0["tm/alpha_suspension"]).max()
     print(f"\nno self-gravity, 1 day: max |A| {A0:.2e} m/s^2, max |G| {G0:.2e} m/s^2, max |alpha| {al0:.2e} rad/s^2")
-    # paper: ~1e-13 m/s^2 and ~1e-13 rad/s^2 (Fig. 7); G ~ 1e-13 m/s^2.  README (1 day): 1.4e-13 / 1.1e-13 m/s^2 /
-    # 3.1e-13 rad/s^2, measured 1.41e-13 / 1.08e-13 / 3.06e-13: bounds ~3x either side (none of them vanishes:
+    # paper: ~1e-13 m/s^2 and ~1e-13 rad/s^2 (Fig. 7); G ~ 1e-13 m/s^2.  Measured (1 day) 1.41e-13 / 1.08e-13 m/s^2 /
+    # 3.06e-13 rad/s^2: bounds ~3x either side (none of them vanishes:
     # the breathing, rotating frame S and the gravity differences across the 0.4 m TM baseline need actuation)
     assert 5e-14 < A0 < 4e-13
     assert 3e-14 < G0 < 3e-13
@@ -210,19 +213,18 @@ def test_control_magnitudes_without_and_with_self_gravity(no_sg_run, table_iv_ru
     # paper (Fig. 8, sec. V.B.1): ~1e-10 m/s^2, "differential acceleration between the two TMs less
     # than 1e-10": that is the differential-mode actuation of each TM, A_z = +/- dg_z / 2 (eq:E1/E2).
     # The difference A_1 - A_2 itself exceeds 1e-10: Table IV alone gives z: 1.10e-10 + 5.72e-11.
-    # README: 8.4e-11 and 1.75e-10 m/s^2 (measured 8.36e-11, 1.75e-10).  Reference: Table IV's z values,
+    # Measured 8.36e-11 and 1.75e-10 m/s^2 (docs/coupled-dynamics.md).  Reference: Table IV's z values,
     # dg_z / 2 = 8.36e-11 m/s^2, plus the no-self-gravity control (< 4e-13, above) on top.
     half_dz = (TABLE_IV_SELF_GRAVITY[0, 2] - TABLE_IV_SELF_GRAVITY[1, 2]) / 2
     assert abs(A1 - half_dz) < 1e-12 and A1 < 1e-10
     assert 2 * half_dz - 1e-12 < dA < 2e-10
+    record_number("coupled.control_1d", {"A_no_sg": A0, "G_no_sg": G0, "alpha_no_sg": al0, "A_table_iv": A1,
+                                         "dA_table_iv": dA})
 
 
 def test_default_run_control_maxima(default_run):
     """The control maxima of the README's `tqdyn run` (tianqin: full model, Table IV, 10 days), from its file.
-    README transcript: max |G_i| 6.428e-11 m/s^2, max |A_c,l| component 8.360e-11 m/s^2, max |alpha_l|
-    component 3.059e-13 rad/s^2.  Measured now: 6.435e-11, 8.362e-11 and 7.363e-13 (the README's alpha is the
-    1-day value of the no-self-gravity run, 3.06e-13; over 10 days alpha grows as |G| does, cf. 7.44e-13 over
-    30 days in docs/report.md)."""
+    Measured: 6.435e-11 m/s^2, 8.362e-11 m/s^2 and 7.363e-13 rad/s^2 (over 10 days alpha grows as |G| does)."""
     status, _, err, path = default_run
     assert status == 0, err
     tr = io.read_trajectory(path)
@@ -289,7 +291,7 @@ def test_control_off_is_the_pure_gravity_constellation(tmp_path):
 
 
 @pytest.mark.parametrize("law", ["global", "taylor2"])
-def test_free_tms_stay_at_their_housing_centers(tmp_path, law):
+def test_free_tms_stay_at_their_housing_centers(tmp_path, law, record_number):
     """Free-TM mode: the six TMs are integrated as bodies under gravity at
     their own positions + self-gravity + suspension; the drift from the EH
     centers after one day is the consistency of the control derivation (G
@@ -300,20 +302,21 @@ def test_free_tms_stay_at_their_housing_centers(tmp_path, law):
                       duration="1d")
     off = np.linalg.norm(tr["tm/housing_offset"], axis=-1)
     print(f"\nfree TMs, {law}, 1 day: max |TM - EH center| = {off.max():.2e} m")
-    # m; the target for 10 days is 1e-12 m.  Measured: global 2.6e-16 m (README 2.6e-16 m); taylor2 9.8e-14 m: its
+    # m; the target for 10 days is 1e-12 m.  Measured: global 2.6e-16 m; taylor2 9.8e-14 m: its
     # omega_dot contains the remote jerk / c, and the jerk model leaves out the Earth-rotation jerk of the sectorial
     # degree-2 terms and the CIP tilt of J2 (~1e-13 m/s^3, ~4e-22 rad/s^2, ~7e-23 m/s^2 at the TM).  Bounds ~3-10x
     # either side: an offset of exactly 0 would mean the TMs are not integrated apart from their EH centres, and
     # taylor2 must show the drift its jerk model leaves.
     low, high = (3e-17, 1e-15) if law == "global" else (2e-14, 3e-13)
     assert low < off.max() < high
+    record_number(f"coupled.free_tms_1d.{law}", off.max(), "m")
     assert res.y_final.shape == (9, 6, 2)
 
 
 @pytest.mark.parametrize("law", ["global", "taylor2"])
-def test_free_tms_ten_days_full_model(tmp_path, law):
-    """README: free TMs vs their EH centres over 10 days, full model, Table IV: global 2.0e-15 m, taylor2 3.4e-13 m
-    (target < 1e-12 m).  ~10 s per law: in the default suite."""
+def test_free_tms_ten_days_full_model(tmp_path, law, record_number):
+    """docs/coupled-dynamics.md: free TMs vs their EH centres over 10 days, full model, Table IV (target
+    < 1e-12 m); measured global 2.0e-15 m, taylor2 3.6e-13 m.  In the default suite."""
     _, tr, _ = _run(tmp_path, "free10.h5", ["constellation.free_tms=true", f"constellation.pointing={law}"],
                     duration="10d")
     off = np.linalg.norm(tr["tm/housing_offset"], axis=-1).max()
@@ -321,9 +324,10 @@ def test_free_tms_ten_days_full_model(tmp_path, law):
     if law == "global":
         assert 3e-16 < off < 1e-14       # measured 1.96e-15 m
     else:
-        # measured 3.63e-13 m (README 3.4e-13 m); the upper bound is the README's target 1e-12 m (2.8x), the lower
-        # one the drift the taylor2 jerk model must leave (see the 1-day test)
+        # measured 3.63e-13 m; the upper bound is the target 1e-12 m (2.8x), the lower one the drift the taylor2
+        # jerk model must leave (see the 1-day test)
         assert 1e-13 < off < 1e-12
+    record_number(f"coupled.free_tms_10d.{law}", off, "m")
 
 
 @pytest.mark.parametrize("override, words", [
@@ -372,7 +376,7 @@ def test_adaptive_mode_matches_fixed(tmp_path):
 
 
 @pytest.mark.parametrize("law", ["taylor1", "taylor2", "iterative"])
-def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
+def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law, record_number):
     """The attitude integrated with a local pointing law equals the frames
     that constellation.pointing computes afterwards from the propagated
     states (iterative: the light-travel-time equation solved to 1e-20 s on
@@ -392,8 +396,9 @@ def test_local_pointing_in_the_loop_matches_post_processing(tmp_path, law):
     err_T = np.abs(f.T_S_I - tr["sat/T_S_I"][sl]).max()
     err_th = np.abs(0.5 * f.theta - tr["mosa/angle"][sl][..., 0]).max()
     print(f"\n{law}: in-loop vs post-processed attitude {err_T:.1e}, MOSA angle {err_th:.1e} rad")
-    # README "< 6e-16" (measured 4.4e-16 / 4.4e-16 / 5.6e-16 for T_S_I, 2.2e-16 rad for the MOSA angle); ~4x above
+    # measured 4.4e-16 / 4.4e-16 / 5.6e-16 for T_S_I, 2.2e-16 rad for the MOSA angle; ~4x above
     assert err_T < 2e-15 and err_th < 1e-15
+    record_number(f"coupled.in_loop_vs_post.{law}", err_T)
 
 
 @pytest.mark.slow

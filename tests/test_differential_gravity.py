@@ -99,7 +99,7 @@ def test_pm_difference_vs_mpmath():
     # direct method's float64 planets, ~2e-7 m/s^2 each, carry ~1e-22)
     ("lisa", (), 0.3, 1e-28),
 ])
-def test_point_masses_vs_mpmath(name, overrides, dist, bound):
+def test_point_masses_vs_mpmath(name, overrides, dist, bound, record_number):
     scen, model, system = _model(name, overrides)
     y0 = initial_state(scen, model, system)
     rng = np.random.default_rng(3)
@@ -114,9 +114,10 @@ def test_point_masses_vs_mpmath(name, overrides, dist, bound):
                                                     model.params, model.layout))
                 worst = max(worst, np.abs(got - _mp_point_masses(r, d, tdat, model)).max())
     assert worst < bound
+    record_number(f"differential.point_masses_vs_mpmath.{name}", worst, "m/s^2")
 
 
-def test_degree2_midpoint_jacobian_vs_dd():
+def test_degree2_midpoint_jacobian_vs_dd(record_number):
     # the Earth's degree 2 (static + solid tides) alone: midpoint Jacobian vs the dd difference
     scen, model, _ = _model("tianqin", ["forces.earth_monopole=false", "forces.earth_degree=2", "forces.third_bodies=[]",
                                         "forces.moon_degree=0", "forces.relativity=false", "forces.sun_j2=false",
@@ -147,9 +148,10 @@ def test_degree2_midpoint_jacobian_vs_dd():
     assert 1e-16 < size < 5e-15  # |J2 d| at 1e8 m, d = 0.2 m
     # measured 2.0e-30 m/s^2 (float64 round-off of the 2e-15 m/s^2 product)
     assert worst < 1e-29
+    record_number("differential.degree2_jacobian_vs_dd", worst, "m/s^2")
 
 
-def test_moon_truncation_at_degree_4():
+def test_moon_truncation_at_degree_4(record_number):
     # the Moon's degrees 5..7 in the differential gravity of a TianQin satellite (GL0660B, degree 7)
     scen, model, system = _model("tianqin")
     y0 = initial_state(scen, model, system)
@@ -168,6 +170,7 @@ def test_moon_truncation_at_degree_4():
     assert deg3 > 1e-25  # degree 3 matters at the 1e-24 level: it is kept
     # measured 4.0e-28 m/s^2 for degrees 5..7
     assert worst < 2e-27
+    record_number("differential.moon_degrees_5_7", worst, "m/s^2")
 
 
 @pytest.mark.parametrize("name, overrides, bound", [
@@ -181,7 +184,7 @@ def test_moon_truncation_at_degree_4():
     # planets at positions rounded to 3e-5 m)
     ("lisa", ("forces.relativity=true", "forces.relativity_model=eih"), 1e-21),
 ])
-def test_full_model_agrees_with_the_direct_method(name, overrides, bound):
+def test_full_model_agrees_with_the_direct_method(name, overrides, bound, record_number):
     scen, model, system = _model(name, overrides)
     y0 = initial_state(scen, model, system)
     worst = {"tm_a_suspension": 0.0, "a_dragfree": 0.0}
@@ -196,9 +199,11 @@ def test_full_model_agrees_with_the_direct_method(name, overrides, bound):
             worst[key] = max(worst[key], np.abs(views[0][key] - views[1][key]).max())
     print(f"{name} {overrides}: differential - direct {worst}")
     assert max(worst.values()) < bound
+    key = name + ("_eih" if any("eih" in o for o in overrides) else "")
+    record_number(f"differential.vs_direct.{key}", max(worst.values()), "m/s^2")
 
 
-def test_ten_day_run_agrees_with_the_direct_method():
+def test_ten_day_run_agrees_with_the_direct_method(record_number):
     # 10 days of coupled TianQin (full model, drag-free): the two methods differ per evaluation
     # by the ~4e-25 m/s^2 round-off of the float64 terms (above), which the orbits integrate;
     # measured 2.3e-15 m, 5.9e-20 m/s.
@@ -211,3 +216,4 @@ def test_ten_day_run_agrees_with_the_direct_method():
     d = (finals[0][..., 0] - finals[1][..., 0]) + (finals[0][..., 1] - finals[1][..., 1])
     assert np.abs(d[:, :3]).max() < 1e-14
     assert np.abs(d[:, 3:]).max() < 3e-19
+    record_number("differential.vs_direct_10d_m", float(np.abs(d[:, :3]).max()), "m")

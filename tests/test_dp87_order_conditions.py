@@ -162,10 +162,12 @@ def test_shapes():
         assert len(vector) == tab.STAGES
 
 
-def test_corrected_b_is_order_8(corrected):
-    """Reference: all 200 order conditions Phi(t) = 1/gamma(t), |t| <= 8.
-    README: "the shipped tableau satisfies them to 5e-41" (measured 5.3e-41)."""
-    assert worst(residuals(corrected, "b", 8)) <= mpf("3e-40")
+def test_corrected_b_is_order_8(corrected, record_number):
+    """Reference: all 200 order conditions Phi(t) = 1/gamma(t), |t| <= 8 (measured 5.3e-41; README and
+    docs/precision.md quote it)."""
+    w = worst(residuals(corrected, "b", 8))
+    assert w <= mpf("3e-40")
+    record_number("dp87.corrected_order_conditions", float(w))
 
 
 def test_corrected_bhat_is_order_7(corrected):
@@ -192,10 +194,10 @@ def test_zero_pattern_is_published_one():
         assert pattern(pub) == pattern(cor)
 
 
-def test_corrections_are_tiny(corrected, published):
+def test_corrections_are_tiny(corrected, published, record_number):
     """Reference: published rationals; the correction must not be a new method.
 
-    README: every coefficient is corrected "by at most 2.2e-17 relative" (measured 2.16e-17): relative bound
+    docs/precision.md: every coefficient is corrected by at most 2.16e-17 relative (measured): relative bound
     1e-16, absolute below |value| = 1e-3 (all published nonzero coefficients are larger than 1e-2, so in
     practice this is relative).  The corrections are not all zero (the published tableau's defect, below,
     needs them): the largest is above 3e-18.
@@ -206,18 +208,21 @@ def test_corrections_are_tiny(corrected, published):
         pairs += list(zip(published[key], corrected[key]))
     for pub, cor in pairs:
         assert abs(cor - pub) <= mpf("1e-16") * max(abs(pub), mpf("1e-3"))
-    assert max(abs(cor - pub) / abs(pub) for pub, cor in pairs if pub != 0) > mpf("3e-18")
+    largest = max(abs(cor - pub) / abs(pub) for pub, cor in pairs if pub != 0)
+    assert largest > mpf("3e-18")
+    record_number("dp87.largest_relative_correction", float(largest))
 
 
-def test_published_b_is_order_7_but_not_exactly_order_8(published):
+def test_published_b_is_order_7_but_not_exactly_order_8(published, record_number):
     """Reference: order conditions |t| <= 7 and |t| = 8.
 
-    The published rationals satisfy them only to ~6.5e-18 (README; measured: 6.5e-18 for |t| <= 7, 6.4e-18 for
-    |t| = 8); this defect is why the corrected tableau is the default.  Bounds ~3-5x either side.
+    The published rationals satisfy them only to ~6.5e-18 (docs/precision.md; measured: 6.5e-18 for |t| <= 7,
+    6.4e-18 for |t| = 8); this defect is why the corrected tableau is the default.  Bounds ~3-5x either side.
     """
     assert mpf("1e-18") < worst(residuals(published, "b", 7)) <= mpf("3e-17")
     order8 = worst(residuals(published, "b", 8, min_order=8))
     assert mpf("1e-18") < order8 < mpf("3e-17")
+    record_number("dp87.published_order_conditions", float(max(order8, worst(residuals(published, "b", 7)))))
 
 
 def test_bhat_is_not_order_8(corrected):

@@ -105,7 +105,7 @@ def test_long_term_model(auto):
     assert abs(lod_bar) < 3e-3
 
 
-def test_junctions_continuous(auto):
+def test_junctions_continuous(auto, record_number):
     """The interpolant is continuous at every junction to round-off (left and right limits at each
     first node of a segment agree to |slope| x 1e-9 d + 1e-16); the steps between the sources' values
     there are measured (printed): C04 -> finals measured < 1 mas, 0.1 ms; predicted -> long-term: the
@@ -128,9 +128,11 @@ def test_junctions_continuous(auto):
           f"predicted -> long-term pole {step_pole / ARCSEC:.3f}\"")
     assert step_pm < 1e-3 * ARCSEC and step_ut < 1e-4
     assert step_pole < 0.6 * ARCSEC
+    record_number("eop.junction_steps", {"c04_finals_pm_mas": step_pm / ARCSEC * 1e3, "c04_finals_ut1_us": step_ut * 1e6,
+                                         "predicted_longterm_pole_arcsec": step_pole / ARCSEC})
 
 
-def test_long_term_error_statistics():
+def test_long_term_error_statistics(record_number):
     """The numbers of the eop_sources docstring, from the 20 C04 series: UT1-TAI extrapolated with the
     mean LOD of the previous 365 days vs held (LOD = 0), for start dates 30 d apart from 1975; the pole
     minus the IERS 2010 mean pole since 2010."""
@@ -153,6 +155,10 @@ def test_long_term_error_statistics():
     assert rms[1][0] < 0.2 and rms[10][0] < 4.0  # docstring: 0.09 s, 2.3 s
     assert rms[1][1] > 3 * rms[1][0] and rms[10][1] > 1.5 * rms[10][0]  # holding is worse
     assert 0.05 < np.sqrt(np.mean(off ** 2)) < 0.25 and off.max() < 0.4  # docstring: 0.12", 0.25"
+    record_number("eop.long_term_statistics", {"ut1_1y": list(rms[1]), "ut1_10y": list(rms[10]),
+                                               "pole_rms_arcsec": float(np.sqrt(np.mean(off ** 2))),
+                                               "pole_max_arcsec": float(off.max())},
+                  "s (extrapolated rms, held rms, extrapolated max); arcsec")
 
 
 def test_truncate_and_extend():
@@ -299,7 +305,7 @@ def _long_term_from(d0):
     return meas, es.with_long_term(es.truncate(meas, d0 - 1), last_mjd=d0 + 60)
 
 
-def test_long_term_force_difference_past_30_days():
+def test_long_term_force_difference_past_30_days(record_number):
     """The full force model of the tianqin scenario along the TianQin orbits (two-body samples every
     30 min over 2025-03-01..31): long-term model (from 2025-03-01) minus measured 20 C04, and the
     sensitivities to 1 s of UT1 and 0.1" of polar motion.  Measured: 3.8e-13 m/s^2 max, 2.6e-13 rms."""
@@ -333,6 +339,11 @@ def test_long_term_force_difference_past_30_days():
           f"{d_ut1.max():.2e}, per 0.1\" of x_p {d_pm.max():.2e} m/s^2 (max)")
     assert 1e-13 < d.max() < 1.2e-12 and np.sqrt(np.mean(d ** 2)) < d.max()  # measured 3.8e-13
     assert 1.4e-13 < d_ut1.max() < 1.3e-12 and 8e-14 < d_pm.max() < 7e-13  # measured 4.2e-13, 2.4e-13
+    record_number("eop.long_term_force_30d", {"max": d.max(), "rms": float(np.sqrt(np.mean(d ** 2))),
+                                              "ut1_error_s": float(np.abs(vl.dut1 - vm.dut1).max()),
+                                              "pole_apart_arcsec": float(np.hypot(vl.xp - vm.xp, vl.yp - vm.yp).max()
+                                                                         / ARCSEC),
+                                              "per_1s_ut1": d_ut1.max(), "per_0.1as_pm": d_pm.max()}, "m/s^2")
 
 
 def _final_positions(scen, eop):
@@ -342,7 +353,7 @@ def _final_positions(scen, eop):
 
 
 @pytest.mark.slow
-def test_long_term_position_difference_10_days():
+def test_long_term_position_difference_10_days(record_number):
     """The tianqin scenario (full model, drag-free, global pointing) from 2025-03-01, 10 days: long-term
     model vs measured 20 C04 (~15 s).  Measured: 11.5, 2.3, 14.3 mm."""
     meas, lt = _long_term_from(D0)
@@ -350,10 +361,11 @@ def test_long_term_position_difference_10_days():
     dr = np.linalg.norm(_final_positions(scen, lt) - _final_positions(scen, meas), axis=1)
     print(f"\nlong-term - measured EOP from 2025-03-01, 10 d: |dr| = {', '.join(f'{x * 1e3:.1f}' for x in dr)} mm")
     assert 3e-3 < dr.max() < 5e-2
+    record_number("eop.long_term_position_10d_m", dr, "m")
 
 
 @pytest.mark.slow
-def test_builtin_scenario_c04_14_vs_auto():
+def test_builtin_scenario_c04_14_vs_auto(record_number):
     """The built-in tianqin scenario (2004-06-06, 10 days): "auto" (20 C04 there) vs the paper-era "c04-14"
     (~15 s).  Measured: 5.7, 4.8, 2.6 um."""
     scen = load_scenario("tianqin")
@@ -361,3 +373,4 @@ def test_builtin_scenario_c04_14_vs_auto():
                         axis=1)
     print(f"\ntianqin 10 d, auto - c04-14: |dr| = {', '.join(f'{x * 1e6:.2f}' for x in dr)} um")
     assert dr.max() < 5e-5
+    record_number("eop.c04_14_vs_auto_10d_m", dr, "m")

@@ -22,14 +22,12 @@ Independent references used here:
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import erfa
 import numpy as np
 import pytest
 
-from tqdyn.astro import earth_orientation as frames
 from tqdyn.astro.eop import ARCSEC, EOP, tidal_arguments, tidal_eop_corrections
 from tqdyn.astro.eop import load_eop
 from tqdyn.readers.iers_tables import load_tidal_eop_terms
@@ -223,24 +221,3 @@ def test_memo_and_read_only(ep):
     assert d is not a
     with pytest.raises(ValueError):
         a.T_ITRS_GCRS[0, 0, 0] = 1.0
-
-
-def test_timing_53000_instants(ep):
-    # one chunk of the propagator: 4096 DP87 steps of 50 s x 13 stages ~ 53,000 instants
-    n = 4096 * 13
-    t = np.sort(np.random.default_rng(1).uniform(30 * DAY, 30 * DAY + 4096 * 50.0, n))
-    earth_orientation(ep, t[:100], 0.0)  # compile / load kernels
-    out = {}
-    for tides in (True, False):
-        best = np.inf
-        for k in range(3):
-            frames._memo.clear()
-            t0 = time.perf_counter()
-            earth_orientation(ep, t + k, 0.0, tidal_eop=tides)
-            best = min(best, time.perf_counter() - t0)
-        out[tides] = best
-    t0 = time.perf_counter()
-    earth_orientation(ep, t + 2, 0.0, tidal_eop=False)
-    memo = time.perf_counter() - t0
-    print(f"\nearth_orientation, {n} instants: {out[True] * 1e3:.1f} ms (with sub-daily EOP terms), "
-          f"{out[False] * 1e3:.1f} ms (without); memoised repeat {memo * 1e3:.2f} ms")

@@ -81,13 +81,13 @@ def _dist(a, b) -> float:
     return max(float(mpmath.sqrt(sum((x - y) ** 2 for x, y in zip(p, q)))) for p, q in zip(a, b))
 
 
-def test_mixed_precision_claim_one_day():
+def test_mixed_precision_claim_one_day(record_number):
     """Full model, 1 day: the default mixed run (dd monopole, Moon, Sun,
     degree 2; float64 for the rest) against a run with every third body in
-    dd as well: 3.3e-17 m (README).  The terms still in float64 are <= 3e-10 m/s^2
+    dd as well: measured 3.3e-17 m (docs/force-model.md, docs/design.md).  The terms still in float64 are <= 3e-10 m/s^2
     (Earth degree 3), so by the scaling above they contribute < 1e-16 m.
     Without the extended Moon/Sun/degree-2 evaluation the run differs by
-    9.7e-13 m (README): the reason for the default."""
+    9.7e-13 m (measured): the reason for the default."""
     default = _final([])
     all_ext = _final([f"forces.third_bodies_extended={ALL_BODIES}"])
     plain = _final(["forces.third_bodies_extended=[]", "forces.earth_degree2_extended=false"])
@@ -95,7 +95,9 @@ def test_mixed_precision_claim_one_day():
     d_plain = _dist(plain, all_ext)
     print(f"\n1 day, full model: |default - all third bodies dd| = {d_default:.2e} m; "
           f"|all float64 perturbations - all third bodies dd| = {d_plain:.2e} m")
-    # README: 3.3e-17 m and 9.7e-13 m (measured 3.29e-17 and 9.67e-13 m); bounds ~5-7x either side.  Neither may
+    # measured 3.29e-17 and 9.67e-13 m; bounds ~5-7x either side.  Neither may
     # vanish: the planets stay float64 in the default run, and float64 round-off of the lunar term accumulates.
     assert 5e-18 < d_default < 2e-16
     assert 2e-13 < d_plain < 5e-12
+    record_number("mixed_precision.default_vs_all_dd_1d_m", d_default, "m")
+    record_number("mixed_precision.all_float64_vs_default_1d_m", d_plain, "m")

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import cmath
 import math
-import time
 
 import numpy as np
 import pytest
@@ -125,18 +124,3 @@ def test_magnitude_at_tianqin_distance():
           f"degrees 5-10 {high:.2e} m/s^2")
     assert 1e-14 < total < 1e-11
     assert high < 1e-15
-
-
-def test_precompute_speed_53000_instants():
-    n = 53000
-    t = np.linspace(0.0, 4096 * 50.0, n)
-    eo = standin_orientation(EPOCH, t, cheap=True)
-    prov = OceanTides(nmax=10)
-    prov.evaluate(eo)
-    times = []
-    for _ in range(3):
-        t0 = time.perf_counter()
-        prov.evaluate(eo)
-        times.append(time.perf_counter() - t0)
-    print(f"\nocean tides (n <= 10), 53,000 instants: {min(times) * 1e3:.1f} ms")
-    assert min(times) < 1.0  # generous for loaded CI machines; target ~50 ms

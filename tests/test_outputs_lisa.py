@@ -201,7 +201,7 @@ def _esa_on_grid(tr):
     return a, geometry.breathing_angles(a)[0]
 
 
-def test_cli_report_lisa_year(lisa_year, tmp_path, capsys, monkeypatch):
+def test_cli_report_lisa_year(lisa_year, tmp_path, capsys, monkeypatch, record_number):
     captured = {}
     real = rp.report_runs
 
@@ -257,9 +257,26 @@ def test_cli_report_lisa_year(lisa_year, tmp_path, capsys, monkeypatch):
     assert np.all(act["A_sensitive"] < 3e-15 * 2e-9)
     # the suspension across them: measured 6.4e-16 m/s^2 at most (3e-15: 5x), and not zero
     assert 1e-16 < act["A_max"].max() < 3e-15
+    # docs/report.md, "A year of lisa": the report's numbers and their differences to ESA's files
+    values = {}
+    for key, v in rep.values.items():
+        if key.startswith("lisa/") and key != "lisa/spacecraft":
+            *path, last = key.split("/")[1:]
+            node = values
+            for p in path:
+                node = node.setdefault(p, {})
+            node[last] = v
+    record_number("report.lisa_year", {
+        **values, "A_per_tm_axis": act["A_axis"].max(axis=0),
+        "vs_esa": {"mean_m": arms["mean"] - L.mean(), "min_m": arms["min"] - L.min(), "max_m": arms["max"] - L.max(),
+                   "rate_min": arms["rate_min"] - Ld.min(), "rate_max": arms["rate_max"] - Ld.max(),
+                   "angle_lo_deg": lo - np.degrees(esa_alpha.min()), "angle_hi_deg": hi - np.degrees(esa_alpha.max())},
+        "mean_over_design": arms["mean"] / 2.5e9 - 1, "A_sensitive_over_G": float(act["A_sensitive"].max() / 2e-9),
+        "G_mean_rel_error": float(np.max(np.abs(act["G_mean_S"][:, 0] / ramp_mean - 1))),
+        "G_across_max": float(np.max(act["G_axis_S"][:, 1:]))})
 
 
-def test_taiji_and_tianqin_references(tmp_path, tianqin_short):
+def test_taiji_and_tianqin_references(tmp_path, tianqin_short, record_number):
     """The constellation a report compares with: Taiji's 3e9 m design for the taiji architecture (mean arm over a
     year measured -0.17 % of it: 1 % bound, 6x), TianQin's sqrt(3) x 1e5 km for geocentric files (the mean
     over this hour of the cheap model measured +1.5e-5 of it: 1e-4 bound, 7x)."""
@@ -277,6 +294,12 @@ def test_taiji_and_tianqin_references(tmp_path, tianqin_short):
     # difference's truncation; 1e-4: 5x)
     dt = 21600.0
     assert np.max(np.abs((L[2:] - L[:-2]) / (2 * dt) - rate[1:-1])) < 1e-4
+    alpha = np.degrees(metrics.breathing_angles_of(tr))
+    record_number("report.taiji_year", {"arm_min_m": float(L.min()), "arm_max_m": float(L.max()),
+                                        "mean_over_design": float(L.mean() / 3e9 - 1), "rate_min": float(rate.min()),
+                                        "rate_max": float(rate.max()), "angle_min_deg": float(alpha.min()),
+                                        "angle_max_deg": float(alpha.max()),
+                                        "G_max": float(np.linalg.norm(tr["sat/a_dragfree"], axis=-1).max())})
 
     tq = io.read_trajectory(tianqin_short)
     assert constellation_reference(tq) is metrics.TIANQIN

@@ -11,7 +11,6 @@ References:
 
 from __future__ import annotations
 
-import time
 
 import mpmath
 import numpy as np
@@ -121,16 +120,3 @@ def test_magnitudes_at_tianqin_distance():
     print(f"\npole tides at r = 1e8 m (2004-06-06): solid {a_solid:.2e}, ocean (degree 2) {a_ocean:.2e} m/s^2")
     assert 1e-14 < a_solid < 1e-12
     assert 1e-15 < a_ocean < a_solid
-
-
-def test_speed_53000_instants():
-    t = np.linspace(0.0, 4096 * 50.0, 53000)
-    eo = standin_orientation(EPOCH, t, cheap=True)
-    prov = SolidPoleTide()
-    best = 1e9
-    for _ in range(3):
-        t0 = time.perf_counter()
-        prov.evaluate(eo)
-        best = min(best, time.perf_counter() - t0)
-    print(f"\npole tide, 53,000 instants: {best * 1e3:.1f} ms")
-    assert best < 0.5

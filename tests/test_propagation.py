@@ -172,20 +172,21 @@ def ecc10():
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_kepler_10_days_dd_final_error(which, request):
+def test_kepler_10_days_dd_final_error(which, request, record_number):
     scen, res, _ = request.getfixturevalue(which + "10")
     assert res.n_steps == 17280 and res.precision == "dd"
     assert el.from_dd(*res.t_final) == 10 * DAY
     err = final_pos_error(res, scen)
     print(f"\n[{which}] 10 d, h = 50 s, dd: |r - r_kepler| = {err:.3e} m  (wall {res.wall_s:.2f} s)")
-    # README "Measured": 3.8e-23 m (circular) and 4.8e-21 m (e = 0.1), requirement < 1e-12 m.  Measured 3.77e-23 and
-    # 4.78e-21 m; bounds ~3-5x either side.  The error is the DP87 truncation error of the 50 s step (the dd
+    # docs/precision.md ("Measured"); requirement < 1e-12 m.  Measured 3.77e-23 (circular) and 4.78e-21 m
+    # (e = 0.1); bounds ~3-5x either side.  The error is the DP87 truncation error of the 50 s step (the dd
     # rounding is ~7e-25 m per day, test_dd_rounding_vs_mpmath_dp87), so it cannot vanish either.
     low, high = {"circ": (1e-23, 1.5e-22), "ecc": (1e-21, 2e-20)}[which]
     assert low < err < high
+    record_number(f"precision.kepler_10d_{which}_dd_final_m", err, "m")
 
 
-def test_kepler_circular_every_row_dd(circ10):
+def test_kepler_circular_every_row_dd(circ10, record_number):
     scen, res, (t, r, v, a) = circ10
     assert t.shape[0] == 17281  # rows at n = 0..17280
     assert np.array_equal(t[:, 0], 50.0 * np.arange(17281)) and not t[:, 1].any()
@@ -193,15 +194,16 @@ def test_kepler_circular_every_row_dd(circ10):
     assert np.array_equal(r[-1, 0], res.y_final[0, 0:3])
     worst, t_worst = rows_max_error(t, r, scen.satellites[0])
     print(f"\n[circ] max over all 17281 rows of |r - r_kepler| = {worst:.3e} m (at t = {t_worst:.0f} s)")
-    # README: worst row 1.2e-22 m (measured 1.23e-22 m, at t = 715900 s); truncation error, not zero
+    # measured 1.23e-22 m, at t = 715900 s (docs/precision.md); truncation error, not zero
     assert 3e-23 < worst < 5e-22
+    record_number("precision.kepler_10d_circ_dd_worst_row_m", worst, "m")
 
 
 # --------------------------------------------------------------------------
 # 2. float64 mode of the same circular run
 
 
-def test_kepler_circular_float64_is_worse(circ10):
+def test_kepler_circular_float64_is_worse(circ10, record_number):
     scen, res_dd, _ = circ10
     sink = RowCollector()
     res = prop.propagate(scen, precision="float64", sink=sink)
@@ -214,9 +216,10 @@ def test_kepler_circular_float64_is_worse(circ10):
     err_dd = final_pos_error(res_dd, scen)
     print(f"\n[circ] 10 d float64: |r - r_kepler| = {err64:.3e} m; dd: {err_dd:.3e} m; ratio {err64 / err_dd:.2e}"
           f"  (float64 wall {res.wall_s:.2f} s)")
-    # README: 7.3e-7 m for float64 ("visibly worse"); measured 7.33e-7 m, 2e16 times the dd error
+    # docs/precision.md ("visibly worse"); measured 7.33e-7 m, 2e16 times the dd error
     assert 2e-7 < err64 < 3e-6
     assert err64 >= 1e15 * err_dd
+    record_number("precision.kepler_10d_circ_float64_final_m", err64, "m")
 
 
 # --------------------------------------------------------------------------
@@ -232,7 +235,7 @@ def circ1_both_tableaux():
     return out
 
 
-def test_dd_rounding_vs_mpmath_dp87(circ1_both_tableaux):
+def test_dd_rounding_vs_mpmath_dp87(circ1_both_tableaux, record_number):
     scen, res = circ1_both_tableaux["corrected"]
     assert res.n_steps == 1728
     coef = dp87.step_coefficients(dp87.load_tableau("corrected"), scen.integrator.step_s, "dd")
@@ -244,14 +247,15 @@ def test_dd_rounding_vs_mpmath_dp87(circ1_both_tableaux):
     err_kepler = final_pos_error(res, scen)
     print(f"\n[circ] 1 d, 1728 steps: |r_dd - r_mpDP87| = {dr:.3e} m, |v_dd - v_mpDP87| = {dv:.3e} m/s; "
           f"|r_dd - r_kepler| = {err_kepler:.3e} m")
-    # README: 6.8e-25 m after 1 day (requirement < 1e-21 m); measured 6.84e-25 m and 1.86e-29 m/s.  The dd
+    # docs/precision.md (requirement < 1e-21 m); measured 6.84e-25 m and 1.86e-29 m/s.  The dd
     # arithmetic cannot agree with the 50-digit run exactly: an agreement far below its rounding (1728 steps x
     # 13 stages x ~1e-32 relative of 1e8 m) would mean the comparison is not independent.
     assert 1e-25 < dr < 3e-24
     assert dv < 1e-28
+    record_number("precision.rounding_vs_mpmath_1d_m", dr, "m")
 
 
-def test_published_tableau_method_error(circ1_both_tableaux):
+def test_published_tableau_method_error(circ1_both_tableaux, record_number):
     scen_c, res_c = circ1_both_tableaux["corrected"]
     scen_p, res_p = circ1_both_tableaux["published"]
     diff = float(dist(P.mp_from_dd(res_c.y_final[0, 0:3]), P.mp_from_dd(res_p.y_final[0, 0:3])))
@@ -259,18 +263,19 @@ def test_published_tableau_method_error(circ1_both_tableaux):
     err_p = final_pos_error(res_p, scen_p)
     print(f"\n[circ] 1 d: |r_corrected - r_published| = {diff:.3e} m; vs Kepler: corrected {err_c:.3e} m, "
           f"published {err_p:.3e} m")
-    # README: the published tableau errs by 6.4e-10 m after a day ("~1e-10 m", precision design); measured
+    # README and docs/precision.md: the published tableau's error after a day; measured
     # 6.36e-10 m, bounds ~3x either side (the order-8 defect of the printed coefficients is not zero); the
     # corrected tableau 7.03e-23 m (truncation, as in the 10-day runs)
     assert 2e-10 < diff < 2e-9
     assert 2e-10 < err_p < 2e-9
+    record_number("precision.published_tableau_1d_m", err_p, "m")
     assert 2e-23 < err_c < 3e-22
 
 
 @pytest.mark.slow
-def test_dd_rounding_vs_mpmath_dp87_90_days():
-    """README: ``benchmarks/bench_rounding.py --days 90`` gives 1.2e-22 m and 2.4e-27 m/s: the same comparison as
-    above over 155,520 steps (the 50-digit reference takes ~2.5 min)."""
+def test_dd_rounding_vs_mpmath_dp87_90_days(record_number):
+    """docs/precision.md (also ``benchmarks/bench_rounding.py --days 90``): the same comparison as above over
+    155,520 steps (the 50-digit reference takes minutes).  Measured 1.2e-22 m and 2.4e-27 m/s."""
     scen = make_scenario(CIRC, duration="90d")
     res = prop.propagate(scen, precision="dd")
     assert res.n_steps == 155520
@@ -280,9 +285,11 @@ def test_dd_rounding_vs_mpmath_dp87_90_days():
     dr = float(dist(y_dd[0:3], y_mp[0:3]))
     dv = float(dist(y_dd[3:6], y_mp[3:6]))
     print(f"\n[circ] 90 d: |r_dd - r_mpDP87| = {dr:.3e} m, |v_dd - v_mpDP87| = {dv:.3e} m/s")
-    # README 1.2e-22 m / 2.4e-27 m/s; bounds ~4x either side (rounding of 155,520 dd steps is not zero)
+    # bounds ~4x either side of the measured values (rounding of 155,520 dd steps is not zero)
     assert 3e-23 < dr < 5e-22
     assert 6e-28 < dv < 1e-26
+    record_number("precision.rounding_vs_mpmath_90d_m", dr, "m")
+    record_number("precision.rounding_vs_mpmath_90d_mps", dv, "m/s")
 
 
 # --------------------------------------------------------------------------
@@ -290,7 +297,7 @@ def test_dd_rounding_vs_mpmath_dp87_90_days():
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_energy_conserved_10_days(which, request):
+def test_energy_conserved_10_days(which, request, record_number):
     scen, res, _ = request.getfixturevalue(which + "10")
     e0, e1 = energy(res.y0)[0], energy(res.y_final)[0]
     with mpmath.workdps(DPS):
@@ -301,7 +308,7 @@ def test_energy_conserved_10_days(which, request):
     print(f"\n[{which}] 10 d energy: relative drift (mpmath) {drift:.3e}, RunResult {res.energy_rel_drift[0]:.3e}; "
           f"initial-state rounding {init:.3e}")
     assert res.energy_rel_drift is not None and res.energy_rel_drift.shape == (1,)
-    # README: 7.0e-32 (circular) / 2.8e-30 (e = 0.1) relative, requirement < 1e-28; measured -7.01e-32 and -2.82e-30.
+    # docs/precision.md, requirement < 1e-28; measured -7.01e-32 (circular) and -2.82e-30 (e = 0.1).
     # Upper bounds ~4x above; e = 0.1 also a lower one: its drift is the truncation error of the step (100x the
     # dd resolution), while the circular one is at the rounding level (6 ulp) and may be smaller.
     high = {"circ": 3e-31, "ecc": 1e-29}[which]
@@ -311,6 +318,7 @@ def test_energy_conserved_10_days(which, request):
     assert abs(res.energy_rel_drift[0]) < high
     assert abs(res.energy_rel_drift[0] - drift) <= 1e-6 * abs(drift) + 1e-40
     assert abs(init) < 1e-30
+    record_number(f"precision.energy_drift_10d_{which}", abs(drift))
 
 
 # --------------------------------------------------------------------------
@@ -347,24 +355,27 @@ def _adaptive_check(rtol: str, out_step: str = "600"):
     return res, err
 
 
-def test_adaptive_meets_tolerance():
+def test_adaptive_meets_tolerance(record_number):
     res14, err14 = _adaptive_check("1e-14")
     res18, err18 = _adaptive_check("1e-18")
     assert err18 < err14
     assert res18.n_steps > res14.n_steps
-    # README: 8.9e-11 m (rtol 1e-14) and 6.3e-16 m (rtol 1e-18) after 10 days; measured 8.95e-11 and 6.34e-16 m.
+    # docs/precision.md; measured 8.95e-11 m (rtol 1e-14) and 6.34e-16 m (rtol 1e-18) after 10 days.
     # Bounds ~3-5x either side: an error orders of magnitude below what the tolerance allows would mean the
     # controller takes far more steps than needed (the bound n_steps * rtol * r itself is 1e7 times looser).
     assert 2e-11 < err14 < 4e-10
     assert 1.5e-16 < err18 < 3e-15
+    record_number("precision.adaptive_rtol1e-14_m", err14, "m")
+    record_number("precision.adaptive_rtol1e-18_m", err18, "m")
 
 
-def test_adaptive_tight_tolerance():
-    """rtol 1e-22 (~3.5 s; README: 4.3e-23 m)."""
+def test_adaptive_tight_tolerance(record_number):
+    """rtol 1e-22 (docs/precision.md)."""
     res, err = _adaptive_check("1e-22")
     assert res.n_rejected > 0
     # measured 4.34e-23 m (34485 steps, 642 rejected): at the dd rounding of 34485 steps (~1e-32 x 1e8 m each)
     assert 1e-23 < err < 2e-22
+    record_number("precision.adaptive_rtol1e-22_m", err, "m")
 
 
 # --------------------------------------------------------------------------
@@ -376,7 +387,7 @@ QUERY_OFFSETS = ("17.3", "25", "41.9")
 
 
 @pytest.mark.parametrize("which", ["circ", "ecc"])
-def test_dense_output_vs_direct_and_kepler(which, request):
+def test_dense_output_vs_direct_and_kepler(which, request, record_number):
     """Hermite dense output from the stored rows (t, r, v in dd; a_gravity in
     float64) at instants between the 50 s nodes, vs a direct compiled DP87
     step of the same length from the stored node state and vs Kepler.
@@ -425,14 +436,16 @@ def test_dense_output_vs_direct_and_kepler(which, request):
     assert worst_direct_kepler < 1e-20
     for key, val in worst.items():
         assert val < 1e-13, key
-    # README: 2.3e-15 m (quintic, 2 nodes) / 2.4e-16 m (4-node Hermite) with the stored float64 accelerations;
-    # measured circ 2.31e-15 / 2.43e-16, ecc 2.14e-15 / 1.50e-16 m.  Bounds ~4x above and ~5x below: the quintic's
+    # docs/precision.md, with the stored float64 accelerations: measured circ 2.31e-15 (quintic, 2 nodes) /
+    # 2.43e-16 (4-node Hermite), ecc 2.14e-15 / 1.50e-16 m.  Bounds ~4x above and ~5x below: the quintic's
     # truncation error (h^6) and the 4-node interpolant's float64-acceleration floor are not zero.
     assert 5e-16 < worst[(2, "a64"), "direct"] < 1e-14
     assert 3e-17 < worst[(4, "a64"), "direct"] < 1e-15
     # the 4-node interpolant is the more accurate one; with dd accelerations by far
     assert worst[(4, "a64"), "direct"] < worst[(2, "a64"), "direct"] / 5
     assert worst[(4, "add"), "direct"] < 1e-20 and worst[(4, "add"), "kepler"] < 1e-20
+    record_number(f"precision.dense_quintic_{which}_m", worst[(2, "a64"), "direct"], "m")
+    record_number(f"precision.dense_hermite4_{which}_m", worst[(4, "a64"), "direct"], "m")
 
 
 # --------------------------------------------------------------------------
@@ -465,11 +478,10 @@ def _kepler_rows_error(scen, precision):
     return t[:, 0], err
 
 
-def test_tianqin_kepler_90_days():
-    """README, "What the precision buys" (docs/figures/kepler-error.png, tools/make_readme_figure.py) and the
-    Kepler benchmark table: the three TianQin satellites around a point-mass Earth, 90 days, every 12 h vs the
-    analytic solution.  dd at 50 s: stays below 1e-20 m, 6.7e-21 m at the end; float64: 1e-8 m after a day,
-    5.9e-6 m after 90 days; dd at 25 s: 5.2e-22 m ("halving the step gives 5e-22 m").  ~6 s."""
+def test_tianqin_kepler_90_days(record_number):
+    """README ("Precision and speed") and docs/precision.md (docs/figures/kepler-error.png,
+    tools/make_readme_figure.py): the three TianQin satellites around a point-mass Earth, 90 days, every 12 h vs
+    the analytic solution: dd at 50 s, float64, dd at 25 s."""
     half_day = 864  # output rows every 12 h
     scen = sc.load_scenario("tianqin-kepler", ["run.duration=90d", f"run.output_every={half_day}"])
     assert scen.n_steps == 155520
@@ -481,15 +493,20 @@ def test_tianqin_kepler_90_days():
     assert np.array_equal(t, t25) and t[-1] == 90 * DAY and t[2] == DAY
     print(f"\n[tianqin-kepler] 90 d vs Kepler: dd 50 s max over rows {dd[1:].max():.2e} m, final {dd[-1]} m; "
           f"float64 after 1 d {f64[2]} m, final {f64[-1]} m; dd 25 s final {dd25[-1]} m")
-    # dd, 50 s: measured max 6.71e-21 m (the final row; README: "below 1e-20 m", bench 6.7e-21 m): the DP87
-    # truncation error grows linearly; bounds ~3x either side of the final value, and the README's 1e-20 m
+    # dd, 50 s: measured max 6.71e-21 m (the final row): the DP87 truncation error grows linearly; bounds ~3x
+    # either side of the final value, and below 1e-20 m over the whole run
     assert 2e-21 < dd[-1].max() < 2e-20
     assert dd[1:].max() < 1e-20
-    # float64: measured 1.8e-8 .. 3.9e-8 m after a day (README "reaches 1e-8 m in a day") and 1.2e-6 .. 5.9e-6 m
-    # after 90 days (README 5e-6 m, bench 5.9e-6 m): round-off, ~4x either side
+    # float64: measured 1.8e-8 .. 3.9e-8 m after a day and 1.2e-6 .. 5.9e-6 m after 90 days: round-off, ~4x
+    # either side
     assert 1e-8 < f64[2].max() < 1.5e-7
     assert 1.5e-6 < f64[-1].max() < 2.5e-5
-    # dd, 25 s: measured 5.22e-22 m (README 5e-22 / bench 5.2e-22 m); ~3-4x either side, and clearly below the
+    # dd, 25 s: measured 5.22e-22 m; ~3-4x either side, and clearly below the
     # 50 s run's error (8th order: the truncation error falls by 2^8; what remains is rounding of 311,040 steps)
     assert 1.5e-22 < dd25[-1].max() < 2e-21
     assert dd25[-1].max() < dd[-1].max() / 5
+    record_number("precision.tianqin_kepler_90d_dd_max_m", dd[1:].max(), "m")
+    record_number("precision.tianqin_kepler_90d_dd_final_m", dd[-1].max(), "m")
+    record_number("precision.tianqin_kepler_1d_float64_m", f64[2].max(), "m")
+    record_number("precision.tianqin_kepler_90d_float64_final_m", f64[-1].max(), "m")
+    record_number("precision.tianqin_kepler_90d_dd_25s_final_m", dd25[-1].max(), "m")

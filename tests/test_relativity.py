@@ -28,7 +28,6 @@ Lense-Thirring 4.6e-15 .. 3.4e-14, de Sitter 9e-13 .. 1.13e-11 m/s^2.
 from __future__ import annotations
 
 import math
-import time
 
 import erfa
 import mpmath
@@ -273,17 +272,3 @@ def test_magnitudes_along_tianqin_orbit():
     d = np.array([np.subtract(relativity_accel(*r[i], *v[i], tdat[i], p), relativity_accel(*r[i], *v[i], tdat_z[i], p))
                   for i in range(t.size)])
     assert 1e-18 < np.linalg.norm(d, axis=1).max() < 1e-16
-
-
-def test_precompute_speed_for_a_chunk():
-    """53,248 instants (4096 steps x 13 stages over 2.4 d): Sun state from
-    the ephemeris + CIP on 6 nodes.  Measured ~10-25 ms (2-core Xeon, shared)."""
-    t = np.sort(np.random.default_rng(5).uniform(0.0, 4096 * 50.0, 4096 * 13))
-    term = Relativity()
-    term.precompute(EPOCH, t[:10], 0.0)
-    best = math.inf
-    for _ in range(3):
-        t0 = time.perf_counter()
-        term.precompute(EPOCH, t, 0.0)
-        best = min(best, time.perf_counter() - t0)
-    assert best < 0.2, best

@@ -75,7 +75,8 @@ def test_unreachable_scheduler_gives_one_line_and_no_folder(tmp_path, capsys):
     addr = f"tcp://127.0.0.1:{_free_port()}"
     t0 = time.perf_counter()
     status, out, err = run_cli(["sweep", str(path), "-q", "--scheduler", addr, "--connect-timeout", "1"], capsys)
-    assert time.perf_counter() - t0 < 15
+    # not a speed claim: the wait ends after --connect-timeout (1 s), not the default 10 s (~2 s in all measured)
+    assert time.perf_counter() - t0 < 9
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and err.startswith(f"tqdyn: error: scheduler: {addr!r} cannot be reached")
     assert not (tmp_path / "sg-out").exists()

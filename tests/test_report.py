@@ -216,6 +216,11 @@ def test_cli_report_runs(runs, tmp_path, capsys):
     assert "| quantity | paper | tqdyn | agreement / notes |" in out
     assert (tmp_path / "o" / "summary.md").is_file() and (tmp_path / "o" / "dragfree-control.pdf").is_file()
     assert err == ""
+    import json
+
+    rec = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert rec["written_by"] == "tqdyn report" and rec["rows"] and "dragfree/control" in rec["values"]
+    assert rec["runs"][str(runs["dragfree"])]["file_mb"] > 0
 
 
 @pytest.mark.parametrize("args, match", [
@@ -261,8 +266,23 @@ def test_cli_one_study_quick_in_process(tmp_path, capsys):
     assert "\n| Fig. 9: extreme case, breathing angles over 1 d" in out
     assert {p.name for p in (tmp_path / "s").glob("fig9*")} == {"fig9-extreme-breathing.png",
                                                                "fig9-extreme-breathing.pdf"}
+    # summary.json: every number of the table with its provenance, the runs with their size and wall time
+    import json
+
+    rec = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert rec["written_by"] == "tqdyn report" and rec["command"].startswith("tqdyn report --studies --quick")
+    assert rec["machine"]["cores"] >= 1 and rec["libraries"]["numpy"] and rec["date"].endswith("Z")
+    assert rec["mission"] == "tianqin" and rec["duration_scale"] == pytest.approx(1 / 90)
+    assert [r["quantity"] for r in rec["rows"]][0].startswith("Fig. 9: extreme case, breathing angles over 1 d")
+    assert rec["values"]["extreme"]["range"][0] < 60 < rec["values"]["extreme"]["range"][1]
+    assert set(rec["runs"]) == {"gravity-90d", "sg-extreme-90d"}
+    assert all(r["status"] == "ran" and r["file_mb"] > 0 and r["wall_s"] > 0 and r["rows"] > 1
+               for r in rec["runs"].values())
+    assert rec["timing"]["n_runs"] == 2 and rec["timing"]["total_wall_s"] > 0
     code, out, err = _cli(args, capsys)
     assert code == 0 and "2 reused, 0 to run" in err
+    rec = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert all(r["status"] == "reused" and r["wall_s"] is None for r in rec["runs"].values())
 
 
 @pytest.mark.slow
@@ -404,7 +424,7 @@ def test_paper_studies_full_spans(tmp_path):
 
 
 @pytest.mark.slow
-def test_gravity_orbit_range_asd_is_the_earth_field():
+def test_gravity_orbit_range_asd_is_the_earth_field(record_number):
     """docs/report.md point 6: the Sat1-Sat3 light-path range ASD of the 30-day gravity orbits is 2.4 times the
     requirement at 0.100 mHz and below it from 0.104 mHz on; it is the orbits' response to the Earth's field:
     only the Earth's field (static field and tides) gives the same ratio (2.41), only the Moon and the Sun
@@ -454,3 +474,6 @@ def test_gravity_orbit_range_asd_is_the_earth_field():
         ratios.append(spectra.band_limited_max_ratio(f, a, 50.0, band=(1e-4, 1e-2))[0])
         assert _band(ratios[-1], quoted), (nperseg, ratios[-1])
     assert ratios[0] == pytest.approx(full.max_ratio, rel=1e-9) and max(ratios) / min(ratios) < 1.5
+    record_number("report.gravity_asd", {**{name: a.max_ratio for name, a in asd.items()}, "welch": ratios,
+                                         "kepler_at_0.1mHz": float(k.asd[sel][0] / spectra.requirement_asd(k.f[sel][0])),
+                                         "f_above_full": full.f_above})

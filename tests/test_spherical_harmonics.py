@@ -23,12 +23,10 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 
 import mpmath
 import numpy as np
 import pytest
-from numba import njit
 
 from tqdyn.readers.gravity_fields import egm2008
 from tqdyn.forces.spherical_harmonics import (
@@ -332,28 +330,3 @@ def test_magnitudes_along_tianqin_orbit(capsys):
     assert 1e-12 < mags[4] < 1e-10
     for n in range(3, 12):
         assert mags[n + 1] < 0.3 * mags[n]
-
-
-@njit
-def _time_loop(n, C, S, N, gm, R):
-    s = 0.0
-    for i in range(n):
-        u = i * 1e-3
-        a = sh_accel(1e8 * math.cos(u), 3e7 * math.sin(u), 9e7 * math.sin(u), gm, R, C, S, N)
-        s += a[0] + a[1] + a[2]
-    return s
-
-
-def test_kernel_timing_report(capsys):
-    """Time per evaluation (reported; a loose bound guards against a
-    pathological slow-down such as per-call allocation)."""
-    out = {}
-    for N, n in [(12, 50_000), (90, 2_000)]:
-        m = egm2008(N)
-        _time_loop(10, m.C, m.S, N, m.gm, m.radius)
-        t0 = time.perf_counter()
-        _time_loop(n, m.C, m.S, N, m.gm, m.radius)
-        out[N] = (time.perf_counter() - t0) / n
-    with capsys.disabled():
-        print(f"\nsh_accel per evaluation: N=12 {out[12] * 1e6:.2f} us, N=90 {out[90] * 1e6:.1f} us")
-    assert out[12] < 20e-6 and out[90] < 2e-3

@@ -41,8 +41,8 @@ everything else (EOP interpolation, ERA, GMST, s', the matrix) is evaluated
 at every instant.  Interpolation error against direct ERFA evaluation at every
 instant (measured over 2004-2006): < 4e-16 rad in X, Y, s (ERFA's own
 evaluation noise); the whole matrix agrees with the
-ERFA composition to < 1e-12 rad.  Cost: ~15-20 ms per 53,000 instants
-(2-core Xeon, numba kernels cached).  The last few results are memoised
+ERFA composition to < 1e-12 rad.  Cost per chunk of 53,248 instants:
+measured by ``tqdyn bench --model kernels``.  The last few results are memoised
 (keyed by the epoch, the options and the exact bytes of t_hi, t_lo), because
 several force terms ask for the same chunk; returned arrays are read-only.
 """

@@ -26,9 +26,9 @@ Units out: m and m/s (the SPK files hold km and km/s, or km/day for the
 derivatives of type-2 polynomials), ICRF axes = GCRS directions.
 
 The SPK segments (Chebyshev types 2 and 3) are evaluated by a compiled
-(numba) Clenshaw-free forward recurrence, vectorised over instants: about
-1-2 ms per segment for 53,000 instants, an order of magnitude faster than
-jplephem's numpy evaluation (jplephem itself only reads the file here).
+(numba) Clenshaw-free forward recurrence, vectorised over instants, faster
+than jplephem's numpy evaluation (jplephem itself only reads the file here;
+``tqdyn bench --model kernels`` times the third bodies of one chunk).
 Files with several segments for one center/target pair (DE431, DE441, split
 in time) are handled by evaluating each instant in the segment that covers it.
 

@@ -4,7 +4,8 @@ Registered in :mod:`tqdyn.cli` with ``cli.add_command(report)``.  It only
 composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
 
 * ``tqdyn report RUN.h5 [...] [--out DIR]``: figures (PNG and PDF) of what
-  the runs contain and ``DIR/summary.md``;
+  the runs contain, ``DIR/summary.md`` and ``DIR/summary.json`` (every
+  number of the table, machine-readable, with its provenance);
 * ``tqdyn report --studies [--mission tianqin|lisa] [--runs-dir DIR] [--out DIR]
   [--quick | --duration-scale X] [--study NAME ...] [--set KEY=VALUE ...]
   [--workers N]``: runs (or reuses) the study runs of the paper's section V
@@ -88,7 +89,17 @@ def report(runs, out, studies, mission, runs_dir, quick, duration_scale, only, s
         _fail(str(exc))
     except KeyboardInterrupt:
         _fail("interrupted", _EXIT_INTERRUPTED)
+    rp.write_summary_json(rep, " ".join(["tqdyn report", *runs] + (["--out", out] if out else [])),
+                          runs={str(r): _file_facts(r) for r in runs})
     _print_report(rep)
+
+
+def _file_facts(path, rows=None, wall_s=None) -> dict:
+    """Size [MB] (and rows, wall time [s] when known) of a trajectory file."""
+    import os
+
+    size = os.path.getsize(path) / 1e6 if path is not None and os.path.exists(path) else None
+    return {"file_mb": size, "rows": rows, "wall_s": wall_s}
 
 
 def _print_report(rep) -> None:
@@ -147,6 +158,9 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         elif not quiet:
             bar.write(f"  {o.run.name}: {o.rows} rows in {o.wall_s:.1f} s", file=sys.stderr)
 
+    import time
+
+    t0 = time.perf_counter()
     try:
         result = st.run_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets,
                                 workers=workers, progress=progress, plan=plan, **catalogue)
@@ -159,6 +173,7 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
     bar.close()
     paths = {name: result.path(name) for name in result.outcomes}
     scaled = "" if scale == 1.0 else f" (durations x {scale:.4g})"
+    t_runs = time.perf_counter()
     try:
         if mission == "lisa":
             rep = report_lisa_studies(paths, out, studies=names, progress=say,
@@ -170,6 +185,23 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         _fail(str(exc))
     except KeyboardInterrupt:
         _fail("interrupted", _EXIT_INTERRUPTED)
+    t_end = time.perf_counter()
+    command = " ".join(["tqdyn report --studies"] + (["--mission", mission] if mission != "tianqin" else [])
+                       + (["--quick"] if quick else []) + ([f"--duration-scale {duration_scale:g}"]
+                                                           if duration_scale is not None else [])
+                       + [f"--study {s}" for s in only] + [f"--set {s}" for s in sets]
+                       + ([f"--workers {workers}"] if workers is not None else []) + ["--out", out])
+    runs_info = {}
+    for name, o in result.outcomes.items():
+        facts = _file_facts(o.run.path if o.ok else None, o.rows or None, o.wall_s if o.status == "ran" else None)
+        days = o.run.duration_s / 86400.0
+        runs_info[name] = {"status": o.status, "duration_s": o.run.duration_s, **facts,
+                           "file_mb_per_day": facts["file_mb"] / days if facts["file_mb"] and days else None}
+    sizes = [r["file_mb"] for r in runs_info.values() if r["file_mb"] is not None]
+    rp.write_summary_json(rep, command, mission=mission, duration_scale=scale, studies=list(result.studies),
+                          timing={"workers": n, "runs_wall_s": t_runs - t0, "report_wall_s": t_end - t_runs,
+                                  "total_wall_s": t_end - t0, "n_runs": len(plan), "n_ran": len(pending)},
+                          runs=runs_info, runs_total_file_mb=sum(sizes) if sizes else None)
     _print_report(rep)
     if result.failures:
         for o in result.failures:

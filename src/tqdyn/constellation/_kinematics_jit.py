@@ -100,16 +100,14 @@ The accelerations ``a`` are whatever the caller passes (gravity plus drag-free
 control G_i if modelled): omega_dot then includes that (~1e-18 m/s^2 / L,
 negligible) feedback; nothing is added here.
 
-Accuracy and cost (measured by ``tests/test_kinematics_jit.py`` on exact Kepler orbits)
-----------------------------------------------------------------------------------------
+Accuracy (bounds of ``tests/test_kinematics_jit.py`` on exact Kepler orbits)
+----------------------------------------------------------------------------
 Against the numpy :func:`.attitude.attitude`: frames 3e-16, omega 1.4e-20
 rad/s, omega_dot 2e-25 rad/s^2.  Iterative law against a 40-digit solution
 of the light-time equation on the exact orbit: tau 1.2e-16 s, beam
 1.1e-16 rad, tau'/tau''/b'/b'' to float64 rounding; taylor2 is 1.9e-11 rad,
 taylor1 3.8e-11 rad and global 5.8e-6 rad from the exact beam.  Rates agree
 with 5-point differences of the frames to < 3e-18 rad/s and < 3e-21 rad/s^2.
-Cost ~0.5 us per call (global, taylor*), ~0.9 us (iterative) when called
-from compiled code.
 """
 
 from __future__ import annotations

@@ -47,12 +47,12 @@ def _node_tdat(model, epoch, times) -> np.ndarray:
 _QUINTIC_ERROR_DIVISOR = 46080.0
 #: Margin on that step (error ~ h^6: 0.75 -> 0.18 of the bound) for the
 #: higher harmonics of eccentric motion near perigee, which the rate w does
-#: not capture (measured: 3.9x the bound on e = 0.1 without it).
+#: not capture (without it the e = 0.1 orbit of the adaptive tests exceeds the bound).
 
 
 #: Margin on that step (error ~ h^6: 0.75 -> 0.18 of the bound) for the
 #: higher harmonics of eccentric motion near perigee, which the rate w does
-#: not capture (measured: 3.9x the bound on e = 0.1 without it).
+#: not capture (without it the e = 0.1 orbit of the adaptive tests exceeds the bound).
 _DENSE_OUTPUT_SAFETY = 0.75
 
 

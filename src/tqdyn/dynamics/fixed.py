@@ -7,8 +7,9 @@ the loop as one array, so no Python runs per step; the inputs of the next
 block are computed in a second thread while the compiled loop (nogil) runs.
 A chunk (the unit of output rows, progress and checkpoints) is split into
 blocks of at most :data:`INPUT_BLOCK` steps, which bounds the memory of the
-time-only inputs (~2.6 MB per 128 steps for the coupled TianQin model, plus
-the temporaries of their evaluation) whatever the chunk.  Time is an
+time-only inputs (n_tdat x 13 stages x 8 bytes per step: ~2.6 MB per 128
+steps for the ~200 columns of the coupled TianQin model, plus the
+temporaries of their evaluation) whatever the chunk.  Time is an
 integer step count times the exact step (a dd pair), never a large bare
 float64.
 """
@@ -30,7 +31,7 @@ from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "propagate_fixed", "warm_up"]
 
-DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints (~2 s of work)
+DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
 
 
@@ -55,7 +56,7 @@ def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step
     diagnostics into aux0), then the compensated update of y.  tdat_step:
     (13, n_tdat) time-only inputs at the stage times.  Independent point
     masses call their right-hand side directly: passing the coupled system's
-    work arrays 13 times per step costs ~4 us (their reference counts)."""
+    work arrays 13 times per step costs time (their reference counts)."""
     if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
         centre = int(cpar[_lay.CP_SGC])
         point_masses(y, tdat_step[0], params, layout, K[0])

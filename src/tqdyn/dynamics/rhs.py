@@ -135,11 +135,11 @@ def _jerk_perturbation(cpar, tdat, fw):
     The geocentric budget:  Left out, with their jerk: the Earth rotation of the sectorial
     degree-2 terms (~1e-13 m/s^3), the CIP tilt from GCRS z in J2 (~2e-14),
     degree >= 3 (~2e-14), planets, tides, relativity (< 1e-15), G (~1e-17):
-    omega_dot is the derivative of omega to ~4e-22 rad/s^2 (measured 1.5e-21
-    against 5-point differences, their own error included; the Moon's tidal
-    jerk alone is ~5e-10 m/s^3, ~2e-18 rad/s^2).  Free TMs under a local
-    law stay within 3.6e-13 m of their EH centers over 10 days (2e-9 m in 2
-    days with the monopole jerk alone).
+    omega_dot is the derivative of omega to ~4e-22 rad/s^2 (tests/test_coupled.py
+    compares it with 5-point differences; the Moon's tidal jerk alone is
+    ~5e-10 m/s^3, ~2e-18 rad/s^2).  Free TMs under a local law stay within
+    1e-12 m of their EH centers over 10 days (tests/test_coupled.py; with the
+    monopole jerk alone they do not).
     """
     v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
     o = int(cpar[CP_TD])

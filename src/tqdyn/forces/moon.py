@@ -25,7 +25,7 @@ the Moon's geocentric GCRS position.  GCRS axes are ICRF axes, so
 T_PA_GCRS = T_PA_ICRF.  The Earth's part (the second term) depends on time
 only and is formed in :meth:`MoonField.precompute`, once per instant rather
 than once per body and stage (the kernel then costs one degree-n field
-evaluation, ~0.4 us at n = 7).  Not included: the reaction of the Moon's
+evaluation; ``tqdyn bench --model kernels`` times the term's time-only inputs).  Not included: the reaction of the Moon's
 monopole on the Earth's oblateness (the Earth's figure in the Moon's field,
 1.1e-11 .. 1.7e-11 m/s^2 on the geocentre in June 2004, twenty times this
 term), which belongs with the Earth-field term.

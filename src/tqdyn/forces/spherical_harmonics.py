@@ -59,12 +59,10 @@ All kernels: float64 scalars in and out, m, m^3/s^2, m/s^2, compiled with
 numba (no fastmath), no allocation.  Round-off: ~1e-16 .. 1e-15 of the
 perturbation's magnitude (measured against a 60-digit, at degree 90
 150-digit, mpmath evaluation of the defining series in
-tests/test_spherical_harmonics.py; the test bound is 1e-14).  Cost on the
-development machine (2-core AMD EPYC VM): 0.40 us per evaluation at N = 12
-with tidal corrections to degree 10, nmin = 3 (the Earth term), 0.20 us at
-N = 7 (the Moon's field), 0.45 us at N = 12 and 24 us at N = 90 (sh_accel,
-tests/test_spherical_harmonics.py); the tables and the split loops made
-these 1.7x, 1.3x, 1.4x and 1.1-1.2x faster, with bit-for-bit the same results.
+tests/test_spherical_harmonics.py; the test bound is 1e-14).  Cost per
+evaluation of :func:`sh_accel` at N = 12 and 90: measured by ``tqdyn bench
+--model kernels``; the tables and the split loops made the kernels faster
+with bit-for-bit the same results.
 """
 
 from __future__ import annotations

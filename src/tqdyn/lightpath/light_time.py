@@ -29,8 +29,7 @@ D = r_e(t - tau) - r_r(t) and f'(tau) = 1 + (D . v_e) / (|D| c) (v_e from the
 same Hermite polynomial), stopping when the Newton correction is below
 ``tol`` (default 1e-24 s); three iterations usually suffice.  The returned
 residual is the equation's residual at the returned tau, evaluated in dd
-(~1e-31 s).  Cost: ~12 s for 90 days at 50 s (155,521 rows x 6 links), after
-~5 s of one-off compilation.
+(~1e-31 s).  Cost: linear in rows x links, after a one-off compilation.
 
 Rows whose emission time t - tau precedes the first grid time cannot be
 interpolated: their tau, range, emitter state and residual are NaN (for a

@@ -35,9 +35,9 @@ _MODES = ("fixed", "adaptive")
 _TABLEAUS = ("corrected", "published")
 _RTOL_MAX = 1e-3
 #: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive
-#: mode) a run may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at the fastest
-#: rate measured (the Kepler model, ~1.3e5 steps/s) 1e9 steps take ~2 h and with the full TianQin
-#: model (~1.9e3 steps/s) ~6 days, and write ~1e11 bytes per satellite (output_every = 1).  A count above this is a mistyped
+#: mode) a run may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at the rates
+#: of ``tqdyn bench`` (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (the full TianQin model),
+#: and write ~1e11 bytes per satellite (output_every = 1).  A count above this is a mistyped
 #: duration or step (1e12 d at 50 s is 1.7e15 steps and would never finish); raise run.max_steps to override.
 MAX_STEPS = 1_000_000_000
 from .initial import BODY_RADII_M, check_above_surface  # noqa: F401

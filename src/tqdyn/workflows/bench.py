@@ -34,6 +34,7 @@ from ..astro import elements as _el
 from .. import dynamics
 from ..numerics.dd import mp_from_dd
 from ..scenario import load_scenario
+from .numbers import machine
 
 __all__ = ["kepler_benchmark", "format_report", "force_model_benchmark", "format_force_report",
            "coupled_benchmark", "format_coupled_report", "lisa_benchmark", "format_lisa_report", "LISA_DURATION",
@@ -82,7 +83,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
     ref = _analytic_final(scen)
     report = {"scenario": scen.name, "n_sat": len(scen.satellites), "duration_s": float(scen.run.duration_s),
               "step_s": float(scen.integrator.step_s), "n_steps": scen.n_steps,
-              "machine": f"{platform.processor() or platform.machine()}, Python {platform.python_version()}",
+              "machine": f"{machine()['summary']}, Python {platform.python_version()}",
               "runs": {}}
     finals = {}
     half = load_scenario("tianqin-kepler", [f"run.duration={duration}",
@@ -97,6 +98,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
         finals[name] = r_final
         report["runs"][f"tqdyn {name}"] = {
             "wall_s": res.wall_s, "compile_s": compile_s, "us_per_step": res.wall_s / res.n_steps * 1e6,
+            "steps_per_s": res.n_steps / res.wall_s,
             "err_vs_analytic_m": _max_dist(r_final, ref),
             "grid_rows": int(sum(len(r) for r in rows)),
         }
@@ -121,7 +123,11 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
     runs = report["runs"]
     report["dd_over_float64"] = runs["tqdyn dd"]["wall_s"] / runs["tqdyn float64"]["wall_s"]
     if "heyoka real128" in runs:
-        report["heyoka_over_dd"] = runs["heyoka real128"]["wall_s"] / runs["tqdyn dd"]["wall_s"]
+        hey = runs["heyoka real128"]
+        report["heyoka_over_dd"] = hey["wall_s"] / runs["tqdyn dd"]["wall_s"]
+        report["heyoka_over_dd_half_step"] = hey["wall_s"] / runs["tqdyn dd h/2"]["wall_s"]
+        report["dd_error_over_heyoka"] = runs["tqdyn dd"]["err_vs_analytic_m"] / hey["err_vs_analytic_m"]
+        report["dd_half_step_error_over_heyoka"] = runs["tqdyn dd h/2"]["err_vs_analytic_m"] / hey["err_vs_analytic_m"]
     report["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     return report
 
@@ -175,7 +181,7 @@ def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
     for name, scen, precision in (("full model, dd", full, "dd"), ("full model, float64", full, "float64"),
                                   ("reduced model, dd", reduced, "dd")):
         wall, rss, res = _timed_run(scen, precision)
-        report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss}
+        report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss, "steps_per_s": res.n_steps / wall}
         if name == "reduced model, dd":
             report["reduced_final"] = res.y_final
     if heyoka:
@@ -195,7 +201,10 @@ def force_model_benchmark(duration: str = "90d", heyoka: bool = True) -> dict:
                 "wall_s": out["wall_s"], "compile_s": out["setup_s"],
                 "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
             report["reduced_dd_minus_heyoka_m"] = _max_dist(mp_from_dd(report["reduced_final"][:, 0:3]), r_final)
+            report["heyoka_over_reduced_dd"] = (report["runs"]["reduced model, heyoka real128"]["wall_s"]
+                                                / report["runs"]["reduced model, dd"]["wall_s"])
     report.pop("reduced_final", None)
+    report["dd_over_float64"] = report["runs"]["full model, dd"]["wall_s"] / report["runs"]["full model, float64"]["wall_s"]
     return report
 
 
@@ -226,20 +235,33 @@ def coupled_benchmark(duration: str = "90d", overrides=()) -> dict:
     under the same force model without attitude, TMs or control
     (``tianqin-gravity``, dd) give the CPU the coupled run cannot go below:
     on two cores its wall time is at least half of that run's inputs + loop,
-    whatever the coupling costs."""
+    whatever the coupling costs.  The coupled dd run with
+    ``constellation.tm_gravity = "direct"`` (the whole force model again at
+    each electrode-housing centre) shows what the differential gravity saves."""
     scen = load_scenario("tianqin", [f"run.duration={duration}", *overrides])
     report = {"duration_s": float(scen.run.duration_s), "n_steps": scen.n_steps, "runs": {}}
     gravity = load_scenario("tianqin-gravity", [f"run.duration={duration}", *overrides])
+    direct = load_scenario("tianqin", [f"run.duration={duration}", *overrides, 'constellation.tm_gravity="direct"'])
     for name, sc, precision in (("coupled, dd", scen, "dd"), ("coupled, float64", scen, "float64"),
-                                ("gravity only, dd", gravity, "dd")):
+                                ("gravity only, dd", gravity, "dd"), ("coupled, dd, tm_gravity direct", direct, "dd")):
         wall, rss, res = _timed_run(sc, precision)
         report["runs"][name] = {"wall_s": wall, "peak_rss_mb": rss, "cpu_inputs_s": res.cpu_inputs_s,
-                                "cpu_loop_s": res.cpu_loop_s}
+                                "cpu_loop_s": res.cpu_loop_s, "steps_per_s": res.n_steps / wall}
     # the machine's yardstick, measured in the same invocation: the Kepler run
     # of the same span and step in float64 (its ratio is robust to a loaded machine)
     kepler = load_scenario("tianqin-kepler", [f"run.duration={duration}", f"integrator.step={scen.integrator.step_s}"])
     wall, _, _ = _timed_run(kepler, "float64")
     report["kepler_float64_s"] = wall
+    days = report["duration_s"] / 86400
+    runs = report["runs"]
+    for r in runs.values():
+        r["cpu_inputs_per_day_s"] = r["cpu_inputs_s"] / days
+        r["cpu_loop_per_day_s"] = r["cpu_loop_s"] / days
+        r["floor_2core_s"] = 0.5 * (r["cpu_inputs_s"] + r["cpu_loop_s"])
+    report["dd_over_float64"] = runs["coupled, dd"]["wall_s"] / runs["coupled, float64"]["wall_s"]
+    report["dd_over_kepler_float64"] = runs["coupled, dd"]["wall_s"] / wall
+    report["direct_over_differential_loop"] = (runs["coupled, dd, tm_gravity direct"]["cpu_loop_s"]
+                                               / runs["coupled, dd"]["cpu_loop_s"])
     return report
 
 
@@ -289,6 +311,7 @@ def lisa_benchmark(duration: str = LISA_DURATION, scenario: str = "lisa-esa") ->
         wall, rss, res = _timed_run(scen, precision)
         report["runs"][f"lisa, {precision}"] = {"wall_s": wall, "peak_rss_mb": rss,
                                                 "us_per_step": wall / res.n_steps * 1e6}
+    report["dd_over_float64"] = report["runs"]["lisa, dd"]["wall_s"] / report["runs"]["lisa, float64"]["wall_s"]
     return report
 
 

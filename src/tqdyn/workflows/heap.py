@@ -4,8 +4,9 @@ glibc's ``malloc`` raises its mmap threshold each time a mapped block is
 freed (up to 32 MB on 64-bit), after which the large, short-lived arrays of
 a run (the time-only inputs of each block, the rows of each chunk, their
 temporaries) come from the heap, where fragmentation keeps them: the
-resident set of a coupled TianQin run then sits ~45 MB higher and creeps
-with the run.  :func:`bound_heap_retention` fixes the threshold at
+resident set of a coupled TianQin run then sits higher and creeps with the
+run (``tqdyn bench --model tianqin-5y`` records the resident set over a
+five-year run).  :func:`bound_heap_retention` fixes the threshold at
 :data:`MMAP_THRESHOLD_BYTES` (which also stops the adjustment), so that
 every block of that size or more is mapped on allocation and unmapped on
 free, while the smaller temporaries, the same sizes block after block,
@@ -21,10 +22,10 @@ import sys
 __all__ = ["MMAP_THRESHOLD_BYTES", "bound_heap_retention"]
 
 #: Blocks of this many bytes or more are mapped: the inputs array of a block
-#: (~10 MB for the coupled TianQin model).  Lower
-#: thresholds cost CPU in page faults: at 256 KiB the time-only inputs took
-#: ~10 % more CPU (the (6656, 3, 3)-sized temporaries of a block mapped and
-#: zeroed anew each time); at 4 MiB they cost the same as glibc's default.
+#: (~10 MB for the coupled TianQin model: n_tdat x 13 x 512 x 8 bytes).  Lower
+#: thresholds cost CPU in page faults (at 256 KiB the (6656, 3, 3)-sized
+#: temporaries of a block are mapped and zeroed anew each time); at 4 MiB the
+#: time-only inputs cost the same CPU as with glibc's default.
 MMAP_THRESHOLD_BYTES = 4 * 1024 * 1024
 _M_MMAP_THRESHOLD = -3  # glibc <malloc.h>
 _state = {"done": False}

@@ -6,15 +6,15 @@ an output decimation; a *study* (:class:`Study`) is one figure or result of
 the paper's section V and names the runs it needs.  Several studies share
 runs (e.g. the 30-day drag-free run serves Figs. 5, 6 and 7).
 
-Output design (file sizes for the full model, 3 satellites + 6 TMs, all
-fields, ~3.4 MB per day at every 50 s step):
+Output design (the file sizes of the runs are in the ``summary.json`` of
+``tqdyn report --studies`` and in docs/report.md):
 
 * ``*-90d`` runs: 90 days, one output row every :data:`COARSE_EVERY` steps
-  (600 s; ~25 MB per coupled run).  Enough for orbit deviations, breathing
+  (600 s).  Enough for orbit deviations, breathing
   angles and the drag-free acceleration (all vary on the orbital period,
   3.65 days); the 50 s integration step is unchanged, only the output is
   decimated, so the states are those of the 50 s propagation.
-* ``*-30d-50s`` runs: 30 days at every 50 s step (~100 MB per coupled run):
+* ``*-30d-50s`` runs: 30 days at every 50 s step:
   range ASDs down to ~5e-5 Hz (the Welch estimate of
   :mod:`tqdyn.analysis.spectra` is reliable above ~26 bins, 26 x 1.8e-6 Hz
   for 30 days), the Hermite dense output of the pointing study, and the

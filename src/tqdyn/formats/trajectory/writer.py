@@ -170,7 +170,7 @@ class TrajectoryWriter:
     expected_rows : int, optional
         Hint only: number of time rows expected.  Datasets are pre-allocated to
         it (and trimmed to :attr:`rows_written` on close) and the chunk size is
-        ``min(expected_rows, 4096)`` rows.  Writing more or fewer rows is fine.
+        ``min(expected_rows, _DEFAULT_CHUNK_ROWS)`` rows.  Writing more or fewer rows is fine.
     compression : str, optional
         h5py compression filter for time-dependent datasets (default None:
         off, for speed).
@@ -340,8 +340,8 @@ class TrajectoryWriter:
         same number of rows.  Everything is validated before anything is
         stored, so a rejected call (ValueError naming the field) changes
         nothing.  The data are copied; small appends are buffered in memory
-        and written in blocks of the chunk size (4096 rows by default), so
-        appending one row per step is fine.
+        and written in blocks of the chunk size (``_DEFAULT_CHUNK_ROWS`` rows by
+        default), so appending one row per step is fine.
         """
         self._require_open("append")
         if not isinstance(rows, Mapping):

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 from .generic import report_runs
 from .paper import report_studies
-from .summary import Report, SummaryRow, check_out_dir, format_summary
+from .summary import Report, SummaryRow, check_out_dir, format_summary, write_summary_json
 
-__all__ = ["Report", "SummaryRow", "check_out_dir", "format_summary", "report_runs", "report_studies"]
+__all__ = ["Report", "SummaryRow", "check_out_dir", "format_summary", "report_runs", "report_studies",
+           "write_summary_json"]

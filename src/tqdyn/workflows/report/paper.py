@@ -121,6 +121,9 @@ def _study_range_asd(rep, runs):
     band = f"{d_df.band[0]:.2g}..{d_df.band[1]:.2g} Hz"
     rep.values.update({"asd/gravity": res["gravity"].max_ratio, "asd/dragfree_minus_gravity": d_df.max_ratio,
                        "asd/global_minus_local": d_gl.max_ratio})
+    rep.values.setdefault("asd_detail", {}).update(
+        {k: _asd_facts(r) for k, r in (("gravity", res["gravity"]), ("global", res["global"]), ("local", res["local"]),
+                                       ("dragfree_minus_gravity", d_df), ("global_minus_local", d_gl))})
     rep.rows += [
         SummaryRow(f"Fig. 6: gravity-orbit Sat-Sat range ASD / requirement, max in {band}", "(curve shown)",
                    res["gravity"].describe(),
@@ -132,6 +135,12 @@ def _study_range_asd(rep, runs):
         SummaryRow(f"Fig. 6: ASD(global - local pointing range) / requirement, max in {band}", "beneath the requirement",
                    d_gl.describe(), _asd_verdict(d_gl)),
     ]
+
+
+def _asd_facts(res) -> dict:
+    """The numbers of an :class:`~tqdyn.analysis.metrics.AsdResult` (ratio, frequencies [Hz], band [Hz])."""
+    return {"max_ratio": res.max_ratio, "f_at_max": res.f_at_max, "f_above": res.f_above, "band": res.band,
+            "f_reliable": res.f_reliable}
 
 
 def _study_control_no_sg(rep, runs):
@@ -198,8 +207,17 @@ def _study_dragfree_deviation(rep, runs):
         dmax = dev.norm.max(axis=0)
         G = np.linalg.norm(tr["sat/a_dragfree"], axis=-1)
         k1 = max(1, round(86400 / float(np.median(np.diff(t)))))
+        r, v = tr["sat/r"], tr["sat/v"]
+        h = np.cross(r, v)
+        t_hat = np.cross(h / np.linalg.norm(h, axis=-1, keepdims=True), r / np.linalg.norm(r, axis=-1, keepdims=True))
+        G_t = np.einsum("nsk,nsk->ns", tr["sat/a_dragfree"], t_hat)
+        T = float(t[-1] - t[0])
         rep.values[f"deviation/{name}"] = {"max": dmax, "end_along": dev.along[-1], "pred_end": pred[-1],
-                                          "G_first_day": G[:k1].max(axis=0), "G_max": G.max(axis=0)}
+                                          "G_first_day": G[:k1].max(axis=0), "G_max": G.max(axis=0),
+                                          "G_along_mean": G_t.mean(axis=0),
+                                          "G_along_max_over_mean": np.abs(G_t).max(axis=0) / np.abs(G_t.mean(axis=0)),
+                                          "G_max_over_along_mean": G.max(axis=0) / np.abs(G_t.mean(axis=0)),
+                                          "drift_of_mean_along": -1.5 * G_t.mean(axis=0) * T ** 2, "span_s": T}
         if ls == "-":
             rep.rows += [
                 SummaryRow(f"Sec. V.A: drag-free ({label}, no self-gravity) vs gravity orbit, max |dr| over "
@@ -253,7 +271,9 @@ def _local_vs_global(rep, glob, loc):
     model = 3 * float(GM_EARTH_EGM2008) / r ** 3 * (d_tm / 2) * delta / np.tan(theta / 2)
     span = float(dev.t[-1] - dev.t[0]) / 86400
     rep.values["deviation/local_vs_global"] = {"max": dev.norm.max(axis=0), "dG_max": np.abs(dG_S).max(axis=0),
-                                               "delta_max": delta.max(axis=0), "model": model.mean(axis=0)}
+                                               "delta_max": delta.max(axis=0), "model": model.mean(axis=0),
+                                               "dG_y_mean": float(np.mean(dG_S[..., 1])), "pred_end": pred[-1],
+                                               "delta_mean": float(np.mean(delta)), "model_mean": float(np.mean(model))}
     rep.rows.append(SummaryRow(
         f"  local (taylor2) vs global pointing: orbit difference over {span:.3g} d", "-",
         _per_sat(dev.norm.max(axis=0), "m", "{:.3f}") + f"; G_local - G_global along Y_S "
@@ -297,9 +317,13 @@ def _study_common_sg(rep, runs):
     hill = (f"Hill: along-track push {1.5e-9 * T ** 2 / 1e3:.3g} km (3/2 f T^2), radial push "
             f"{2e-9 * T / n_mean / 1e3:.3g} km (2 f T / n, X_S ~ radial), normal push <= {2e-9 / n_mean ** 2:.2g} m "
             "(2 f / n^2, no drift)")
+    rep.values["common_sg_theory"] = {"hill_along_km": theory / 1e3, "along_push_km": 1.5e-9 * T ** 2 / 1e3,
+                                      "radial_push_km": 2e-9 * T / n_mean / 1e3, "normal_push_m": 2e-9 / n_mean ** 2,
+                                      "flight_label": fl, "most_sensitive": most}
     alpha_all = max(results[lab]["dalpha_max"] for lab in SG_DIRECTIONS)
     lo = min(results[lab]["alpha_range"][0] for lab in SG_DIRECTIONS)
     hi = max(results[lab]["alpha_range"][1] for lab in SG_DIRECTIONS)
+    rep.values["common_sg_theory"].update({"dalpha_max_all": alpha_all, "alpha_range_all": (lo, hi)})
     rep.rows += [
         SummaryRow(f"Sec. V.B.2: +flight ({fl} of S) 1e-9 m/s^2, deviation from gravity orbit at {span:.3g} d",
                    "~100 km (order of) over 3 months", _per_sat(results[fl]["dev_end"] / 1e3, "km", "{:.4g}"),
@@ -372,6 +396,9 @@ def _study_light_path(rep, runs):
                             f"Fig. 11: Sat{int(ln.receiver)}-Sat{int(ln.emitter)} vs TM-TM instantaneous range, "
                             f"Table IV, {span:.3g} d")
     band = f"{r_lp.band[0]:.2g}..{r_lp.band[1]:.2g} Hz"
+    rep.values.setdefault("asd_detail", {}).update(
+        {k: _asd_facts(r) for k, r in (("light_path", r_lp), ("tm", r_tm), ("sat", r_sat), ("lp_minus_inst", r_lp_tm),
+                                       ("tm_minus_sat", r_tm_sat))})
     rep.values.update({"asd/light_path": r_lp.max_ratio,
                        "asd/tm_minus_sat": r_tm_sat.max_ratio, "asd/lp_minus_inst": r_lp_tm.max_ratio,
                        "lightpath/residual_max": float(np.nanmax(np.abs(lt.residual)))})

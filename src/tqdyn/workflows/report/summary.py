@@ -1,6 +1,7 @@
 """What a report produces: :class:`Report`, the rows of ``summary.md``
-(:class:`SummaryRow`, :func:`format_summary`), the output directory and the
-formatting of the measured values."""
+(:class:`SummaryRow`, :func:`format_summary`), ``summary.json``
+(:func:`write_summary_json`), the output directory and the formatting of
+the measured values."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ import numpy as np
 from ...analysis.metrics import times_s
 from ...formats import trajectory as io
 
-__all__ = ["Report", "RunFiles", "evaluate_studies", "SummaryRow", "check_out_dir", "format_summary"]
+__all__ = ["Report", "RunFiles", "evaluate_studies", "SummaryRow", "check_out_dir", "format_summary",
+           "write_summary_json"]
 
 
 @dataclass(frozen=True)
@@ -54,6 +56,21 @@ def format_summary(rows: Sequence[SummaryRow], title: str = "tqdyn report", note
     if notes:
         out += ["", "Notes:", ""] + [f"- {n}" for n in notes]
     return "\n".join(out) + "\n"
+
+
+def write_summary_json(rep: Report, command: str, **extra) -> Path:
+    """Write ``summary.json`` next to ``summary.md``: the provenance of the
+    numbers (:func:`tqdyn.workflows.numbers.provenance`: ``command``, date,
+    machine, library versions), the keyword arguments ``extra`` (e.g. the
+    study runs and their timing), the table rows, the notes and every
+    measured value (``rep.values``, SI units; arrays as lists).  Returns the
+    path.  Read by ``tools/render_docs.py`` (docs/numbers.md)."""
+    from ..numbers import provenance, write_record
+
+    data = {"format_version": 1, **provenance("tqdyn report", command), **extra,
+            "rows": [{"quantity": r.quantity, "paper": r.paper, "tqdyn": r.tqdyn, "notes": r.notes} for r in rep.rows],
+            "notes": list(rep.notes), "values": rep.values}
+    return write_record(rep.out_dir / "summary.json", data)
 
 
 def check_out_dir(out_dir) -> Path:

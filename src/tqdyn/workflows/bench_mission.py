@@ -1,0 +1,221 @@
+"""Benchmarks of whole ``tqdyn run`` commands (``tqdyn bench --model
+default-run | tianqin-5y | lisa-10y``).
+
+Each runs the command as a child process in a temporary directory, as a user
+would (start-up, JIT cache loading, propagation, output file), and measures
+from outside: the wall time of the command, the child's CPU time and peak
+resident set (``wait4``), its resident set sampled every
+:data:`SAMPLE_S` seconds (to show whether memory grows over the run), the
+size of the trajectory file, and, from the command's own summary, the
+propagation wall time, the JIT time, the steps and the transcript (the
+banner on stderr and the summary on stdout, as the README shows them,
+with the temporary directory's path left out of the output line).  A
+one-step run of the same command before it compiles and caches the
+kernels, so the measured run starts as every run after the first does.
+
+* ``default-run``: ``tqdyn run``, the README's main job (built-in
+  ``tianqin``, 10 days at 50 s);
+* ``tianqin-5y``: ``tqdyn run tianqin --duration 1826d --set
+  run.output_every=72`` (five years, a row per hour);
+* ``lisa-10y``: ``tqdyn run lisa --duration 3653d`` (ten years at 6 h).
+
+:func:`startup_benchmark` (``tqdyn bench --model startup``): ``tqdyn run
+--duration 1h`` with an empty kernel cache (``$TQDYN_CACHE_DIR`` a new
+directory: the first run after an install or a change of the sources
+compiles the kernels) and then again with the cache it filled.
+
+``duration`` replaces the span (to check the pipeline quickly); the
+report records the span that ran.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["MISSION_RUNS", "MissionRun", "mission_benchmark", "format_mission_report", "startup_benchmark",
+           "format_startup_report", "SAMPLE_S"]
+
+#: Interval of the resident-set samples [s].
+SAMPLE_S = 0.5
+
+
+@dataclass(frozen=True)
+class MissionRun:
+    """A benchmarked command: ``tqdyn run [scenario] [args]``, the default
+    ``duration`` (None: the scenario's own) and what it is."""
+
+    scenario: str | None
+    args: tuple
+    duration: str | None
+    title: str
+
+
+#: The benchmarked commands by model name.
+MISSION_RUNS = {
+    "default-run": MissionRun(None, (), None, "tqdyn run: the built-in tianqin scenario, 10 days at 50 s"),
+    "tianqin-5y": MissionRun("tianqin", ("--set", "run.output_every=72"), "1826d",
+                             "coupled TianQin, five years at 50 s, a row every 72 steps"),
+    "lisa-10y": MissionRun("lisa", (), "3653d", "coupled LISA, ten years at 6 h"),
+}
+
+_ENTRY = "import sys; from tqdyn.cli import main; sys.exit(main())"
+
+
+def _rss_mb(pid: int) -> float | None:
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024.0
+    except (OSError, ValueError):
+        return None
+    return None
+
+
+def _parse(stdout: str) -> dict:
+    out = {}
+    m = re.search(r"steps: (\d+) accepted.*?, (\d+) right-hand-side evaluations", stdout)
+    if m:
+        out["n_steps"], out["n_rhs"] = int(m.group(1)), int(m.group(2))
+    m = re.search(r"wall time: ([0-9.]+) s propagation \(\+ ([0-9.]+) s JIT compilation\)", stdout)
+    if m:
+        out["propagation_wall_s"], out["compile_s"] = float(m.group(1)), float(m.group(2))
+    m = re.search(r"output: .* \((\d+) rows, ([0-9.]+) MB\)", stdout)
+    if m:
+        out["rows"] = int(m.group(1))
+    return out
+
+
+def mission_benchmark(name: str, duration: str | None = None) -> dict:
+    """Run the command of :data:`MISSION_RUNS` ``[name]`` once; returns a
+    dict (times [s], memory [MB], file size [MB], the transcript).  A
+    failing command raises RuntimeError with its last stderr line."""
+    import subprocess
+
+    spec = MISSION_RUNS[name]
+    duration = duration or spec.duration
+    args = ["run"] + ([spec.scenario] if spec.scenario else []) + (["--duration", duration] if duration else []) \
+        + list(spec.args)
+    shown = "tqdyn " + " ".join(args)
+    from ..scenario import load_scenario
+
+    scen = load_scenario(spec.scenario or "tianqin", [f"run.duration={duration}"] if duration else [])
+    with tempfile.TemporaryDirectory(prefix="tqdyn-bench-") as tmp:
+        # warm-up: one step, so that the kernels are compiled and cached before the measured run
+        warm = ["run"] + ([spec.scenario] if spec.scenario else []) + [
+            "--duration", f"{scen.integrator.step_s}", "--output", "warm-up.h5", "-q"]
+        subprocess.run([sys.executable, "-c", _ENTRY, *warm], cwd=tmp, capture_output=True, check=False)
+        (Path(tmp) / "warm-up.h5").unlink(missing_ok=True)
+        out_f, err_f = Path(tmp) / "stdout.txt", Path(tmp) / "stderr.txt"
+        with open(out_f, "w") as so, open(err_f, "w") as se:
+            t0 = time.perf_counter()
+            proc = subprocess.Popen([sys.executable, "-c", _ENTRY, *args, "-q"], cwd=tmp, stdout=so, stderr=se,
+                                    env={**os.environ, "COLUMNS": "200"})
+            samples = []
+            while True:
+                pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+                if pid:
+                    break
+                rss = _rss_mb(proc.pid)
+                if rss is not None:
+                    samples.append((time.perf_counter() - t0, rss))
+                time.sleep(SAMPLE_S)
+            wall = time.perf_counter() - t0
+            proc.returncode = os.waitstatus_to_exitcode(status)
+        stdout = out_f.read_text().replace(str(Path(tmp).resolve()) + os.sep, "").replace(tmp + os.sep, "")
+        stderr = err_f.read_text()
+        if proc.returncode != 0:
+            last = (stderr.strip().splitlines() or ["no message"])[-1]
+            raise RuntimeError(f"{shown} failed (exit {proc.returncode}): {last}")
+        files = sorted(Path(tmp).glob("*.h5"))
+        file_mb = files[0].stat().st_size / 1e6 if files else None
+    parsed = _parse(stdout)
+    late = [r for t, r in samples if t >= 0.1 * wall]
+    keep = max(1, len(samples) // 200)
+    transcript = "\n".join([f"$ {shown}"] + [ln for ln in stderr.splitlines() if ln.startswith("tqdyn ")]
+                           + stdout.rstrip("\n").splitlines())
+    return {"title": spec.title, "command": shown, "duration_s": float(scen.run.duration_s),
+            "step_s": float(scen.integrator.step_s), "wall_s": wall, **parsed,
+            "cpu_user_s": usage.ru_utime, "cpu_sys_s": usage.ru_stime, "peak_rss_mb": usage.ru_maxrss / 1024.0,
+            "rss_run_min_mb": min(late) if late else None, "rss_run_max_mb": max(late) if late else None,
+            "rss_samples": [[round(t, 1), round(r, 1)] for t, r in samples[::keep]],
+            "file_mb": file_mb, "transcript": transcript}
+
+
+def _timed_command(args, cwd, env) -> dict:
+    """Run ``tqdyn ARGS`` in ``cwd``: wall time [s], peak resident set [MB], the parsed summary."""
+    import subprocess
+
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-c", _ENTRY, *args], cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    out, err = proc.communicate()
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        last = (err.strip().splitlines() or ["no message"])[-1]
+        raise RuntimeError(f"tqdyn {' '.join(args)} failed (exit {proc.returncode}): {last}")
+    return {"wall_s": wall, **_parse(out)}
+
+
+def startup_benchmark(duration: str | None = None) -> dict:
+    """``tqdyn run --duration 1h`` (or ``duration``) with a new, empty kernel
+    cache and then with the cache filled: wall time [s] of each command, the
+    JIT time the command reports, and the peak resident set [MB] of the
+    compiling one (children's ``ru_maxrss``, measured from a fresh helper
+    process so that no earlier child counts)."""
+    import json
+    import subprocess
+
+    duration = duration or "1h"
+    with tempfile.TemporaryDirectory(prefix="tqdyn-bench-startup-") as tmp:
+        env = {**os.environ, "TQDYN_CACHE_DIR": str(Path(tmp) / "cache")}
+        args = ["run", "--duration", duration, "--output", "startup.h5", "-q"]
+        probe = ("import json, resource, subprocess, sys, time\n"
+                 "t0 = time.perf_counter()\n"
+                 f"p = subprocess.run([sys.executable, '-c', {_ENTRY!r}, *{args!r}], capture_output=True, text=True)\n"
+                 "print(json.dumps({'wall_s': time.perf_counter() - t0, 'status': p.returncode, 'stdout': p.stdout, "
+                 "'stderr': p.stderr[-2000:], "
+                 "'peak_rss_mb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0}))\n")
+        out = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
+        try:
+            cold = json.loads(out.stdout)
+        except ValueError:
+            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {out.stderr[-300:]}") from None
+        if cold["status"] != 0:
+            last = (cold["stderr"].strip().splitlines() or ["no message"])[-1]
+            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {last}")
+        (Path(tmp) / "startup.h5").unlink(missing_ok=True)
+        warm = _timed_command(args, tmp, env)
+    return {"command": "tqdyn " + " ".join(args[:-3]), "cold": {"wall_s": cold["wall_s"],
+                                                               "peak_rss_mb": cold["peak_rss_mb"],
+                                                               **_parse(cold["stdout"])},
+            "warm": warm}
+
+
+def format_startup_report(report: dict) -> str:
+    """Human-readable lines of a :func:`startup_benchmark` report."""
+    c, w = report["cold"], report["warm"]
+    return (f"start-up: {report['command']}\n"
+            f"  empty kernel cache: {c['wall_s']:.1f} s (JIT {c.get('compile_s', float('nan')):.1f} s), peak resident "
+            f"set {c['peak_rss_mb']:.0f} MB\n"
+            f"  cache filled: {w['wall_s']:.1f} s (JIT {w.get('compile_s', float('nan')):.2f} s)")
+
+
+def format_mission_report(report: dict) -> str:
+    """Human-readable lines of a :func:`mission_benchmark` report."""
+    r = report
+    lines = [f"{r['title']}: {r['command']}",
+             f"  {r.get('n_steps', '?')} steps, {r['duration_s'] / 86400:g} days; command {r['wall_s']:.1f} s "
+             f"(propagation {r.get('propagation_wall_s', float('nan')):.1f} s, JIT {r.get('compile_s', float('nan')):.2f} s); "
+             f"CPU {r['cpu_user_s'] + r['cpu_sys_s']:.1f} s",
+             f"  peak resident set {r['peak_rss_mb']:.0f} MB"
+             + (f"; over the run (after its first 10 %) {r['rss_run_min_mb']:.0f}-{r['rss_run_max_mb']:.0f} MB"
+                if r["rss_run_min_mb"] is not None else "")
+             + (f"; file {r['file_mb']:.1f} MB ({r.get('rows', '?')} rows)" if r["file_mb"] is not None else "")]
+    return "\n".join(lines)

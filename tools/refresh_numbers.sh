@@ -1,0 +1,49 @@
+#!/bin/bash
+# Refresh every measured number of README.md and docs/*.md from new runs (docs/numbers.md).
+#
+#   tools/refresh_numbers.sh            # the full-size runs the pages describe (about an hour on 2 cores)
+#   tools/refresh_numbers.sh --quick    # short spans: checks the pipeline; the pages then show those spans
+#
+# Run it on a quiet machine: the speed numbers record the machine, its load and the date.  Each step
+# updates its own JSON record under docs/data/ (bench models and test numbers are merged: the entries
+# of what ran are replaced, the others kept), then the pages are rendered and checked.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DATA=docs/data
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/tqdyn-refresh.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT
+QUICK=0
+[ "${1:-}" = "--quick" ] && QUICK=1
+mkdir -p "$DATA"
+
+# 1. benchmarks (tqdyn bench --json): one entry per model
+if [ $QUICK = 1 ]; then
+    tqdyn bench --model kepler --model lisa --model lisa-coupled --model kernels --model default-run \
+        --model startup --model lisa-10y --json "$DATA/bench.json"
+    tqdyn bench --model full --model coupled --duration 2d --json "$DATA/bench.json"
+    tqdyn bench --model tianqin-5y --duration 10d --json "$DATA/bench.json"
+else
+    tqdyn bench --model all --model default-run --model startup --model tianqin-5y --model lisa-10y \
+        --json "$DATA/bench.json"
+fi
+
+# 2. the paper's studies on TianQin and on LISA (summary.json of tqdyn report --studies), in fresh
+#    run folders so that every run's wall time is measured
+SCALE=()
+[ $QUICK = 1 ] && SCALE=(--quick)
+tqdyn report --studies "${SCALE[@]}" --out "$WORK/studies-tianqin" -q > "$WORK/studies-tianqin.log"
+cp "$WORK/studies-tianqin/summary.json" "$DATA/studies-tianqin.json"
+tqdyn report --studies --mission lisa "${SCALE[@]}" --out "$WORK/studies-lisa" -q > "$WORK/studies-lisa.log"
+cp "$WORK/studies-lisa/summary.json" "$DATA/studies-lisa.json"
+
+# 3. the pages from the new benchmark and study records (so that the suite's page checks pass)
+python tools/render_docs.py
+
+# 4. the numbers the tests measure (record_number): the default suite (its duration and each file's too),
+#    then the slow tests that record numbers
+python -m pytest -p no:cacheprovider -q --record-numbers "$DATA/tests.json" tests
+python -m pytest -p no:cacheprovider -q --record-numbers "$DATA/tests.json" --numbers-only -m slow tests
+
+# 5. the pages again, from the new test records, and the check
+python tools/render_docs.py
+python tools/render_docs.py --check
