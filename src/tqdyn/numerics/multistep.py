@@ -60,7 +60,7 @@ CORRECTORS = ("pe", "pec", "pece", "pecec", "pecece")
 #: Defaults of ``integrator.order`` and ``integrator.corrector``: docs/precision.md ("Multistep
 #: integration") gives the measurements behind them.
 DEFAULT_ORDER = 10
-DEFAULT_CORRECTOR = "pec"
+DEFAULT_CORRECTOR = "pece"
 #: Rows of ``coef``: position predictor, velocity predictor, position corrector, velocity corrector.
 ROW_NAMES = ("PREDICTOR_POSITION", "PREDICTOR_VELOCITY", "CORRECTOR_POSITION", "CORRECTOR_VELOCITY")
 _PP, _PV, _CP, _CV = 0, 1, 2, 3
