@@ -3,19 +3,20 @@
 ``integrator.method = "multistep"``: the satellites (and, in the free-TM mode,
 the test masses) are integrated by the summed Stormer-Cowell / Adams pair of
 :mod:`tqdyn.numerics.multistep` of order ``integrator.order`` K, each step
-P(EC)^k E with k = ``integrator.corrector_iterations``: k + 1 evaluations of
-the right-hand side per step, all at the step's end time t_{n+1}, so the
-time-only inputs of the force model are computed once per step (not 13
-times as for DP87).  Attitude and control are algebraic in the state
+with the stages ``integrator.corrector`` ("pece": predict, evaluate,
+correct, evaluate; one evaluation of the right-hand side per "e"), all at
+the step's end time t_{n+1}, so the time-only inputs of the force model are
+computed once per step (not 13 times as for DP87).  Attitude and control are algebraic in the state
 (:func:`tqdyn.dynamics.rhs.system_rhs` forms them at every evaluation), so
 nothing else is integrated.
 
 Start-up: the first K steps are DP87 steps of the same size (the fixed-step
 kernel of :mod:`.fixed`, the scenario's tableau), which give the states
 y_0 .. y_K and the accelerations f_0 .. f_K; the sums are then fixed by the
-corrector at t_K (:func:`tqdyn.numerics.multistep.start`).  The DP87 local
-error at these steps is what the fixed-step mode makes at every step, so the
-start-up adds an error of that size once (docs/precision.md derives it).
+corrector at t_K (:func:`tqdyn.numerics.multistep.start`).  These are the
+first K steps of the DP87 run, so the start-up carries DP87's local error
+of K steps, like an error of the initial state (docs/precision.md derives
+what that costs: ~2K/N of the DP87 run's final error after N steps).
 
 Output rows, progress and checkpoints follow the fixed-step mode: chunks of
 steps (:func:`.fixed.chunk_plan`), the inputs of the next block computed in a
@@ -162,9 +163,9 @@ def warm_up_multistep(precision: str = "dd") -> None:
 
 
 def _start_up(st, mc, scenario, precision, model, epoch, tab, y0_dd, sink, system, cpu):
-    """The first min(K, n_total) steps by DP87 at the same step: emits their
-    rows, fills the table with f_0 .. f_K and fixes the sums.  Returns the
-    steps done."""
+    """The first n_s = min(K, n_total) steps by DP87 at the same step: emits
+    their rows, fills the table with f_0 .. f_{n_s} and, if n_s = K, fixes
+    the sums.  Returns (n_s, the rows' diagnostics or None)."""
     n_s = min(mc.order, scenario.n_steps)
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
     y, comp, K, ystage, err = _workspace(y0_dd, precision)
