@@ -441,3 +441,15 @@ def test_light_paths_of_coupled_rows_match_dp87():
           f"tau {tau:.2e} s")
     assert emit < 1.01 * rows_diff + 1e-16
     assert tau < 3 * rows_diff / 299792458.0
+
+
+def test_cpu_accounting_and_evaluations():
+    """RunResult of a coupled multistep day: the CPU of the time-only inputs
+    and of the compiled loop are measured, the loop's within the wall time,
+    the process's at least the loop's; PECE evaluates twice per step after
+    the 10 DP87 steps of the start-up (13 each, and one at their end)."""
+    scen = load_scenario("tianqin", ["run.duration=1d", *MS])
+    res = dynamics.propagate(scen)
+    assert 0.0 < res.cpu_inputs_s and 0.0 < res.cpu_loop_s <= res.wall_s * 1.02
+    assert res.cpu_process_s >= res.cpu_loop_s
+    assert res.n_rhs == 13 * 10 + 1 + 2 * (1728 - 10)

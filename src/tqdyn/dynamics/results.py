@@ -172,7 +172,8 @@ class RunResult:
     states and times (the force model's); cpu_inputs_s, cpu_loop_s: CPU
     time [s] of the time-only inputs (their thread) and of the compiled loop
     (fixed mode; 0 otherwise) -- on two cores the wall time cannot be below
-    half their sum.
+    half their sum; cpu_process_s: CPU time [s] of the whole process during
+    :func:`~tqdyn.dynamics.propagate` (all threads, the BLAS library's too).
     """
 
     precision: str
@@ -189,6 +190,7 @@ class RunResult:
     reference: object = None
     cpu_inputs_s: float = 0.0
     cpu_loop_s: float = 0.0
+    cpu_process_s: float = 0.0
 
 
 def update_extremes(ext: dict, out_aux: np.ndarray, system) -> None:
