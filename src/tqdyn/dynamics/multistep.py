@@ -253,7 +253,12 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
         chunk span = (first step, steps), at their end times.  A block
         shorter than its chunk is evaluated together with the chunk's first
         and last instants, whose rows are dropped (as in :mod:`.fixed`: the
-        inputs of a step do not depend on the block holding it)."""
+        inputs of a step do not depend on the block holding it).  The
+        instants are passed as an (m, 1) array, as DP87 passes (m, 13): the
+        force model's matrix products (the ocean tides') then run row by
+        row instead of as one large BLAS product, whose threads would spin
+        beside the compiled loop (measured: 40-50% more CPU for the
+        process, the same wall time)."""
         if not model.time_dependent:
             return np.zeros((m, 0))
         t_cpu = _time.thread_time()
@@ -262,7 +267,7 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
             t = eval_times(n0, m)
             if (n0, m) != (c0, cm):
                 t = np.concatenate([t, eval_times(c0, 1), eval_times(c0 + cm - 1, 1)])
-            return model.precompute(epoch, t[:, 0], t[:, 1])[:m]
+            return model.precompute(epoch, t[:, None, 0], t[:, None, 1])[:m, 0]
         finally:
             cpu["inputs"] += _time.thread_time() - t_cpu
 
