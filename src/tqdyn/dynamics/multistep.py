@@ -293,8 +293,8 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
                 o, e = b0 - n0, b0 - n0 + mb
                 t_cpu = _time.thread_time()
                 _multistep_chunk(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux,
-                                 stats, n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, mb, out_y[o:e],
-                                 out_a[o:e], out_aux[o:e])
+                                 stats, n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, mb,
+                                 out_y[o:e], out_a[o:e], out_aux[o:e])
                 cpu["loop"] += _time.thread_time() - t_cpu
                 del tdat
             if sink is not None:

@@ -47,8 +47,8 @@ from numba import njit
 from . import _multistep_coefficients as _tab
 from .dd import add, dd_from_mp, div, ld, mp_exact, mul, st, sub, to_f64
 
-__all__ = ["ORDERS", "CORRECTORS", "DEFAULT_ORDER", "DEFAULT_CORRECTOR", "Coefficients", "load_coefficients", "StepCoefficients", "step_coefficients",
-           "predict", "correct", "commit", "start", "max_change", "ROW_NAMES"]
+__all__ = ["ORDERS", "CORRECTORS", "DEFAULT_ORDER", "DEFAULT_CORRECTOR", "Coefficients", "load_coefficients",
+           "StepCoefficients", "step_coefficients", "predict", "correct", "commit", "start", "max_change", "ROW_NAMES"]
 
 #: Orders (degree K of the acceleration interpolant, K + 1 back values) the generated table holds:
 #: the allowed values of ``integrator.order``.
