@@ -257,8 +257,8 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
         instants are passed as an (m, 1) array, as DP87 passes (m, 13): the
         force model's matrix products (the ocean tides') then run row by
         row instead of as one large BLAS product, whose threads would spin
-        beside the compiled loop (measured: 40-50% more CPU for the
-        process, the same wall time)."""
+        beside the compiled loop (more CPU for the process, not less wall
+        time: ``tqdyn bench --model coupled`` prints the process's CPU)."""
         if not model.time_dependent:
             return np.zeros((m, 0))
         t_cpu = _time.thread_time()
