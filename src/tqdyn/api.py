@@ -98,7 +98,8 @@ def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, ob
     """
     scen = load_scenario(scenario, overrides)
     model = dynamics.check_inputs(scen)
-    dynamics.warm_up(scen.run.precision)  # compile (or load the cached kernels) outside the timed propagation
+    # compile (or load the cached kernels) outside the timed propagation
+    dynamics.warm_up(scen.run.precision, scen.integrator.method)
     blocks: list = []
     bar = None
     if progress:

@@ -24,6 +24,7 @@ def info():
     from ..astro.reference import REFERENCE_SYSTEMS
     from ..forces.model import describe_terms
     from ..numerics.dp87 import CORRECTED_TABLEAU_PROVENANCE
+    from ..numerics.multistep import CORRECTORS, ORDERS
     from ..scenario import builtin_scenarios
 
     def version(mod):
@@ -44,6 +45,8 @@ def info():
              "Hermite dense output",
              f"  tableaux: corrected (default; {CORRECTED_TABLEAU_PROVENANCE}) | published "
              "(GSL rk8pd.c / GMAT rationals, order conditions hold to ~6.5e-18)",
+             "  or (integrator.method = \"multistep\") Gauss-Jackson / summed Adams, fixed step, order "
+             f"{ORDERS[0]}..{ORDERS[-1]}, {' | '.join(CORRECTORS)}, DP87 start-up",
              "force models:"]
     for name, description, source in describe_terms():
         lines.append(f"  {name:<20} {description} [{source}]")

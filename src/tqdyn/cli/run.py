@@ -158,7 +158,9 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     n_total = scen.n_steps
     c = scen.constellation
     click.echo(f"tqdyn {__version__}: scenario {scen.name!r}, {len(scen.satellites)} satellite(s), "
-               f"{scen.run.precision} precision, DP87 {integ.mode} "
+               f"{scen.run.precision} precision, "
+               + (f"multistep order {integ.order} {integ.corrector.upper()} (DP87 start-up) "
+                  if integ.method == "multistep" else f"DP87 {integ.mode} ")
                + (f"{integ.step_s} s x {n_total} steps" if fixed else f"rtol {integ.rtol}, output every {integ.step_s} s")
                + f", {scen.run.duration_s} s from {scen.epoch.iso}"
                + (f"; pointing {c.pointing}, control {c.control}" + (", free TMs" if c.free_tms else "")

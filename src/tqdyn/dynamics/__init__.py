@@ -9,16 +9,16 @@ module                   job
 :mod:`.system`           a scenario's constellation as the system's parameters
 :mod:`.initial`          initial states (elements -> state; free TMs at their housings)
 :mod:`.fixed`            fixed-step DP87 loop, chunked and compiled
+:mod:`.multistep`        fixed-step Gauss-Jackson / summed Adams loop (DP87 start-up)
 :mod:`.adaptive`         adaptive DP87 with dense output on the output grid
 :mod:`.results`          typed output rows, checkpoints, the run result
 :mod:`.propagation`      :func:`propagate`, the entry point
 =======================  ==========================================================
 """
 
-from .fixed import warm_up
 from .initial import initial_state
 from .layout import PRECISIONS
-from .propagation import check_inputs, propagate, two_body_energy
+from .propagation import check_inputs, propagate, two_body_energy, warm_up
 from .results import Checkpoint, Rows, RunResult, row_names
 from .rhs import evaluate_rhs
 from .system import System, build_system, self_gravity_oa

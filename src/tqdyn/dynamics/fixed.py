@@ -29,7 +29,7 @@ from . import layout as _lay
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
-__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "propagate_fixed", "warm_up"]
+__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "chunk_plan", "propagate_fixed", "warm_up"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -140,6 +140,21 @@ def warm_up(precision: str = "dd") -> None:
 # Python driver
 
 
+def chunk_plan(n: int, n_total: int, chunk: int, checkpoint_every: int) -> list[tuple[int, int]]:
+    """(first step, steps) of the chunks from step n to n_total: at most
+    ``chunk`` steps each, ending at every multiple of ``checkpoint_every``
+    (0: none).  The boundaries depend on n only through where the plan
+    starts, so a run resumed at a boundary takes the same chunks."""
+    plan = []
+    while n < n_total:
+        m = min(chunk, n_total - n)
+        if checkpoint_every:
+            m = min(m, (n // checkpoint_every + 1) * checkpoint_every - n)
+        plan.append((n, m))
+        n += m
+    return plan
+
+
 def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
                      start=None, checkpoint=None, checkpoint_every=0, system=None, checkpoint_interval_s=0.0):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
@@ -163,17 +178,9 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
     t_start = _time.perf_counter()
     t_ckpt = t_start
     extremes: dict = {}
-    # chunk boundaries (fixed by chunk and checkpoint_every, so a resumed run
-    # takes the same steps); the time-only inputs of the next chunk are
-    # computed in a second thread while the compiled loop (nogil) runs.
-    plan = []
-    n_plan = n
-    while n_plan < n_total:
-        m = min(chunk, n_total - n_plan)
-        if checkpoint_every:
-            m = min(m, (n_plan // checkpoint_every + 1) * checkpoint_every - n_plan)
-        plan.append((n_plan, m))
-        n_plan += m
+    # the time-only inputs of the next chunk are computed in a second thread
+    # while the compiled loop (nogil) runs.
+    plan = chunk_plan(n, n_total, chunk, checkpoint_every)
 
     def inputs(n0, m, span):
         """Time-only inputs (m, 13, n_tdat) of the steps n0 .. n0 + m - 1 of

@@ -145,13 +145,16 @@ def select_rows(t, y, a, precision, every, n0, aux=None, system=None) -> Rows:
 class Checkpoint:
     """State of a fixed-step run after ``n`` steps: y (working precision,
     (n_body, 6[, 2]): the satellites, then the TMs in the free-TM mode) and
-    its Kahan compensation ``comp``.  Resuming from it reproduces the
-    uninterrupted run bit for bit (every step depends only on y, comp and
-    the step index)."""
+    its Kahan compensation ``comp``; ``table``: the multistep integrator's
+    table as one flat float64 array (accelerations, sums, compensations and
+    the last diagnostics, :mod:`tqdyn.dynamics.multistep`; None for DP87).
+    Resuming from it reproduces the uninterrupted run bit for bit (every
+    step depends only on y, comp, the table and the step index)."""
 
     n: int
     y: np.ndarray
     comp: np.ndarray
+    table: np.ndarray | None = None
 
 
 @dataclass
@@ -169,7 +172,8 @@ class RunResult:
     states and times (the force model's); cpu_inputs_s, cpu_loop_s: CPU
     time [s] of the time-only inputs (their thread) and of the compiled loop
     (fixed mode; 0 otherwise) -- on two cores the wall time cannot be below
-    half their sum.
+    half their sum; cpu_process_s: CPU time [s] of the whole process during
+    :func:`~tqdyn.dynamics.propagate` (all threads, the BLAS library's too).
     """
 
     precision: str
@@ -186,6 +190,7 @@ class RunResult:
     reference: object = None
     cpu_inputs_s: float = 0.0
     cpu_loop_s: float = 0.0
+    cpu_process_s: float = 0.0
 
 
 def update_extremes(ext: dict, out_aux: np.ndarray, system) -> None:

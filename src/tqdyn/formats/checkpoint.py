@@ -3,8 +3,10 @@
 A checkpoint lets an interrupted run continue (``tqdyn run --resume``) to
 the same trajectory bit for bit.  It holds the resolved scenario (TOML
 text), the precision, the step count, the state (all propagated bodies, TMs
-included in the free-TM mode) and its compensation, the partial trajectory
-file and how many of its rows the checkpoint covers.  What to do with it
+included in the free-TM mode) and its compensation, the multistep
+integrator's table (``integrator.method = "multistep"`` only: one flat
+float64 array, absent for DP87), the partial trajectory file and how many of
+its rows the checkpoint covers.  What to do with it
 (checking that it belongs to the run, continuing the partial trajectory) is
 :mod:`tqdyn.workflows.run`'s job.
 
@@ -37,7 +39,8 @@ class CheckpointFile:
     scenario : the resolved scenario as TOML text; precision : "dd" |
     "float64"; n : steps done; y, comp : the state and its compensation
     (float64 arrays); partial : path of the partial trajectory file; rows :
-    time rows of it the checkpoint covers.
+    time rows of it the checkpoint covers; table : the multistep
+    integrator's table (flat float64 array) or None (DP87).
     """
 
     scenario: str
@@ -47,19 +50,23 @@ class CheckpointFile:
     comp: np.ndarray
     partial: str
     rows: int
+    table: np.ndarray | None = None
 
 
-def write_checkpoint(path, *, scenario: str, precision: str, n: int, y, comp, partial, rows: int) -> None:
+def write_checkpoint(path, *, scenario: str, precision: str, n: int, y, comp, partial, rows: int,
+                     table=None) -> None:
     """Atomically write a run checkpoint (npz): the resolved scenario, the
     step count, the state (all propagated bodies, TMs included in the free-TM
-    mode) and its compensation, the partial trajectory file and how many of
-    its rows the checkpoint covers."""
+    mode) and its compensation, the multistep table if any, the partial
+    trajectory file and how many of its rows the checkpoint covers."""
     path = pathlib.Path(path)
     tmp = path.with_name(path.name + ".tmp")
     arrays = dict(scenario=np.array(str(scenario)), precision=np.array(str(precision)),
                   n=np.array(int(n), dtype=np.int64), y=np.asarray(y, dtype=np.float64),
                   comp=np.asarray(comp, dtype=np.float64), partial=np.array(str(partial)),
                   rows=np.array(int(rows), dtype=np.int64))
+    if table is not None:
+        arrays["table"] = np.asarray(table, dtype=np.float64).ravel()
     try:
         with open(tmp, "wb") as fh:
             np.savez(fh, **arrays)
@@ -87,10 +94,16 @@ def read_checkpoint(path) -> CheckpointFile:
                 if a.dtype.kind not in kind or (kind in ("U", "iu") and a.ndim != 0):
                     raise ValueError(f"entry {key!r} has dtype {a.dtype} shape {a.shape}")
                 arrays[key] = a
+            table = None
+            if "table" in data.files:  # multistep runs only
+                table = data["table"]
+                if table.dtype.kind != "f" or table.ndim != 1:
+                    raise ValueError(f"entry 'table' has dtype {table.dtype} shape {table.shape}")
+                table = np.array(table, dtype=np.float64)
             return CheckpointFile(scenario=str(arrays["scenario"]), precision=str(arrays["precision"]),
                                   n=int(arrays["n"]), y=np.array(arrays["y"], dtype=np.float64),
                                   comp=np.array(arrays["comp"], dtype=np.float64),
-                                  partial=str(arrays["partial"]), rows=int(arrays["rows"]))
+                                  partial=str(arrays["partial"]), rows=int(arrays["rows"]), table=table)
     except FileNotFoundError:
         raise
     except Exception as exc:  # noqa: BLE001 - BadZipFile, EOFError, KeyError, numpy's pickle refusal, ...

@@ -26,8 +26,9 @@ TOML layout (every section and key optional except at least one
     [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
                     precision ("dd" | "float64"), output, output_every,
                     max_steps (default 1e9: the most steps a run may have)
-    [integrator]    method ("dp87"), mode ("fixed" | "adaptive"), step [s],
-                    tableau ("corrected" | "published"), rtol
+    [integrator]    method ("dp87" | "multistep"), mode ("fixed" | "adaptive"), step [s],
+                    tableau ("corrected" | "published"), rtol; multistep: order,
+                    corrector ("pe" | "pec" | "pece" | "pecec" | "pecece")
     [forces]        earth_monopole, gm_earth [m^3/s^2], the force-model switches,
                     gm_sun, gm_earth_tdb, gm_moon, gm_mercury .. gm_neptune
                     [m^3/s^2, TDB-compatible; default DE430/DE431]

@@ -20,6 +20,7 @@ from ..astro.constants import GM_EARTH_EGM2008
 from ..astro.eop_sources import DEFAULT_EOP_SOURCE, EOP_SOURCES, EOP_SOURCES_ALLOWED, normalize_eop_source
 from ..astro.timescales import Epoch
 from ..forces.body_gms import BODY_GM_KEYS, default_body_gm
+from ..numerics import multistep as _ms
 from .toml_text import toml_str, toml_value
 
 __all__ = [
@@ -30,7 +31,7 @@ __all__ = [
 ]
 
 _PRECISIONS = ("dd", "float64")
-_METHODS = ("dp87",)
+_METHODS = ("dp87", "multistep")
 _MODES = ("fixed", "adaptive")
 _TABLEAUS = ("corrected", "published")
 _RTOL_MAX = 1e-3
@@ -54,11 +55,12 @@ from .values import (  # noqa: F401  (re-exported for the loader)
 class IntegratorConfig:
     """Integrator choice.
 
-    ``method``: ``"dp87"`` (Dormand-Prince 8(7)); ``mode``: ``"fixed"`` or
-    ``"adaptive"``; ``step_s`` [s] (> 0): the fixed step, or in adaptive mode
+    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"``
+    (fixed step; :mod:`tqdyn.numerics.multistep`); ``mode``: ``"fixed"`` or
+    ``"adaptive"`` (DP87 only); ``step_s`` [s] (> 0): the fixed step, or in adaptive mode
     the output interval; ``tableau``: ``"corrected"`` or ``"published"``
-    coefficients; ``rtol``: adaptive-mode relative local error tolerance
-    (0 < rtol < 1e-3).
+    coefficients (also of the multistep start-up); ``rtol``: adaptive-mode relative local error tolerance
+    (0 < rtol < 1e-3).  Multistep: ``order`` and ``corrector`` (:mod:`tqdyn.numerics.multistep`).
     """
 
     method: str = "dp87"
@@ -66,10 +68,18 @@ class IntegratorConfig:
     step_s: Decimal = Decimal(50)
     tableau: str = "corrected"
     rtol: float = 1e-22
+    order: int = _ms.DEFAULT_ORDER
+    corrector: str = _ms.DEFAULT_CORRECTOR
 
     def __post_init__(self) -> None:
         _require_choice(self.method, "integrator.method", _METHODS)
         _require_choice(self.mode, "integrator.mode", _MODES)
+        _require(self.method != "multistep" or self.mode == "fixed", "integrator.mode", self.mode,
+                 'has no multistep form (integrator.method = "multistep")', '"fixed", or method = "dp87"')
+        o = self.order
+        _require(isinstance(o, int) and not isinstance(o, bool) and o in _ms.ORDERS, "integrator.order", o,
+                 "is not an available order", f"an integer {_ms.ORDERS[0]}..{_ms.ORDERS[-1]}")
+        _require_choice(self.corrector, "integrator.corrector", _ms.CORRECTORS)
         _require_choice(self.tableau, "integrator.tableau", _TABLEAUS)
         _set(self, "step_s", _to_decimal(self.step_s, "integrator.step_s"))
         _require(self.step_s > 0, "integrator.step_s", self.step_s, "is not positive", "step > 0 s")
@@ -517,7 +527,10 @@ class Scenario:
                 f"max_steps = {r.max_steps}", ""]
         g = self.integrator
         out += ["[integrator]", f"method = {toml_str(g.method)}", f"mode = {toml_str(g.mode)}",
-                f"step = {toml_value(g.step_s)}  # s", f"tableau = {toml_str(g.tableau)}", f"rtol = {g.rtol!r}", ""]
+                f"step = {toml_value(g.step_s)}  # s", f"tableau = {toml_str(g.tableau)}", f"rtol = {g.rtol!r}"]
+        if g.method != "dp87" or (g.order, g.corrector) != (_ms.DEFAULT_ORDER, _ms.DEFAULT_CORRECTOR):
+            out += [f"order = {g.order}", f"corrector = {toml_str(g.corrector)}"]  # DP87 runs: left implicit
+        out += [""]
         f = self.forces
         b = lambda x: "true" if x else "false"  # noqa: E731
         out += ["[forces]", f"earth_monopole = {b(f.earth_monopole)}", f"sun_monopole = {b(f.sun_monopole)}",

@@ -132,6 +132,15 @@ def spacecraft_attrs(scen) -> dict:
             "spacecraft_units": io.schema.SPACECRAFT_UNITS}
 
 
+def integrator_label(integ) -> str:
+    """The trajectory file's ``integrator`` attribute: "dp87-<mode>-<tableau>",
+    or for the multistep method "multistep-<order>-<corrector>-dp87-<tableau>"
+    (order, step stages, the DP87 tableau of its start-up)."""
+    if integ.method == "multistep":
+        return f"multistep-{integ.order}-{integ.corrector}-dp87-{integ.tableau}"
+    return f"dp87-{integ.mode}-{integ.tableau}"
+
+
 def output_attrs(scen, model=None) -> dict:
     """Root attributes of the trajectory file of ``scen`` (the EOP attributes
     from ``model``'s table if given, see :func:`eop_attrs`; the spacecraft
@@ -151,7 +160,7 @@ def output_attrs(scen, model=None) -> dict:
         "time_scale": ref.time_scale,
         "precision": scen.run.precision,
         "step_s": float(integ.step_s),
-        "integrator": f"dp87-{integ.mode}-{integ.tableau}",
+        "integrator": integrator_label(integ),
         "pointing": c.pointing,
         "control": c.control,
         "free_tms": int(c.free_tms),
@@ -278,7 +287,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         writer_factory = None
     t0 = time.perf_counter()
     try:
-        dynamics.warm_up(scen.run.precision)
+        dynamics.warm_up(scen.run.precision, scen.integrator.method)
     except OSError as exc:  # numba could not write its cache (disk full, file-size limit)
         raise io.OutputIOError(f"JIT compilation could not write numba's cache: {exc.strerror or exc}; free "
                                f"space, or set NUMBA_CACHE_DIR to a writable directory") from None
@@ -302,7 +311,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         partial = writer.sync()
         try:
             write_checkpoint(ckpt, scenario=scen.to_toml(), precision=scen.run.precision, n=c.n, y=c.y,
-                             comp=c.comp, partial=partial, rows=writer.rows_written)
+                             comp=c.comp, partial=partial, rows=writer.rows_written, table=c.table)
         except OSError as exc:  # disk full: the previous checkpoint (if any) stays valid
             raise io.OutputIOError(f"cannot write the checkpoint {str(ckpt)!r}: "
                                    f"{exc.strerror or exc}") from None
@@ -365,6 +374,6 @@ def _resume(ckpt_path, scen, out_path):
     """(Checkpoint, writer factory) of an interrupted run; ValueError if
     there is none or it belongs to another scenario."""
     data = _read_own_checkpoint(ckpt_path, scen)
-    start = Checkpoint(data.n, data.y, data.comp)
+    start = Checkpoint(data.n, data.y, data.comp, data.table)
     partial, rows = data.partial, data.rows
     return start, lambda: io.TrajectoryWriter.reopen(partial, out_path, rows)
