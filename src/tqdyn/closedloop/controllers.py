@@ -36,7 +36,8 @@ LOOPS = {
     "suspension": (("tm1 p axis (Z x e_1)", "tm2 p axis (Z x e_2)", "half the z difference"), "m",
                    "capacitive", "electrostatic force"),
     "attitude": (("x", "y"), "rad", "DWS (the pitches of both MOSAs)", "thrusters (torque)"),
-    "attitude_z": (("z",), "rad", "star tracker", "thrusters (torque)"),
+    "attitude_z": (("z",), "rad", "mean DWS yaw minus mean MOSA encoder angle (or the star tracker)",
+                   "thrusters (torque)"),
     "mosa": (("MOSA 1", "MOSA 2"), "rad", "DWS yaw of the MOSA (spacecraft yaw + MOSA angle)", "MOSA actuator"),
     "tm_rotation": (("tm1 x", "tm1 y", "tm1 z", "tm2 x", "tm2 y", "tm2 z"), "rad", "capacitive", "electrostatic torque"),
 }

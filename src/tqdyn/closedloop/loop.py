@@ -36,6 +36,7 @@ SOURCES = {
     "interferometer": (2, "m", "TM interferometer along each sensitive axis"),
     "dws": (4, "rad", "DWS pitch and yaw of MOSA 1, then MOSA 2"),
     "star_tracker": (3, "rad", "star tracker, S axes"),
+    "mosa_encoder": (2, "rad", "MOSA angle encoder (the angle of the MOSA relative to the spacecraft)"),
     "mosa_actuator": (2, "N m", "MOSA actuator torque"),
 }
 
@@ -126,9 +127,15 @@ def _controllers_ss(controllers: dict) -> list:
     return out
 
 
-def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict) -> ClosedLoop:
+def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
+                      attitude_z_sensor: str = "dws") -> ClosedLoop:
     """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
-    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`."""
+    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
+    ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
+    "star_tracker" (as LISA Pathfinder, which had no DWS)."""
+    if attitude_z_sensor not in ("dws", "star_tracker"):
+        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
+                         "allowed: 'dws', 'star_tracker'")
     P = linear_plant(p, wp)
     basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
     from ..constellation.control import oa_rotation
@@ -142,7 +149,8 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict) -
     sin = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
            + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
            + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
-           + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker"))
+           + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker")
+           + source_inputs("mosa_encoder"))
     ci = {s: k for k, s in enumerate(sin)}
     rows, names = [], []
 
@@ -181,7 +189,10 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict) -
     for a in range(2):
         row(comb(Pm[a], pitch))
         names.append(f"e_attitude[{a}]")
-    row({"phi[2]": 1.0, "star_tracker[2]": 1.0})
+    if attitude_z_sensor == "star_tracker":
+        row({"phi[2]": 1.0, "star_tracker[2]": 1.0})
+    else:     # mean DWS yaw minus the mean MOSA angle from the encoders
+        row(comb((0.5, 0.5, -0.5, -0.5), yaw + [{f"dth[{l}]": 1.0, f"mosa_encoder[{l}]": 1.0} for l in range(2)]))
     names.append("e_attitude_z[0]")
     for l in range(2):
         row(yaw[l])
@@ -286,6 +297,6 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict) -
     inplist = noise + [f"d_{c}" for c in chans]
     outlist = onames + [f"c_{c}" for c in chans]
     syslist = [P, sensors, actuators, observables] + _controllers_ss(controllers)
-    cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, check_unused=False,
-                              name="closed_loop", warn_duplicate=False)
+    cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
+                              check_unused=False, name="closed_loop", warn_duplicate=False)
     return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=dc)

@@ -31,7 +31,7 @@ _COMMON_PLANT = dict(mosa_inertia=10.0, mosa_stiffness=0.0, stiffness=(-1e-6, -1
                      rotational_stiffness=(-1e-6, -1e-6, -1e-6), crosstalk=1e-3)
 
 #: Crossover frequencies of the default controllers [Hz] (docs/closed-loop.md derives them).
-CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitude_z": 0.001, "mosa": 0.01,
+CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitude_z": 0.02, "mosa": 0.01,
                 "tm_rotation": 0.005}
 
 
@@ -81,7 +81,8 @@ def default_noise(mission: str) -> dict:
                             ((2e-3, -2.0),), "m"),
         "dws": m("dws", 2e-10, ((2e-3, -2.0),), "rad"),
         "star_tracker": m("star_tracker", 1e-5, (), "rad"),
-        "mosa_actuator": m("mosa_actuator", 1e-7, (), "N m"),
+        "mosa_encoder": m("mosa_encoder", 1e-9, ((1e-3, -1.0),), "rad"),
+        "mosa_actuator": m("mosa_actuator", 1e-9, (), "N m"),
     }
 
 
