@@ -27,6 +27,9 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from ..scenario.closed_loop import LOOP_NAMES, check_controller
+from ..scenario.values import ScenarioError
+
 __all__ = ["Controller", "ControllerError", "LOOPS", "lead_lag_pid"]
 
 #: Loops: name -> (channels, what is sensed, sensor, actuator).
@@ -43,29 +46,8 @@ LOOPS = {
 }
 
 
-class ControllerError(ValueError):
-    """An invalid controller: one line naming the field (attribute ``field``)."""
-
-    def __init__(self, field_name: str, value, problem: str, allowed: str):
-        self.field = field_name
-        super().__init__(f"{field_name}: {value!r} {problem}; allowed: {allowed}")
-
-
-def _roots(values, name: str) -> np.ndarray:
-    out = []
-    for v in values:
-        if isinstance(v, (list, tuple)) and len(v) == 2:
-            re, im = v
-            out += [complex(re, im), complex(re, -im)] if im != 0 else [complex(re, 0.0)]
-        elif isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool):
-            out.append(complex(v, 0.0))
-        else:
-            raise ControllerError(name, list(values), "is not a list of roots",
-                                  "real numbers (rad/s) or [re, im] pairs for conjugate pairs")
-    a = np.array(out, dtype=complex)
-    if not np.all(np.isfinite(a)):
-        raise ControllerError(name, list(values), "is not finite", "finite roots (rad/s)")
-    return a
+#: Invalid controllers raise the scenario's one-line error naming the key.
+ControllerError = ScenarioError
 
 
 @dataclass(frozen=True)
@@ -78,25 +60,12 @@ class Controller:
     name: str = "controller"
 
     def __post_init__(self):
-        z = _roots(self.zeros, f"closed_loop.controllers.{self.name}.zeros")
-        p = _roots(self.poles, f"closed_loop.controllers.{self.name}.poles")
-        g = self.gain
-        if isinstance(g, bool) or not isinstance(g, (int, float, np.floating, np.integer)) or not math.isfinite(g) \
-                or g <= 0:
-            raise ControllerError(f"closed_loop.controllers.{self.name}.gain", g, "is not a positive number",
-                                  "gain > 0 (negative feedback is built into the loop)")
-        if len(z) > len(p):
-            raise ControllerError(f"closed_loop.controllers.{self.name}", f"{len(z)} zeros, {len(p)} poles",
-                                  "is improper", "at most as many zeros as poles")
-        if np.any(p.real > 0):
-            raise ControllerError(f"closed_loop.controllers.{self.name}.poles", list(self.poles),
-                                  "has an unstable pole", "poles with Re <= 0 (an integrator at 0 is allowed)")
+        check_controller(self.name, list(self.zeros), list(self.poles), self.gain)
 
     def tf(self) -> control.TransferFunction:
         """C(s) as a python-control TransferFunction (real coefficients)."""
-        z = _roots(self.zeros, "zeros")
-        p = _roots(self.poles, "poles")
-        return control.zpk(z, p, float(self.gain))
+        z, p, k = check_controller(self.name, list(self.zeros), list(self.poles), self.gain)
+        return control.zpk(np.array(z), np.array(p), k)
 
 
 def lead_lag_pid(f_c: float, alpha: float = 10.0, integrator_ratio: float = 10.0, name: str = "controller") \
@@ -107,3 +76,6 @@ def lead_lag_pid(f_c: float, alpha: float = 10.0, integrator_ratio: float = 10.0
     s = 1j * wc
     mag = abs((s + wz) * (s + wi) / (s * (s + wp))) / wc ** 2
     return Controller(zeros=(-wz, -wi), poles=(0.0, -wp), gain=1.0 / mag, name=name)
+
+
+assert tuple(LOOPS) == LOOP_NAMES, "the scenario's loop names and LOOPS differ"

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from ..scenario.closed_loop import SOURCE_UNITS
 from .controllers import LOOPS, Controller
 from .plant import PlantParameters, WorkingPoint, linear_plant, sensitive_basis
 
@@ -41,6 +42,7 @@ SOURCES = {
 }
 
 _AX = ("x", "y", "z")
+assert {k: v[1] for k, v in SOURCES.items()} == SOURCE_UNITS, "the scenario's source units and SOURCES differ"
 
 
 def _output_table() -> dict:

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 
+from ..scenario.closed_loop import MISSIONS
 from .controllers import Controller, lead_lag_pid
 from .noise import AsdModel
 
-__all__ = ["MISSIONS", "default_controllers", "default_noise", "default_plant", "requirement"]
+__all__ = ["MISSIONS", "controller_from_keys", "default_controllers", "default_noise", "default_plant", "requirement",
+           "resolve"]
 
-MISSIONS = ("tianqin", "lisa", "taiji")
 
 #: Plant defaults per mission (scenario keys of [closed_loop.plant]).
 _PLANT = {
@@ -96,7 +97,34 @@ def default_controllers(mission: str) -> dict:
 
 def controller_from_keys(loop: str, zeros, poles, gain) -> Controller:
     """A :class:`Controller` of ``loop`` from scenario keys (zeros, poles in rad/s; gain)."""
-    return Controller(zeros=tuple(zeros), poles=tuple(poles), gain=gain, name=loop)
+    def flat(x):
+        return tuple(tuple(float(a) for a in r) if isinstance(r, (list, tuple)) else float(r) for r in x)
+
+    return Controller(zeros=flat(zeros), poles=flat(poles), gain=float(gain), name=loop)
+
+
+def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
+    """(mission, plant dict, {loop: Controller}, {source: AsdModel}) of a
+    :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` over the mission's defaults (the mission:
+    ``closed_loop.mission`` or the spacecraft ``architecture``); a given noise ``level`` or ``knees``
+    replaces that part of the default."""
+    from ..scenario.closed_loop import PLANT_KEYS
+
+    mission = config.mission(architecture)
+    raw = config.raw or {}
+    plant = default_plant(mission)
+    for k, v in raw.get("plant", {}).items():
+        plant[k] = float(v) if PLANT_KEYS[k] == 1 else tuple(float(x) for x in v)
+    ctl = default_controllers(mission)
+    for loop, spec in raw.get("controllers", {}).items():
+        ctl[loop] = controller_from_keys(loop, spec["zeros"], spec["poles"], float(spec["gain"]))
+    noise = default_noise(mission)
+    for src, spec in raw.get("noise", {}).items():
+        base = noise[src]
+        noise[src] = AsdModel(float(spec.get("level", base.level)),
+                              tuple(tuple(float(x) for x in k) for k in spec.get("knees", base.knees)),
+                              base.unit, base.name)
+    return mission, plant, ctl, noise
 
 
 _ = math

@@ -35,6 +35,9 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..scenario.closed_loop import check_asd
+from ..scenario.values import ScenarioError
+
 __all__ = ["AsdModel", "NoiseModelError", "shaping_error"]
 
 #: Ladder spacing of the fitted knees (poles per decade) and the band margin (decades) beyond [f_lo, f_hi].
@@ -44,12 +47,8 @@ _BAND_MARGIN_DECADES = 1.0
 _ROLLOFF_FACTOR = 30.0
 
 
-class NoiseModelError(ValueError):
-    """An invalid noise model: one line ``<name>: <value> <problem>; allowed: <what>`` (attribute ``field``)."""
-
-    def __init__(self, field_name: str, value, problem: str, allowed: str):
-        self.field = field_name
-        super().__init__(f"{field_name}: {value!r} {problem}; allowed: {allowed}")
+#: Invalid noise models raise the scenario's one-line error (field, value, what is allowed).
+NoiseModelError = ScenarioError
 
 
 @dataclass(frozen=True)
@@ -72,22 +71,9 @@ class AsdModel:
     name: str = "noise"
 
     def __post_init__(self):
-        lv = self.level
-        if isinstance(lv, bool) or not isinstance(lv, (int, float, np.floating, np.integer)) or not math.isfinite(lv):
-            raise NoiseModelError(f"{self.name}.level", lv, "is not a finite number", "a level >= 0 (unit/Hz^1/2)")
-        if lv < 0:
-            raise NoiseModelError(f"{self.name}.level", lv, "is a negative ASD", "a level >= 0 (unit/Hz^1/2)")
-        out = []
-        for k in self.knees:
-            ok = isinstance(k, (tuple, list)) and len(k) == 2 and all(
-                isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool) and math.isfinite(x)
-                for x in k)
-            if not ok or k[0] <= 0 or k[1] == 0:
-                raise NoiseModelError(f"{self.name}.knees", list(self.knees), "has an invalid knee",
-                                      "pairs [frequency Hz > 0, slope != 0]")
-            out.append((float(k[0]), float(k[1])))
-        object.__setattr__(self, "level", float(lv))
-        object.__setattr__(self, "knees", tuple(out))
+        level, knees = check_asd(self.name, self.level, self.knees)
+        object.__setattr__(self, "level", level)
+        object.__setattr__(self, "knees", knees)
 
     def asd(self, f) -> np.ndarray:
         """ASD at frequencies ``f`` [Hz] (> 0), shape of ``f``, (unit)/Hz^1/2."""

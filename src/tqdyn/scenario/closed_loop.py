@@ -35,7 +35,18 @@ from typing import Any
 from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _require
 
-__all__ = ["CLOSED_LOOP_KEYS", "PLANT_KEYS", "ClosedLoopConfig"]
+__all__ = ["CLOSED_LOOP_KEYS", "LOOP_NAMES", "MISSIONS", "PLANT_KEYS", "SOURCE_UNITS", "ClosedLoopConfig",
+           "check_asd", "check_controller"]
+
+#: Missions with a default closed-loop design (tqdyn.closedloop.missions).
+MISSIONS = ("tianqin", "lisa", "taiji")
+#: Control loops (tqdyn.closedloop.controllers.LOOPS describes their channels).
+LOOP_NAMES = ("dragfree", "suspension", "attitude", "attitude_z", "mosa", "tm_rotation")
+#: Noise sources and the unit of their ASD (tqdyn.closedloop.loop.SOURCES: components, where they enter).
+SOURCE_UNITS = {"thruster_force": "N", "thruster_gain": "1", "thruster_torque": "N m", "tm_force": "m/s^2",
+                "tm_torque": "rad/s^2", "actuation_force": "1", "actuation_torque": "1",
+                "capacitive_translation": "m", "capacitive_rotation": "rad", "interferometer": "m", "dws": "rad",
+                "star_tracker": "rad", "mosa_encoder": "rad", "mosa_actuator": "N m"}
 
 #: Top-level keys of [closed_loop] and their kind.
 CLOSED_LOOP_KEYS = {"mission": "string", "fs": "number", "duration": "duration", "seed": "integer",
@@ -58,10 +69,7 @@ class ClosedLoopConfig:
     raw: Any = field(default_factory=dict)
 
     def __post_init__(self):
-        from ..closedloop.controllers import LOOPS
-        from ..closedloop.loop import SOURCES
-        from ..closedloop.missions import MISSIONS
-
+        LOOPS, SOURCES = LOOP_NAMES, SOURCE_UNITS
         raw = self.raw if self.raw is not None else {}
         _require(isinstance(raw, dict), "closed_loop", raw, "is not a table", "a [closed_loop] table")
         allowed = tuple(CLOSED_LOOP_KEYS) + ("plant", "controllers", "noise")
@@ -111,38 +119,14 @@ class ClosedLoopConfig:
 
     @staticmethod
     def _controller(loop: str, spec: dict):
-        from ..closedloop.controllers import ControllerError
-        from ..closedloop.missions import controller_from_keys
-
-        def flat(x):
-            return [[float(a) for a in r] if isinstance(r, list) else float(r) for r in x]
-
         for k in ("zeros", "poles", "gain"):
             _require(k in spec, f"closed_loop.controllers.{loop}.{k}", None, "is missing",
                      "zeros, poles (rad/s) and gain, all three")
-        try:
-            return controller_from_keys(loop, flat(spec["zeros"]), flat(spec["poles"]), float(spec["gain"])
-                                        if _num(spec["gain"]) else spec["gain"])
-        except (ControllerError, TypeError) as exc:
-            raise ScenarioError(getattr(exc, "field", f"closed_loop.controllers.{loop}"),
-                                problem=str(exc).split(": ", 1)[-1]) from None
+        check_controller(loop, spec["zeros"], spec["poles"], spec["gain"])
 
     @staticmethod
     def _asd(src: str, spec: dict):
-        from ..closedloop.loop import SOURCES
-        from ..closedloop.noise import AsdModel, NoiseModelError
-
-        try:
-            level = float(spec["level"]) if _num(spec.get("level")) else spec.get("level", 0.0)
-            knees = spec.get("knees", [])
-            _require(isinstance(knees, list), f"closed_loop.noise.{src}.knees", knees, "is not a list",
-                     "[[frequency Hz, slope], ...]")
-            knees = tuple(tuple(float(x) if _num(x) else x for x in k) if isinstance(k, list) else k for k in knees)
-            return AsdModel(level, knees, SOURCES[src][1], f"closed_loop.noise.{src}")
-        except NoiseModelError as exc:
-            raise ScenarioError(exc.field, problem=str(exc).split(": ", 1)[-1]) from None
-
-    # ------------------------------------------------------------------ resolved values
+        check_asd(f"closed_loop.noise.{src}", spec.get("level", 0.0), spec.get("knees", []))
 
     def mission(self, architecture: str) -> str:
         """The mission whose defaults apply: ``mission`` or the spacecraft architecture."""
@@ -156,36 +140,6 @@ class ClosedLoopConfig:
         if isinstance(v, (Decimal, float)):
             return float(v)
         return v
-
-    def plant(self, mission: str) -> dict:
-        """[closed_loop.plant] over the mission's defaults (floats / tuples)."""
-        from ..closedloop.missions import default_plant
-
-        out = default_plant(mission)
-        for k, v in self.raw.get("plant", {}).items():
-            out[k] = float(v) if PLANT_KEYS[k] == 1 else tuple(float(x) for x in v)
-        return out
-
-    def controllers(self, mission: str) -> dict:
-        """{loop: Controller} over the mission's defaults."""
-        from ..closedloop.missions import default_controllers
-
-        out = default_controllers(mission)
-        for loop, spec in self.raw.get("controllers", {}).items():
-            out[loop] = self._controller(loop, spec)
-        return out
-
-    def noise(self, mission: str) -> dict:
-        """{source: AsdModel} over the mission's defaults (a given ``level`` or ``knees`` replaces that part)."""
-        from ..closedloop.missions import default_noise
-
-        out = default_noise(mission)
-        for src, spec in self.raw.get("noise", {}).items():
-            base = out[src]
-            merged = {"level": spec.get("level", base.level),
-                      "knees": spec.get("knees", [list(k) for k in base.knees])}
-            out[src] = self._asd(src, merged)
-        return out
 
     def to_toml_lines(self) -> list[str]:
         """The given keys as TOML lines (nothing when the section is empty)."""
@@ -204,3 +158,45 @@ class ClosedLoopConfig:
             for name, spec in raw.get(group, {}).items():
                 out += [f"[closed_loop.{group}.{name}]"] + [f"{k} = {toml_value(v)}" for k, v in spec.items()] + [""]
         return out
+
+
+def _roots(values, name: str) -> list:
+    ok = isinstance(values, (list, tuple)) and all(
+        _num(v) or (isinstance(v, (list, tuple)) and len(v) == 2 and all(_num(x) for x in v)) for v in values)
+    _require(ok, name, values, "is not a list of roots", "real numbers (rad/s) or [re, im] pairs (conjugate pairs)")
+    out = []
+    for v in values:
+        if isinstance(v, (list, tuple)):
+            re, im = float(v[0]), float(v[1])
+            out += [complex(re, im), complex(re, -im)] if im != 0 else [complex(re, 0.0)]
+        else:
+            out.append(complex(float(v), 0.0))
+    return out
+
+
+def check_controller(loop: str, zeros, poles, gain) -> tuple[list, list, float]:
+    """The rules of a controller C(s) = gain prod(s - z)/prod(s - p) (tqdyn.closedloop.controllers): roots
+    real or [re, im] pairs [rad/s], finite; at most as many zeros as poles (proper); poles with Re <= 0;
+    gain > 0.  Returns (zeros, poles, gain) as complex lists and a float; ScenarioError naming the key."""
+    name = f"closed_loop.controllers.{loop}"
+    z = _roots(zeros, f"{name}.zeros")
+    p = _roots(poles, f"{name}.poles")
+    _require(_num(gain) and float(gain) > 0, f"{name}.gain", gain, "is not a positive number",
+             "gain > 0 (negative feedback is built into the loop)")
+    _require(len(z) <= len(p), name, f"{len(z)} zeros, {len(p)} poles", "is improper",
+             "at most as many zeros as poles")
+    _require(all(r.real <= 0 for r in p), f"{name}.poles", poles, "has an unstable pole",
+             "poles with Re <= 0 (an integrator at 0 is allowed)")
+    return z, p, float(gain)
+
+
+def check_asd(name: str, level, knees) -> tuple[float, tuple]:
+    """The rules of an ASD model (tqdyn.closedloop.noise.AsdModel): level finite and >= 0 (a negative ASD
+    is refused), knees pairs [f > 0 Hz, slope != 0].  Returns (level, knees) as floats."""
+    _require(_num(level), f"{name}.level", level, "is not a finite number", "a level >= 0 (unit/Hz^1/2)")
+    _require(float(level) >= 0, f"{name}.level", level, "is a negative ASD", "a level >= 0 (unit/Hz^1/2)")
+    ok = isinstance(knees, (list, tuple)) and all(
+        isinstance(k, (list, tuple)) and len(k) == 2 and all(_num(x) for x in k) and float(k[0]) > 0
+        and float(k[1]) != 0 for k in knees)
+    _require(ok, f"{name}.knees", knees, "has an invalid knee", "pairs [frequency Hz > 0, slope != 0]")
+    return float(level), tuple((float(a), float(b)) for a, b in knees)
