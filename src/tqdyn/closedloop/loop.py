@@ -114,6 +114,16 @@ class ClosedLoop:
     system: control.StateSpace
     channel_names: tuple
     dc_force: dict
+    sources: tuple = ()
+    outputs: tuple = ()
+
+    def source_components(self) -> dict:
+        """{source: number of input components} of the noise inputs (``<source>[k]``)."""
+        return {s: SOURCES[s][0] for s in SOURCES} if not self.sources else dict(self.sources)
+
+    def time_outputs(self) -> list:
+        """The outputs the time domain runs."""
+        return output_names(time_domain=True) if not self.outputs else list(self.outputs)
 
 
 def _controllers_ss(controllers: dict) -> list:

@@ -31,7 +31,7 @@ import control
 import numpy as np
 from scipy import signal
 
-from .loop import SOURCES, ClosedLoop, output_names, source_inputs
+from .loop import ClosedLoop
 
 __all__ = ["Block", "MemorySink", "Sink", "simulate"]
 
@@ -89,10 +89,9 @@ class MemorySink(Sink):
 class _Noise:
     """Coloured noise of one satellite: sources in SOURCES order, components concatenated."""
 
-    def __init__(self, noise: dict, sat: int, seed: int, fs: float, f_lo: float):
+    def __init__(self, noise: dict, sat: int, seed: int, fs: float, f_lo: float, components: dict):
         self.parts = []
-        for src in SOURCES:
-            n = SOURCES[src][0]
+        for src, n in components.items():
             model = noise.get(src)
             rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(sat, zlib.crc32(src.encode()))))
             if model is None or model.level == 0:
@@ -111,7 +110,7 @@ class _Noise:
     def draw(self, m: int) -> np.ndarray:
         out = []
         for i, (n, level, sos, zi, rng) in enumerate(self.parts):
-            w = rng.standard_normal((n, m)) * math.sqrt(0.5 * self.fs)
+            w = rng.standard_normal((m, n)).T * math.sqrt(0.5 * self.fs)   # time-major: blocks do not matter
             if level is None:
                 out.append(np.zeros((n, m)))
                 continue
@@ -128,7 +127,7 @@ class _DiscreteLoop:
     def __init__(self, cl: ClosedLoop, dt: float, outputs: list):
         sys = cl.system
         keep = [k for k, s in enumerate(sys.state_labels) if not (s.startswith("plant_u[") or s.startswith("plant_du["))]
-        ii = [sys.input_labels.index(s) for src in SOURCES for s in source_inputs(src)]
+        ii = [sys.input_labels.index(f"{src}[{k}]") for src, n in cl.source_components().items() for k in range(n)]
         oi = [sys.output_labels.index(o) for o in outputs]
         red = control.ss(sys.A[np.ix_(keep, keep)], sys.B[np.ix_(keep, ii)], sys.C[np.ix_(oi, keep)],
                          sys.D[np.ix_(oi, ii)])
@@ -177,16 +176,16 @@ def simulate(loops: list, noise: dict, fs: float, n_samples: int, seed: int = 0,
         returned).  f_lo : lowest frequency [Hz] of the shaping filters' band (default 0.1 fs/n_samples).
     """
     sink = MemorySink() if sink is None else sink
-    outputs = output_names(time_domain=True)
+    outputs = loops[0][0][1].time_outputs()
     dt = 1.0 / fs
     f_lo = 0.1 * fs / max(n_samples, 1) if f_lo is None else f_lo
     units = {}
     from .loop import OUTPUTS
     for o in outputs:
-        units[o] = OUTPUTS[o][0]
+        units[o] = OUTPUTS[o][0] if o in OUTPUTS else ""
     sink.start({"outputs": tuple(outputs), "n_sat": len(loops), "fs": fs, "n_samples": n_samples, "t0": t0,
                 "units": units, "seed": seed})
-    gens = [_Noise(noise, s, seed, fs, f_lo) for s in range(len(loops))]
+    gens = [_Noise(noise, s, seed, fs, f_lo, loops[s][0][1].source_components()) for s in range(len(loops))]
     cache: dict = {}
     states = [None] * len(loops)
     k = 0
