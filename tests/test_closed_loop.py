@@ -216,3 +216,22 @@ def test_entry_point_budget_and_series_are_xarray(tianqin_runs):
     assert set(ds["source"].values) == set(SOURCES)
     ts = closed_loop_timeseries(model, duration_s=600.0, fs=2.0)
     assert ts["values"].dims == ("time", "sat", "output") and ts["values"].shape[:2] == (1200, 3)
+
+
+def test_docs_numbers_json_is_what_design_numbers_computes():
+    """docs/data/closed-loop-numbers.json (the numbers docs/closed-loop.md quotes) equals a fresh
+    tqdyn.closedloop.study.design_numbers() to 1e-6 relative (regenerate it with that function)."""
+    import json
+    import pathlib
+
+    from tqdyn.closedloop.study import design_numbers
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "docs" / "data" / "closed-loop-numbers.json"
+    stored = json.loads(path.read_text())
+    fresh = json.loads(json.dumps(design_numbers()))
+    for m in stored["missions"]:
+        for key in ("tm_acceleration_total", "actuation_force", "stiffness_times_jitter", "sc_tm_jitter_m"):
+            assert np.allclose(stored["missions"][m][key], fresh["missions"][m][key], rtol=1e-6), (m, key)
+    # the DC self-gravity's path (actuation noise x cross-talk) is far below the requirement at 1 mHz
+    for m in stored["missions"]:
+        assert fresh["missions"][m]["actuation_force"][0] < 1e-3 * requirement(m).asd(1e-3)
