@@ -128,6 +128,9 @@ class ClosedLoopConfig:
     def _asd(src: str, spec: dict):
         check_asd(f"closed_loop.noise.{src}", spec.get("level", 0.0), spec.get("knees", []))
 
+    def __hash__(self) -> int:  # the raw tables are dicts; the scenario is hashable
+        return hash(repr(self.raw))
+
     def mission(self, architecture: str) -> str:
         """The mission whose defaults apply: ``mission`` or the spacecraft architecture."""
         return str(self.raw.get("mission", architecture))
