@@ -27,7 +27,7 @@ __all__ = [
     "SatelliteConfig", "IntegratorConfig", "RunConfig", "ForcesConfig", "SpacecraftConfig",
     "ConstellationConfig", "POINTING_LAWS", "Scenario", "ScenarioError", "CONTROL_MODES", "LIBRATION_MODELS",
     "MAX_EARTH_DEGREE", "MAX_MOON_DEGREE", "MAX_OCEAN_TIDE_DEGREE", "SELF_GRAVITY_MODELS", "THIRD_BODIES",
-    "TM_AXES", "MAX_STEPS", "BODY_RADII_M",
+    "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig",
 ]
 
 _PRECISIONS = ("dd", "float64")
@@ -43,6 +43,7 @@ _RTOL_MAX = 1e-3
 MAX_STEPS = 1_000_000_000
 from .initial import BODY_RADII_M, check_above_surface  # noqa: F401
 from .spacecraft import SELF_GRAVITY_MODELS, TM_AXES, SpacecraftConfig  # noqa: F401  (re-exported)
+from .closed_loop import ClosedLoopConfig  # noqa: F401  ([closed_loop]; re-exported)
 from .initial import AU_M, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
 from .values import (  # noqa: F401  (re-exported for the loader)
     _EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require, _require_choice, _set, _to_decimal,
@@ -341,6 +342,8 @@ class Scenario:
     epoch_tdb: str = ""
     initial: InitialConfig = field(default_factory=InitialConfig)
     allow_below_surface: bool = False
+    # ---- [closed_loop] (tqdyn.scenario.closed_loop): the closed-loop model's settings, sparse
+    closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
 
     def __post_init__(self) -> None:
         _require_choice(self.central_body, "scenario.central_body", CENTRAL_BODIES)
@@ -576,6 +579,7 @@ class Scenario:
         c = self.constellation
         out += ["[constellation]", f"pointing = {toml_str(c.pointing)}", f"control = {toml_str(c.control)}",
                 f"free_tms = {b(c.free_tms)}", f"tm_gravity = {toml_str(c.tm_gravity)}", ""]
+        out += self.closed_loop.to_toml_lines()  # [closed_loop]: only the keys given (none: nothing)
         for sat in self.satellites:
             out += ["[[satellites]]", f"name = {toml_str(sat.name)}"]
             if i.derived:  # the states follow from [initial]

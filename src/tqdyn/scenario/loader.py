@@ -25,6 +25,7 @@ from .config import (
     EOP_SOURCES_ALLOWED,
     _EXACT,
     _NOVALUE,
+    ClosedLoopConfig,
     ConstellationConfig,
     ForcesConfig,
     InitialConfig,
@@ -118,7 +119,7 @@ _SAT_SCHEMA: dict[str, str] = {
     "r_km": _ANY, "v_kmps": _ANY,
 }
 _ELEMENT_KEYS = ("a_km", "e", "i_deg", "raan_deg", "argp_deg", "nu_deg")
-_TOP_KEYS = tuple(_SCHEMA) + ("satellites",)
+_TOP_KEYS = tuple(_SCHEMA) + ("satellites", "closed_loop")
 #: Epoch keys: one of them sets the epoch (a file or override that sets one drops the other).
 _EPOCH_KEYS = ("epoch_utc", "epoch_tdb")
 # TOML key -> dataclass field, where they differ
@@ -277,9 +278,40 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
         epoch_tdb = oem_first_common_epoch(initial.oem, initial.oem_eme2000)
     body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
     below = _typed(meta.get("allow_below_surface", False), _BOOL, "scenario.allow_below_surface")
+    closed = _closed_loop_from_raw(raw.get("closed_loop", {}))
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
                     spacecraft=craft, constellation=const, satellites=sats, central_body=body,
-                    epoch_tdb=epoch_tdb, initial=initial, allow_below_surface=below)
+                    epoch_tdb=epoch_tdb, initial=initial, allow_below_surface=below, closed_loop=closed)
+
+
+# --------------------------------------------------------------------------- [closed_loop] (nested tables)
+
+
+def _closed_loop_from_raw(table: Any) -> ClosedLoopConfig:
+    """The [closed_loop] table: durations ("3d") to seconds, then validated by ClosedLoopConfig."""
+    _require(isinstance(table, dict), "closed_loop", table, f"is {_a(_toml_type(table))}", "a table")
+    table = dict(table)
+    for key in ("duration", "segment"):
+        if key in table:
+            table[key] = _parse_duration(table[key], f"closed_loop.{key}")
+    return ClosedLoopConfig(raw=table)
+
+
+def _closed_loop_override(raw: dict, key: str, text: str) -> None:
+    """--set closed_loop.<key>, closed_loop.plant.<key>, closed_loop.controllers.<loop>.<key>,
+    closed_loop.noise.<source>.<key>: nested tables created as needed (validated with the scenario)."""
+    parts = key.split(".")[1:]
+    groups = {"plant": 2, "controllers": 3, "noise": 3}
+    depth = groups.get(parts[0], 1) if parts else 0
+    if len(parts) != depth:
+        raise ScenarioError(f"override {key}", problem="is not a [closed_loop] key",
+                            allowed="closed_loop.<key>, closed_loop.plant.<key>, closed_loop.controllers.<loop>.<key>, "
+                                    "closed_loop.noise.<source>.<key>")
+    table = raw.setdefault("closed_loop", {})
+    for p in parts[:-1]:
+        _require(isinstance(table, dict), "closed_loop", table, "is not a table", "a table")
+        table = table.setdefault(p, {})
+    table[parts[-1]] = _parse_override_value(text, _ANY)
 
 
 # --------------------------------------------------------------------------- overrides
@@ -322,6 +354,9 @@ def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
             sat = sats[int(idx_text) - 1]
             _require(isinstance(sat, dict), f"satellites.{idx_text}", sat, "is not a table", "a [[satellites]] table")
             sat[sat_key] = _parse_override_value(text, _SAT_SCHEMA[sat_key])
+            continue
+        if parts[0] == "closed_loop":
+            _closed_loop_override(raw, key, text)
             continue
         if len(parts) != 2 or parts[0] not in _SCHEMA:
             allowed = ", ".join(f"{s}.<key>" for s in _SCHEMA) + ", satellites.N.<key>"

@@ -1,0 +1,314 @@
+"""The closed loop of one spacecraft: plant, sensors, controllers and actuators joined by name.
+
+Built with ``control.interconnect`` (signals connected by their names).  The closed loop's inputs
+are the noise sources (:data:`SOURCES`, each component in the unit of its ASD) and one loop-break
+input ``d_<loop>[k]`` per controller channel (added to the controller output; the loop-at-a-time
+gain is L = -T/(1 + T), T the closed-loop transfer from ``d`` to the controller output ``c``);
+its outputs are the quantities of :data:`OUTPUTS` and the controller signals ``c_<loop>[k]``.
+
+Frames: spacecraft quantities in S (body frame at the working point), TM quantities in OA_l
+(x the sensitive axis of the presets, X_OA_l).  Units SI.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..scenario.closed_loop import SOURCE_UNITS
+from .controllers import LOOPS, Controller
+from .plant import PlantParameters, WorkingPoint, linear_plant, sensitive_basis
+
+__all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "build_closed_loop", "output_names", "source_inputs"]
+
+#: Noise sources: name -> (components, unit of the ASD, where it enters).
+SOURCES = {
+    "thruster_force": (3, "N", "thrust, S axes"),
+    "thruster_gain": (3, "1", "fractional thrust noise times the DC thrust M |G| per S axis"),
+    "thruster_torque": (3, "N m", "thruster torque, S axes"),
+    "tm_force": (6, "m/s^2", "stray acceleration of TM 1, TM 2 (OA_l axes)"),
+    "tm_torque": (6, "rad/s^2", "stray angular acceleration of TM 1, TM 2 (OA_l)"),
+    "actuation_force": (6, "1", "fractional electrostatic force noise times the DC force m |A| per OA_l axis"),
+    "actuation_torque": (6, "1", "fractional electrostatic torque noise times the DC torque I |alpha| per OA_l axis"),
+    "capacitive_translation": (6, "m", "capacitive readout of x_1, x_2 (OA_l)"),
+    "capacitive_rotation": (6, "rad", "capacitive readout of eta_1, eta_2 (OA_l)"),
+    "interferometer": (2, "m", "TM interferometer along each sensitive axis"),
+    "dws": (4, "rad", "DWS pitch and yaw of MOSA 1, then MOSA 2"),
+    "star_tracker": (3, "rad", "star tracker, S axes"),
+    "mosa_encoder": (2, "rad", "MOSA angle encoder (the angle of the MOSA relative to the spacecraft)"),
+    "mosa_actuator": (2, "N m", "MOSA actuator torque"),
+}
+
+_AX = ("x", "y", "z")
+assert {k: v[1] for k, v in SOURCES.items()} == SOURCE_UNITS, "the scenario's source units and SOURCES differ"
+
+
+def _output_table() -> dict:
+    out = {}
+    for i, a in enumerate(_AX):
+        out[f"sc_attitude_{a}"] = ("rad", "S", f"spacecraft attitude jitter about {a.upper()}_S")
+    for l in (1, 2):
+        out[f"mosa_angle_{l}"] = ("rad", "about Z_S", f"MOSA {l} angle jitter")
+    for l in (1, 2):
+        for a in _AX:
+            out[f"tm{l}_displacement_{a}"] = ("m", f"OA_{l}", f"TM {l} minus its housing centre, {a}")
+        for a in _AX:
+            out[f"tm{l}_rotation_{a}"] = ("rad", f"OA_{l}", f"TM {l} rotation relative to its housing, {a}")
+        out[f"tm{l}_sc_jitter"] = ("m", "sensitive axis", f"spacecraft-TM {l} jitter along the sensitive axis")
+        out[f"tm{l}_acceleration"] = ("m/s^2", "sensitive axis",
+                                      f"residual (non-gravitational) acceleration of TM {l} along its sensitive axis")
+        out[f"tm{l}_relative_acceleration"] = ("m/s^2", "sensitive axis",
+                                               f"acceleration of TM {l} relative to its housing, sensitive axis")
+    for a in _AX:
+        out[f"thrust_force_{a}"] = ("N", "S", f"thrust along {a.upper()}_S (commands and noise)")
+    for a in _AX:
+        out[f"thrust_torque_{a}"] = ("N m", "S", f"thruster torque about {a.upper()}_S")
+    for l in (1, 2):
+        for a in _AX:
+            out[f"tm{l}_es_force_{a}"] = ("N", f"OA_{l}", f"electrostatic force on TM {l}, {a}")
+        for a in _AX:
+            out[f"tm{l}_es_torque_{a}"] = ("N m", f"OA_{l}", f"electrostatic torque on TM {l}, {a}")
+    for l in (1, 2):
+        out[f"mosa{l}_torque"] = ("N m", "about Z_S", f"MOSA {l} actuator torque")
+    for a in _AX:
+        out[f"sc_position_{a}"] = ("m", "S", f"spacecraft displacement from its nominal orbit, {a.upper()}_S "
+                                               "(frequency domain only)")
+    return out
+
+
+#: Outputs: name -> (unit, frame, meaning).
+OUTPUTS = _output_table()
+#: Outputs left out of the time-domain simulation (a branch nothing feeds back from: the spacecraft's
+#: displacement from its nominal orbit, unstable at orbital frequencies through the Hill dynamics).
+FREQUENCY_ONLY = tuple(k for k in OUTPUTS if k.startswith("sc_position"))
+
+
+def output_names(time_domain: bool = False) -> list[str]:
+    """The output names (:data:`OUTPUTS` order); ``time_domain``: without :data:`FREQUENCY_ONLY`."""
+    return [k for k in OUTPUTS if not (time_domain and k in FREQUENCY_ONLY)]
+
+
+def source_inputs(source: str) -> list[str]:
+    """The closed loop's input signal names of one source."""
+    return [f"{source}[{k}]" for k in range(SOURCES[source][0])]
+
+
+def _static(D, inputs, outputs, name):
+    return control.ss(np.zeros((0, 0)), np.zeros((0, len(inputs))), np.zeros((len(outputs), 0)),
+                      np.asarray(D, dtype=np.float64), inputs=inputs, outputs=outputs, name=name)
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """One spacecraft's closed loop at one working point.
+
+    system : control.StateSpace, continuous; inputs: noise (SOURCES order) then ``d_*``; outputs:
+        :data:`OUTPUTS` (order of :func:`output_names`) then ``c_*``.
+    channel_names : the controller channels ``<loop>[k]``.
+    dc_force : dict of the DC levels that scale the force-proportional sources:
+        ``thruster_gain`` (3,) [N], ``actuation_force`` (6,) [N], ``actuation_torque`` (6,) [N m].
+    """
+
+    system: control.StateSpace
+    channel_names: tuple
+    dc_force: dict
+    sources: tuple = ()
+    outputs: tuple = ()
+
+    def source_components(self) -> dict:
+        """{source: number of input components} of the noise inputs (``<source>[k]``)."""
+        return {s: SOURCES[s][0] for s in SOURCES} if not self.sources else dict(self.sources)
+
+    def time_outputs(self) -> list:
+        """The outputs the time domain runs."""
+        return output_names(time_domain=True) if not self.outputs else list(self.outputs)
+
+
+def _controllers_ss(controllers: dict) -> list:
+    out = []
+    for loop, (channels, *_rest) in LOOPS.items():
+        ctl = controllers[loop]
+        if not isinstance(ctl, Controller):
+            raise TypeError(f"controllers[{loop!r}] is not a Controller")
+        tf = control.ss(ctl.tf())
+        for k in range(len(channels)):
+            out.append(control.ss(tf.A, tf.B, tf.C, tf.D, inputs=[f"e_{loop}[{k}]"], outputs=[f"c_{loop}[{k}]"],
+                                  name=f"C_{loop}_{k}"))
+    return out
+
+
+def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
+                      attitude_z_sensor: str = "dws") -> ClosedLoop:
+    """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
+    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
+    ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
+    "star_tracker" (as LISA Pathfinder, which had no DWS)."""
+    if attitude_z_sensor not in ("dws", "star_tracker"):
+        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
+                         "allowed: 'dws', 'star_tracker'")
+    P = linear_plant(p, wp)
+    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
+    from ..constellation.control import oa_rotation
+    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
+    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
+    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
+    m, Itm, Im, Msc = p.tm_mass, p.tm_inertia, p.mosa_inertia, p.sc_mass
+    J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
+
+    # ---- sensors: plant coordinates + sensor noise -> error signals e_<loop>[k]
+    sin = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
+           + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
+           + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
+           + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker")
+           + source_inputs("mosa_encoder"))
+    ci = {s: k for k, s in enumerate(sin)}
+    rows, names = [], []
+
+    def row(coeffs):
+        r = np.zeros(len(sin))
+        for s, c in coeffs.items():
+            r[ci[s]] += c
+        rows.append(r)
+
+    for l in (1, 2):      # drag-free: IFO along e_l
+        e = basis[l - 1, 0]
+        row({**{f"x{l}[{i}]": e[i] for i in range(3)}, f"interferometer[{l - 1}]": 1.0})
+        names.append(f"e_dragfree[{l - 1}]")
+    row({"x1[2]": 0.5, "x2[2]": 0.5, "capacitive_translation[2]": 0.5, "capacitive_translation[5]": 0.5})
+    names.append("e_dragfree[2]")
+    for l in (1, 2):      # suspension: capacitive along p_l
+        pv = basis[l - 1, 1]
+        row({**{f"x{l}[{i}]": pv[i] for i in range(3)},
+             **{f"capacitive_translation[{3 * (l - 1) + i}]": pv[i] for i in range(3)}})
+        names.append(f"e_suspension[{l - 1}]")
+    row({"x1[2]": 0.5, "x2[2]": -0.5, "capacitive_translation[2]": 0.5, "capacitive_translation[5]": -0.5})
+    names.append("e_suspension[2]")
+    # DWS: pitch_l = Y_OA_l . phi + n, yaw_l = phi_z + dth_l + n; attitude estimate (phi_x, phi_y) from the
+    # two pitches, phi_z from the mean yaw
+    Pm = np.linalg.inv(yoa[:, :2])                      # (phi_x, phi_y) = Pm @ (pitch_1, pitch_2)
+    pitch = [dict({f"phi[{i}]": yoa[l][i] for i in range(3)}, **{f"dws[{2 * l}]": 1.0}) for l in range(2)]
+    yaw = [{"phi[2]": 1.0, f"dth[{l}]": 1.0, f"dws[{2 * l + 1}]": 1.0} for l in range(2)]
+
+    def comb(ws, ds):
+        out: dict = {}
+        for w, d in zip(ws, ds):
+            for s, c in d.items():
+                out[s] = out.get(s, 0.0) + w * c
+        return out
+
+    for a in range(2):
+        row(comb(Pm[a], pitch))
+        names.append(f"e_attitude[{a}]")
+    if attitude_z_sensor == "star_tracker":
+        row({"phi[2]": 1.0, "star_tracker[2]": 1.0})
+    else:     # mean DWS yaw minus the mean MOSA angle from the encoders
+        row(comb((0.5, 0.5, -0.5, -0.5), yaw + [{f"dth[{l}]": 1.0, f"mosa_encoder[{l}]": 1.0} for l in range(2)]))
+    names.append("e_attitude_z[0]")
+    for l in range(2):
+        row(yaw[l])
+        names.append(f"e_mosa[{l}]")
+    for l in (1, 2):
+        for i in range(3):
+            row({f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
+            names.append(f"e_tm_rotation[{3 * (l - 1) + i}]")
+    sensors = _static(np.array(rows), sin, names, "sensors")
+
+    # ---- actuators: controller outputs c + loop breaks d + actuation noise -> plant inputs
+    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
+    ain = ([f"c_{c}" for c in chans] + [f"d_{c}" for c in chans] + source_inputs("thruster_force")
+           + source_inputs("thruster_gain") + source_inputs("thruster_torque") + source_inputs("actuation_force")
+           + source_inputs("actuation_torque") + source_inputs("mosa_actuator") + source_inputs("tm_force")
+           + source_inputs("tm_torque"))
+    aout = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
+            + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
+            + ["tm[0]", "tm[1]"] + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)]
+            + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)])
+    ai = {s: k for k, s in enumerate(ain)}
+    ao = {s: k for k, s in enumerate(aout)}
+    Da = np.zeros((len(aout), len(ain)))
+
+    def cmd(chan, out, gain):
+        Da[ao[out], ai[f"c_{chan}"]] += gain
+        Da[ao[out], ai[f"d_{chan}"]] += gain
+
+    Ninv = np.linalg.inv(np.array([e_S[0], e_S[1], [0.0, 0.0, 1.0]]))   # F = M N^-1 c (drag-free)
+    for k in range(3):
+        for i in range(3):
+            cmd(f"dragfree[{k}]", f"F[{i}]", Msc * Ninv[i, k])
+    for l in (1, 2):
+        pv, q = basis[l - 1, 1], basis[l - 1, 2]
+        for i in range(3):
+            cmd(f"suspension[{l - 1}]", f"f{l}[{i}]", -m * pv[i])
+            cmd("suspension[2]", f"f{l}[{i}]", -m * q[i] * (1.0 if l == 1 else -1.0))
+    for a in range(3):
+        for i in range(3):
+            cmd(f"attitude[{a}]" if a < 2 else "attitude_z[0]", f"T[{i}]", -J[i, a])
+    cmd("mosa[0]", "tm[0]", -Im)
+    cmd("mosa[1]", "tm[1]", -Im)
+    for l in (1, 2):
+        for i in range(3):
+            cmd(f"tm_rotation[{3 * (l - 1) + i}]", f"t{l}[{i}]", -Itm)
+    G = np.asarray(wp.a_dragfree, dtype=np.float64)
+    dc = {"thruster_gain": Msc * np.abs(G),
+          "actuation_force": m * np.abs(np.asarray(wp.a_suspension, dtype=np.float64)).reshape(6),
+          "actuation_torque": Itm * np.abs(np.asarray(wp.alpha_suspension, dtype=np.float64)).reshape(6)}
+    for i in range(3):
+        Da[ao[f"F[{i}]"], ai[f"thruster_force[{i}]"]] = 1.0
+        Da[ao[f"F[{i}]"], ai[f"thruster_gain[{i}]"]] = dc["thruster_gain"][i]
+        Da[ao[f"T[{i}]"], ai[f"thruster_torque[{i}]"]] = 1.0
+    for l in (1, 2):
+        for i in range(3):
+            k = 3 * (l - 1) + i
+            Da[ao[f"f{l}[{i}]"], ai[f"actuation_force[{k}]"]] = dc["actuation_force"][k]
+            Da[ao[f"t{l}[{i}]"], ai[f"actuation_torque[{k}]"]] = dc["actuation_torque"][k]
+            Da[ao[f"a{l}[{i}]"], ai[f"tm_force[{k}]"]] = 1.0
+            Da[ao[f"b{l}[{i}]"], ai[f"tm_torque[{k}]"]] = 1.0
+    for l in range(2):
+        Da[ao[f"tm[{l}]"], ai[f"mosa_actuator[{l}]"]] = 1.0
+    actuators = _static(Da, ain, aout, "actuators")
+
+    # ---- observables: named outputs from plant outputs and actuator signals
+    oin = ([f"u[{i}]" for i in range(3)] + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
+           + [f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
+           + [f"acc{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"xdd{l}[{i}]" for l in (1, 2) for i in range(3)]
+           + [f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
+           + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
+           + ["tm[0]", "tm[1]"])
+    oi = {s: k for k, s in enumerate(oin)}
+    onames = output_names()
+    Do = np.zeros((len(onames), len(oin)))
+    X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))
+
+    def put(name, coeffs):
+        r = onames.index(name)
+        for s, c in coeffs.items():
+            Do[r, oi[s]] += c
+
+    for i, a in enumerate(_AX):
+        put(f"sc_attitude_{a}", {f"phi[{i}]": 1.0})
+        put(f"thrust_force_{a}", {f"F[{i}]": 1.0})
+        put(f"thrust_torque_{a}", {f"T[{i}]": 1.0})
+        put(f"sc_position_{a}", {f"u[{i}]": 1.0})
+    for l in (1, 2):
+        put(f"mosa_angle_{l}", {f"dth[{l - 1}]": 1.0})
+        put(f"mosa{l}_torque", {f"tm[{l - 1}]": 1.0})
+        e = basis[l - 1, 0]
+        put(f"tm{l}_sc_jitter", {f"x{l}[{i}]": e[i] for i in range(3)})
+        put(f"tm{l}_acceleration", {f"acc{l}[{i}]": e[i] for i in range(3)})
+        put(f"tm{l}_relative_acceleration", {f"xdd{l}[{i}]": e[i] for i in range(3)})
+        for i, a in enumerate(_AX):
+            put(f"tm{l}_displacement_{a}", {f"x{l}[{i}]": 1.0})
+            put(f"tm{l}_rotation_{a}", {f"eta{l}[{i}]": 1.0})
+            put(f"tm{l}_es_force_{a}", {f"f{l}[{j}]": X[i, j] for j in range(3)})
+            put(f"tm{l}_es_torque_{a}", {f"t{l}[{j}]": X[i, j] for j in range(3)})
+    observables = _static(Do, oin, onames, "observables")
+
+    noise = [s for src in SOURCES for s in source_inputs(src)]
+    inplist = noise + [f"d_{c}" for c in chans]
+    outlist = onames + [f"c_{c}" for c in chans]
+    syslist = [P, sensors, actuators, observables] + _controllers_ss(controllers)
+    cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
+                              check_unused=False, name="closed_loop", warn_duplicate=False)
+    return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=dc)

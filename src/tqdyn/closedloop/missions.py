@@ -1,0 +1,130 @@
+"""Default closed-loop parameters, noise models and controllers of TianQin, LISA and Taiji.
+
+Every number has its source in src/tqdyn/data/SOURCES.md (section "Closed-loop defaults"); the ones
+marked *assumption* are tqdyn's choices where no public document gives a value, stated with the
+reason.  Units: SI; ASDs one-sided (:mod:`tqdyn.closedloop.noise`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..scenario.closed_loop import MISSIONS
+from .controllers import Controller, lead_lag_pid
+from .noise import AsdModel
+
+__all__ = ["MISSIONS", "controller_from_keys", "default_controllers", "default_noise", "default_plant", "requirement",
+           "resolve"]
+
+
+#: Plant defaults per mission (scenario keys of [closed_loop.plant]).
+_PLANT = {
+    # TM: 2.45 kg, 50 mm cube (TianQin test-mass design); spacecraft 600 kg (assumption), inertias of a
+    # 1 m-radius, 0.8 m-high cylinder of that mass (assumption)
+    "tianqin": dict(sc_mass=600.0, sc_inertia=(182.0, 182.0, 300.0), tm_mass=2.45, tm_side=0.050),
+    # TM: 1.96 kg, 46 mm Au-Pt cube (LISA Pathfinder / LISA); spacecraft ~2000 kg, inertias of a 1.5 m-radius,
+    # 0.8 m-high cylinder (assumption)
+    "lisa": dict(sc_mass=2000.0, sc_inertia=(1232.0, 1232.0, 2250.0), tm_mass=1.96, tm_side=0.046),
+    # Taiji: LISA-like (assumption: no public mass budget); TM as LISA's
+    "taiji": dict(sc_mass=2000.0, sc_inertia=(1232.0, 1232.0, 2250.0), tm_mass=1.96, tm_side=0.046),
+}
+_COMMON_PLANT = dict(mosa_inertia=10.0, mosa_stiffness=0.0, stiffness=(-1e-6, -1e-6, -1e-6),
+                     rotational_stiffness=(-1e-6, -1e-6, -1e-6), crosstalk=1e-3)
+
+#: Crossover frequencies of the default controllers [Hz] (docs/closed-loop.md derives them).
+CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitude_z": 0.02, "mosa": 0.01,
+                "tm_rotation": 0.005}
+
+
+def _check(mission: str) -> None:
+    if mission not in MISSIONS:
+        raise ValueError(f"closed_loop.mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+
+
+def default_plant(mission: str) -> dict:
+    """The [closed_loop.plant] defaults of ``mission`` (keys of :class:`tqdyn.closedloop.plant.PlantParameters`
+    that are not geometry): masses [kg], inertias [kg m^2], tm_side [m], stiffness [s^-2], crosstalk [1]."""
+    _check(mission)
+    return {**_COMMON_PLANT, **_PLANT[mission]}
+
+
+def requirement(mission: str) -> AsdModel:
+    """The mission's TM acceleration-noise requirement [m/s^2/Hz^1/2] (one-sided):
+    TianQin 1e-15 sqrt(1 + 0.1 mHz/f); LISA 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4);
+    Taiji 3e-15 with LISA's knees."""
+    _check(mission)
+    if mission == "tianqin":
+        return AsdModel(1e-15, ((1e-4, -0.5),), "m/s^2", "requirement")
+    return AsdModel(3e-15, ((4e-4, -1.0), (8e-3, 2.0)), "m/s^2", "requirement")
+
+
+def default_noise(mission: str) -> dict:
+    """{source: AsdModel} defaults of ``mission`` (one-sided ASDs; units of :data:`tqdyn.closedloop.loop.SOURCES`)."""
+    _check(mission)
+    req = requirement(mission)
+    a = _PLANT[mission]["tm_side"]
+
+    def m(name, level, knees=(), unit=""):
+        return AsdModel(level, knees, unit, f"closed_loop.noise.{name}")
+
+    return {
+        "thruster_force": m("thruster_force", 1e-7, (), "N"),
+        "thruster_gain": m("thruster_gain", 1e-3, (), "1"),
+        "thruster_torque": m("thruster_torque", 1e-7, (), "N m"),
+        "tm_force": m("tm_force", req.level, req.knees, "m/s^2"),
+        # a force noise f on one face of a cube, lever a/2, inertia m a^2/6: angular 3 f/(m a)
+        "tm_torque": m("tm_torque", 3.0 * req.level / a, req.knees, "rad/s^2"),
+        "actuation_force": m("actuation_force", 1e-6, (), "1"),
+        "actuation_torque": m("actuation_torque", 1e-6, (), "1"),
+        "capacitive_translation": m("capacitive_translation", 2.4e-9, ((1e-3, -1.0),), "m"),
+        "capacitive_rotation": m("capacitive_rotation", 1.7e-7, ((1e-3, -1.0),), "rad"),
+        "interferometer": m("interferometer", 1e-12 if mission == "tianqin" else 3.5e-14,
+                            ((2e-3, -2.0),), "m"),
+        "dws": m("dws", 2e-10, ((2e-3, -2.0),), "rad"),
+        "star_tracker": m("star_tracker", 1e-5, (), "rad"),
+        "mosa_encoder": m("mosa_encoder", 1e-9, ((1e-3, -1.0),), "rad"),
+        "mosa_actuator": m("mosa_actuator", 1e-9, (), "N m"),
+    }
+
+
+def default_controllers(mission: str) -> dict:
+    """{loop: Controller}: :func:`tqdyn.closedloop.controllers.lead_lag_pid` at :data:`CROSSOVER_HZ`
+    (the same crossovers for the three missions; the plants differ in masses and inertias only by
+    the actuator conversion, which the controllers' acceleration commands absorb)."""
+    _check(mission)
+    return {loop: lead_lag_pid(f, name=loop) for loop, f in CROSSOVER_HZ.items()}
+
+
+def controller_from_keys(loop: str, zeros, poles, gain) -> Controller:
+    """A :class:`Controller` of ``loop`` from scenario keys (zeros, poles in rad/s; gain)."""
+    def flat(x):
+        return tuple(tuple(float(a) for a in r) if isinstance(r, (list, tuple)) else float(r) for r in x)
+
+    return Controller(zeros=flat(zeros), poles=flat(poles), gain=float(gain), name=loop)
+
+
+def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
+    """(mission, plant dict, {loop: Controller}, {source: AsdModel}) of a
+    :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` over the mission's defaults (the mission:
+    ``closed_loop.mission`` or the spacecraft ``architecture``); a given noise ``level`` or ``knees``
+    replaces that part of the default."""
+    from ..scenario.closed_loop import PLANT_KEYS
+
+    mission = config.mission(architecture)
+    raw = config.raw or {}
+    plant = default_plant(mission)
+    for k, v in raw.get("plant", {}).items():
+        plant[k] = float(v) if PLANT_KEYS[k] == 1 else tuple(float(x) for x in v)
+    ctl = default_controllers(mission)
+    for loop, spec in raw.get("controllers", {}).items():
+        ctl[loop] = controller_from_keys(loop, spec["zeros"], spec["poles"], float(spec["gain"]))
+    noise = default_noise(mission)
+    for src, spec in raw.get("noise", {}).items():
+        base = noise[src]
+        noise[src] = AsdModel(float(spec.get("level", base.level)),
+                              tuple(tuple(float(x) for x in k) for k in spec.get("knees", base.knees)),
+                              base.unit, base.name)
+    return mission, plant, ctl, noise
+
+
+_ = math

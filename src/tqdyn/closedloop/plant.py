@@ -1,0 +1,269 @@
+"""The linearised plant of one spacecraft around its working point (derivation: docs/closed-loop.md).
+
+Degrees of freedom (20; the state is [q, q'], 40 states), frames and units:
+
+* ``u``   (3)  spacecraft centre-of-mass displacement from its nominal orbit, S components [m];
+* ``phi`` (3)  small rotation of the body frame B from the nominal S (T_B_I = (I - [phi x]) T_S_I) [rad];
+* ``x1``, ``x2`` (3 each) TM l centre of mass minus its electrode-housing (EH) centre, OA_l components [m];
+* ``eta1``, ``eta2`` (3 each) small rotation of TM l relative to its housing, OA_l components [rad];
+* ``dth`` (2) MOSA angle perturbations (the angle of X_OA_l from X_S about Z_S, ``mosa/angle``) [rad].
+
+Inputs (named, python-control signal names): ``F[0..2]`` thrust [N, B axes], ``T[0..2]`` thruster
+torque [N m, B], ``f1[0..2]``, ``f2[..]`` electrostatic force on TM l [N, OA_l], ``t1[..]``,
+``t2[..]`` electrostatic torque on TM l [N m, OA_l], ``a1[..]``, ``a2[..]`` TM force noise [m/s^2,
+OA_l, not reacted on the spacecraft], ``b1[..]``, ``b2[..]`` TM torque noise [rad/s^2, OA_l],
+``tm[0..1]`` MOSA actuator torque [N m about Z_S].  Outputs: every coordinate of q (same names as
+the DOFs, ``u[0]`` ... ``dth[1]``) and the TM's non-gravitational acceleration ``acc1[..]``,
+``acc2[..]`` [m/s^2, OA_l] (electrostatic force / m + force noise - stiffness x: the residual
+acceleration of the TM against its geodesic) and the relative acceleration ``xdd1[..]``,
+``xdd2[..]`` (x_l'', what a local readout sees) [m/s^2, OA_l].
+
+The working point (:class:`WorkingPoint`) holds the coefficients that change over days: the
+gravity-gradient tensor at the spacecraft in S, the nominal omega, omega_dot, the MOSA angle and
+rate, the DC electrostatic force and torque (``tm/a_suspension``, ``tm/alpha_suspension``) and the
+DC drag-free acceleration in S.  Time scale: instantaneous (frozen coefficients).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..constellation.control import oa_rotation
+
+__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "sensitive_basis"]
+
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def _skew(v) -> np.ndarray:
+    """[v x] (3, 3): skew(v) @ w = v x w."""
+    x, y, z = v
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+@dataclass(frozen=True)
+class PlantParameters:
+    """Masses, inertias, geometry and stiffness of one spacecraft (SI; the same for the three).
+
+    sc_mass [kg]; sc_inertia (3,) [kg m^2] principal moments about the S axes; tm_mass [kg];
+    tm_side [m] (cube: moment of inertia tm_mass tm_side^2 / 6); mosa_inertia [kg m^2] about Z_S;
+    mosa_stiffness [N m/rad] of the MOSA mechanism; stiffness (2, 3) [s^-2] per TM and OA_l axis,
+    x'' = -stiffness x + ... (electrostatic + self-gravity gradient; negative = destabilising);
+    rotational_stiffness (2, 3) [s^-2] likewise for eta; crosstalk: the electrostatic actuation
+    cross-talk, the fraction of a force (torque) commanded on one axis of a TM that appears on each
+    other axis of the same TM; housing_centers (2, 3) [m, S], lever_arms (2, 3) [m, S] (EH centre
+    minus MOSA pivot) and sensitive_axes (2, 3) [unit, OA_l] from the trajectory's spacecraft.
+    """
+
+    sc_mass: float
+    sc_inertia: tuple
+    tm_mass: float
+    tm_side: float
+    mosa_inertia: float
+    mosa_stiffness: float
+    stiffness: np.ndarray
+    rotational_stiffness: np.ndarray
+    crosstalk: float
+    housing_centers: np.ndarray
+    lever_arms: np.ndarray
+    sensitive_axes: np.ndarray
+
+    @property
+    def tm_inertia(self) -> float:
+        """TM moment of inertia [kg m^2] (a homogeneous cube)."""
+        return self.tm_mass * self.tm_side ** 2 / 6.0
+
+
+@dataclass(frozen=True)
+class WorkingPoint:
+    """Frozen coefficients of one spacecraft (S frame unless noted; SI).
+
+    gamma (3, 3) [s^-2] gravity-gradient tensor at the spacecraft in S; omega (3,) [rad/s],
+    omega_dot (3,) [rad/s^2]; theta [rad] the opening angle (MOSA angles +-theta/2), theta_dot
+    [rad/s]; a_suspension (2, 3) [m/s^2, OA_l] and alpha_suspension (2, 3) [rad/s^2, OA_l] the DC
+    electrostatic actuation; a_dragfree (3,) [m/s^2, S] the DC drag-free acceleration;
+    self_gravity (2, 3) [m/s^2, OA_l] the DC self-gravity at the TMs (``tm/self_gravity``); t [s]
+    the time it belongs to (the run's time axis).
+    """
+
+    gamma: np.ndarray
+    omega: np.ndarray
+    omega_dot: np.ndarray
+    theta: float
+    theta_dot: float
+    a_suspension: np.ndarray
+    alpha_suspension: np.ndarray
+    a_dragfree: np.ndarray
+    self_gravity: np.ndarray
+    t: float = 0.0
+
+
+def dof_names() -> list[str]:
+    """The 20 coordinates q in state order (module docstring)."""
+    out = []
+    for g, n in (("u", 3), ("phi", 3), ("x1", 3), ("x2", 3), ("eta1", 3), ("eta2", 3), ("dth", 2)):
+        out += [f"{g}[{i}]" for i in range(n)]
+    return out
+
+
+def sensitive_basis(p: PlantParameters) -> np.ndarray:
+    """(2, 3, 3): for each TM, rows e_l (sensitive axis), p_l = Z x e_l, q = Z, in OA_l components.
+    The closed loop needs e_l perpendicular to Z (every preset: X_OA_l); ValueError otherwise."""
+    out = np.zeros((2, 3, 3))
+    for l in range(2):
+        e = np.asarray(p.sensitive_axes[l], dtype=np.float64)
+        e = e / np.linalg.norm(e)
+        if abs(e[2]) > 1e-12:
+            raise ValueError(f"spacecraft.sensitive_axes: {p.sensitive_axes[l].tolist()} has a Z_S component; "
+                             "allowed: sensitive axes in the plane of the constellation for the closed loop")
+        out[l] = [e, np.cross(Z, e), Z]
+    return out
+
+
+def _gg_torque_jacobian(gamma: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """d(gravity-gradient torque / J)/d phi (3, 3): torque_i = eps_ijk Gamma_kl S_jl with S = tr(J)/2 - J
+    and Gamma_B = Gamma - [phi x] Gamma + Gamma [phi x] (the attitude perturbation)."""
+    S = 0.5 * np.trace(J) * np.eye(3) - J
+    eps = np.zeros((3, 3, 3))
+    eps[0, 1, 2] = eps[1, 2, 0] = eps[2, 0, 1] = 1.0
+    eps[0, 2, 1] = eps[2, 1, 0] = eps[1, 0, 2] = -1.0
+    out = np.zeros((3, 3))
+    for a in range(3):
+        P = _skew(np.eye(3)[a])
+        dG = -P @ gamma + gamma @ P
+        out[:, a] = np.einsum("ijk,kl,jl->i", eps, dG, S)
+    return np.linalg.solve(J, out)
+
+
+def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> control.StateSpace:
+    """The linearised plant (module docstring) as a named python-control StateSpace (continuous)."""
+    n = 20
+    iu, iphi, ix, ieta, ith = 0, 3, (6, 9), (12, 15), 18
+    M = np.eye(n)            # mass matrix: M q'' + D q' + K q = B w
+    D = np.zeros((n, n))
+    K = np.zeros((n, n))
+    G = np.asarray(wp.gamma, dtype=np.float64)
+    W = _skew(wp.omega)
+    Wd = _skew(wp.omega_dot)
+    W2 = W @ W
+    J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
+    m, Msc, Itm, Im = p.tm_mass, p.sc_mass, p.tm_inertia, p.mosa_inertia
+    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))          # (2, 3, 3): T_S_OA_l (OA_l -> S)
+    half = 0.5 * wp.theta_dot
+    rh = np.asarray(p.housing_centers, dtype=np.float64)
+    rho = np.asarray(p.lever_arms, dtype=np.float64)
+    rh_dot = np.array([np.cross(s * half * Z, rho[l]) for l, s in enumerate((1.0, -1.0))])   # w_oa x rho
+    inputs = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
+              + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
+              + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)]
+              + ["tm[0]", "tm[1]"])
+    col = {s: k for k, s in enumerate(inputs)}
+    B = np.zeros((n, len(inputs)))
+    F, T = col["F[0]"], col["T[0]"]
+
+    # spacecraft translation u (S): u'' = (Gamma - W' - W^2) u - 2 W u' + F_S/M - [G x] phi + reactions / M
+    K[0:3, 0:3] = -(G - Wd - W2)
+    D[0:3, 0:3] = 2 * W
+    B[0:3, F:F + 3] = np.eye(3) / Msc
+    K[0:3, 3:6] = _skew(wp.a_dragfree)                      # + phi x G_S  ->  K = -[phi x G] coefficient
+    # spacecraft rotation: J phi'' + (J W - [(J w) x] + W J) phi' + (J W' - [(J w) x] W + W J W) phi = T
+    Jw = _skew(J @ wp.omega)
+    Jinv = np.linalg.inv(J)
+    D[3:6, 3:6] = Jinv @ (J @ W - Jw + W @ J)
+    K[3:6, 3:6] = Jinv @ (J @ Wd - Jw @ W + W @ J @ W) - _gg_torque_jacobian(G, J)
+    B[3:6, T:T + 3] = Jinv
+    for l in range(2):
+        Rl, kx, kr = R[l], np.diag(p.stiffness[l]), np.diag(p.rotational_stiffness[l])
+        xs, es = slice(ix[l], ix[l] + 3), slice(ieta[l], ieta[l] + 3)
+        th = ith + l
+        c = np.cross(Z, rho[l])                               # d r_h / d dth_l (S)
+        fcol, tcol, acol, bcol = col[f"f{l + 1}[0]"], col[f"t{l + 1}[0]"], col[f"a{l + 1}[0]"], col[f"b{l + 1}[0]"]
+        X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))     # cross-talk of the actuation
+        # --- TM translation, in OA_l: x = R^T x_S
+        # x_S'' + 2 W x_S' + (W' + W^2 - Gamma) x_S = attitude + MOSA terms + f_S/m - F/M - R kx x
+        M[xs, 3:6] = -Rl.T @ _skew(rh[l])                    # - [r_h x] phi''  (moved to the left)
+        M[xs, th] = Rl.T @ c                                  # + c dth''
+        D[xs, xs] = Rl.T @ (2 * W) @ Rl
+        K[xs, xs] = Rl.T @ (Wd + W2 - G) @ Rl + kx
+        rx, wrx = _skew(rh[l]), _skew(W @ rh[l])
+        D[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot[l]) + rx @ W + wrx + W @ rx)
+        K[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot[l]) @ W + rx @ Wd + wrx @ W + W @ rx @ W
+                              - G @ rx + _skew(G @ rh[l]))
+        D[xs, th] = Rl.T @ (2 * W @ c)
+        K[xs, th] = Rl.T @ ((Wd + W2 - G) @ c - np.cross(Z, Rl @ wp.a_suspension[l]))
+        B[xs, fcol:fcol + 3] = X / m + X / Msc            # own force, and its reaction on the spacecraft
+        B[xs, acol:acol + 3] = np.eye(3)
+        B[xs, F:F + 3] = -Rl.T / Msc
+        # reactions on the spacecraft: -R f (force), -r_h x R f - R t (torque), stiffness likewise
+        B[0:3, fcol:fcol + 3] = -Rl @ X / Msc
+        B[3:6, fcol:fcol + 3] = -Jinv @ _skew(rh[l]) @ Rl @ X
+        B[3:6, tcol:tcol + 3] = -Jinv @ Rl @ X
+        K[0:3, xs] = -(m / Msc) * Rl @ kx
+        K[3:6, xs] = -(m * Jinv @ _skew(rh[l]) @ Rl @ kx)
+        K[3:6, es] = -(Itm * Jinv @ Rl @ kr)
+        # the reactions on the spacecraft move both housings: x_k'' contains -F_sc/M (k = 1, 2)
+        other = 1 - l
+        ox = slice(ix[other], ix[other] + 3)
+        B[ox, fcol:fcol + 3] = R[other].T @ Rl @ X / Msc
+        for k in range(2):
+            ks = slice(ix[k], ix[k] + 3)
+            K[ks, xs] += (m / Msc) * R[k].T @ Rl @ kx
+        # --- TM rotation, in OA_l: eta'' = tau/I - R^T(phi'' + dth'' Z) - [Wt x](eta' + R^T(phi' + dth' Z))
+        #                                  - [Wt' x](eta + R^T(phi + dth Z)) - kr eta
+        Wt = Rl.T @ (wp.omega + np.array([0.0, 0.0, (1 if l == 0 else -1) * half]))
+        Sw, Swd = _skew(Wt), _skew(wp.alpha_suspension[l])
+        M[es, 3:6] = Rl.T
+        M[es, th] = Rl.T @ Z
+        D[es, es] = Sw
+        D[es, 3:6] = Sw @ Rl.T
+        D[es, th] = Sw @ Rl.T @ Z
+        K[es, es] = Swd + kr
+        K[es, 3:6] = Swd @ Rl.T
+        K[es, th] = Swd @ Rl.T @ Z
+        B[es, tcol:tcol + 3] = X / Itm
+        B[es, bcol:bcol + 3] = np.eye(3)
+        # --- MOSA: Im (Z . (phi'' + W' phi + W phi') + dth'') + k dth = tau  (reaction -tau Z on the spacecraft)
+        M[th, 3:6] = Z
+        D[th, 3:6] = Z @ W
+        K[th, 3:6] = Z @ Wd
+        K[th, th] = p.mosa_stiffness / Im
+        B[th, col[f"tm[{l}]"]] = 1.0 / Im
+        B[3:6, col[f"tm[{l}]"]] = -Jinv @ Z
+    Minv = np.linalg.inv(M)
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -Minv @ K
+    A[n:, n:] = -Minv @ D
+    Bs = np.vstack([np.zeros((n, B.shape[1])), Minv @ B])
+    # outputs: q, the TMs' non-gravitational accelerations (OA_l) and the relative accelerations x_l''
+    C = [np.hstack([np.eye(n), np.zeros((n, n))])]
+    Dm = [np.zeros((n, B.shape[1]))]
+    outs = dof_names()
+    for l in range(2):
+        xs = slice(ix[l], ix[l] + 3)
+        Cacc = np.zeros((3, 2 * n))
+        Cacc[:, xs] = -np.diag(p.stiffness[l])
+        Dacc = np.zeros((3, B.shape[1]))
+        fcol, acol = col[f"f{l + 1}[0]"], col[f"a{l + 1}[0]"]
+        X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))
+        Dacc[:, fcol:fcol + 3] = X / m
+        Dacc[:, acol:acol + 3] = np.eye(3)
+        # the body-fixed DC forces (suspension + self-gravity) turn with the attitude, the suspension
+        # also with the MOSA: (phi + dth Z) x F_dc, seen along the nominal (inertial) OA_l axes
+        Rl = R[l]
+        dc = Rl @ (np.asarray(wp.a_suspension[l]) + np.asarray(wp.self_gravity[l]))
+        Cacc[:, 3:6] = -Rl.T @ _skew(dc)
+        Cacc[:, ith + l] = -Rl.T @ _skew(Rl @ np.asarray(wp.a_suspension[l])) @ Z
+        C.append(Cacc)
+        Dm.append(Dacc)
+        outs += [f"acc{l + 1}[{i}]" for i in range(3)]
+    for l in range(2):
+        xs = slice(n + ix[l], n + ix[l] + 3)
+        C.append(A[xs, :])
+        Dm.append(Bs[xs, :])
+        outs += [f"xdd{l + 1}[{i}]" for i in range(3)]
+    states = dof_names() + [f"d{s}" for s in dof_names()]
+    return control.ss(A, Bs, np.vstack(C), np.vstack(Dm), inputs=inputs, outputs=outs, states=states, name=name)

@@ -1,0 +1,237 @@
+"""The closed-loop model (tqdyn.closedloop, tqdyn.analysis.closed_loop; docs/closed-loop.md).
+
+References: the analytic closed-loop transfer functions of a one-degree-of-freedom loop
+(S = 1/(1 + L), T = L/(1 + L), evaluated directly from C(s) and P(s) = 1/(s^2 + k)); the Welch
+estimate's own statistics (chi^2 with the segments' degrees of freedom); the nominal control of real
+coupled runs (tqdyn.propagate: the drag-free and suspension accelerations the compiled kernel
+computes from the three control conditions); the published ASD shapes of the requirements.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from tqdyn.closedloop.budget import DesignError, check_stable, closed_loop_response, loop_margins, noise_budget
+from tqdyn.closedloop.controllers import Controller, lead_lag_pid
+from tqdyn.closedloop.loop import SOURCES, build_closed_loop, output_names
+from tqdyn.closedloop.missions import MISSIONS, default_controllers, default_noise, default_plant, requirement
+from tqdyn.closedloop.noise import AsdModel, shaping_error
+from tqdyn.closedloop.one_dof import one_dof_loop
+from tqdyn.closedloop.plant import PlantParameters, WorkingPoint
+from tqdyn.closedloop.simulate import simulate
+from tqdyn.constellation.spacecraft import Spacecraft
+from tqdyn.scenario import ScenarioError, load_scenario
+
+
+def _model(mission, wp=None, **plant):
+    sc = Spacecraft.preset(mission)
+    d = {**default_plant(mission), **plant}
+    p = PlantParameters(sc_mass=d["sc_mass"], sc_inertia=d["sc_inertia"], tm_mass=d["tm_mass"], tm_side=d["tm_side"],
+                        mosa_inertia=d["mosa_inertia"], mosa_stiffness=d["mosa_stiffness"],
+                        stiffness=np.tile(d["stiffness"], (2, 1)),
+                        rotational_stiffness=np.tile(d["rotational_stiffness"], (2, 1)), crosstalk=d["crosstalk"],
+                        housing_centers=sc.housing_centers(math.pi / 3), lever_arms=sc.lever_arms(math.pi / 3),
+                        sensitive_axes=sc.sensitive_axes_array)
+    if wp is None:
+        n2 = 4e-10 if mission == "tianqin" else 4e-14
+        wp = WorkingPoint(gamma=np.diag([2 * n2, -n2, -n2]), omega=np.array([0.0, 0.0, math.sqrt(n2)]),
+                          omega_dot=np.zeros(3), theta=math.pi / 3, theta_dot=0.0,
+                          a_suspension=np.array([[0.0, 1e-10, 5e-11], [0.0, -1e-10, -5e-11]]),
+                          alpha_suspension=np.full((2, 3), 1e-13), a_dragfree=np.array([1e-11, 2e-11, 3e-11]),
+                          self_gravity=np.full((2, 3), 5e-11))
+    return p, wp
+
+
+def test_one_dof_reproduces_the_analytic_sensitivity_and_complementary_sensitivity():
+    """x/n_thr = -(1/M) P/(1 + L), x/n_s = -L/(1 + L) with L = C P, P = 1/(s^2 + k) (module docstring of
+    tqdyn.closedloop.one_dof): the interconnected loop agrees to round-off (measured ~1e-15; bound 1e-6)."""
+    c = lead_lag_pid(0.05)
+    M, k = 2000.0, -1e-6
+    cl = one_dof_loop(c, M, k)
+    f = np.logspace(-6, 1, 200)
+    s = 2j * math.pi * f
+    L = c.tf()(s) / (s ** 2 + k)
+    G = closed_loop_response(cl, f, ["x"], ["thruster_force[0]", "interferometer[0]"])
+    assert np.max(np.abs(G[0, 0] / (-(1 / M) / (s ** 2 + k) / (1 + L)) - 1)) < 1e-6
+    assert np.max(np.abs(G[0, 1] / (-L / (1 + L)) - 1)) < 1e-6
+    m = loop_margins(cl)[0]
+    # the design's crossover and its phase margin: arcsin((a-1)/(a+1)) - atan(1/r) = 54.9 - 5.7 deg
+    assert m.f_phase_margin == pytest.approx(0.05, rel=1e-3)
+    assert 45 < m.phase_margin < 52
+
+
+def test_one_dof_time_domain_asd_agrees_with_the_budget_within_welch_statistics():
+    """White thruster noise (1e-7 N/Hz^1/2) through the discretised loop, one day at 4 Hz: the Welch ASD over
+    the discretised loop's predicted ASD has mean 1 within 4 of its standard errors (Hann, 50 % overlap)."""
+    cl = one_dof_loop(lead_lag_pid(0.05), 2000.0, -1e-6)
+    fs, n, nper = 4.0, 4 * 86400, 2 ** 14
+    snk = simulate([[(0.0, cl)]], {"thruster_force": AsdModel(1e-7, (), "N", "n")}, fs, n, seed=3)
+    f, pxx = signal.welch(snk.values[:, 0, 0], fs=fs, nperseg=nper)
+    G = closed_loop_response(cl, f[1:], ["x"], ["thruster_force[0]"], dt=1 / fs)
+    r = pxx[1:] / (np.abs(G[0, 0]) * 1e-7) ** 2
+    band = f[1:] > 10 * fs / nper
+    k = 2 * n / nper - 1                                 # segments (50 % overlap)
+    sigma = math.sqrt(1.0 / (0.5 * k)) / math.sqrt(band.sum())   # Hann's effective dof ~ k (overlap)
+    assert abs(np.mean(r[band]) - 1) < 4 * sigma + 0.01
+
+
+@pytest.mark.parametrize("mission", MISSIONS)
+def test_default_designs_are_stable_with_margins_and_name_their_dominant_sources(mission):
+    """Every loop channel of the default design: phase margin 40..60 deg near its design crossover (the
+    lead-lag design gives 49 deg on 1/s^2); the budget names a largest source for every output and band."""
+    p, wp = _model(mission)
+    cl = build_closed_loop(p, wp, default_controllers(mission))
+    check_stable(cl)
+    for m in loop_margins(cl):
+        assert 40 < m.phase_margin < 60, m
+    f = np.logspace(-4, 0, 60)
+    b, sources = noise_budget(cl, default_noise(mission), f)
+    assert b.shape == (len(output_names()), len(sources), len(f))
+    assert np.all(np.isfinite(b)) and np.all(b >= 0)
+    i = output_names().index("tm1_acceleration")
+    low = f < 3e-4
+    # below the loops' bandwidths the residual acceleration is the TM force noise (the requirement curve)
+    assert sources[int(np.argmax(np.mean(b[i][:, low] ** 2, axis=1)))] == "tm_force"
+
+
+def test_an_unstable_design_is_refused_naming_the_loop():
+    """A suspension crossover far below the stiffness's unstable pole (sqrt(1e-6) rad/s = 0.16 mHz) cannot
+    hold the TM: refused with the loop's name and its margins."""
+    p, wp = _model("lisa")
+    ctl = default_controllers("lisa")
+    ctl["suspension"] = lead_lag_pid(1e-6, name="suspension")
+    with pytest.raises(DesignError, match=r"^closed_loop\.controllers\.\w+: the closed loop is unstable") as e:
+        check_stable(build_closed_loop(p, wp, ctl))
+    assert "\n" not in str(e.value)
+
+
+def test_improper_and_bad_controllers_and_noise_are_refused_in_one_line():
+    for kw, pat in ((dict(zeros=(-1.0, -2.0), poles=(-1.0,), gain=1.0), "improper"),
+                    (dict(zeros=(), poles=(1.0,), gain=1.0), "unstable pole"),
+                    (dict(zeros=(), poles=(-1.0,), gain=-1.0), "positive")):
+        with pytest.raises(ScenarioError, match=pat):
+            Controller(name="dragfree", **kw)
+    with pytest.raises(ScenarioError, match="negative ASD"):
+        AsdModel(-1.0, (), "N", "closed_loop.noise.thruster_force")
+    for over, pat in (("closed_loop.noise.thruster_force.level=-1", "negative ASD"),
+                      ("closed_loop.noise.nonsense.level=1", "not a noise source"),
+                      ("closed_loop.controllers.nonsense.gain=1", "not a loop"),
+                      ("closed_loop.mission=hubble", "not a mission")):
+        with pytest.raises(ScenarioError, match=pat) as e:
+            load_scenario("tianqin", [over])
+        assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("model", [AsdModel(3e-15, ((4e-4, -1.0), (8e-3, 2.0))), AsdModel(1e-15, ((1e-4, -0.5),)),
+                                   AsdModel(2.4e-9, ((1e-3, -1.0),))])
+def test_shaping_filters_follow_the_asd_models(model):
+    """The rational shaping filters of the published shapes (LISA's knees, TianQin's sqrt(1 + 0.1 mHz/f)):
+    within 1 % of the model over [1e-6, 2] Hz (measured <= 0.44 %)."""
+    assert shaping_error(model, 1e-6, 2.0) < 1e-2
+
+
+def test_requirements_are_the_published_curves():
+    """LISA 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4); TianQin 1e-15 sqrt(1 + 0.1 mHz/f)."""
+    f = np.array([1e-4, 1e-3, 1e-2])
+    assert np.allclose(requirement("lisa").asd(f), 3e-15 * np.sqrt(1 + (4e-4 / f) ** 2) * np.sqrt(1 + (f / 8e-3) ** 4))
+    assert np.allclose(requirement("tianqin").asd(f), 1e-15 * np.sqrt(1 + 1e-4 / f))
+
+
+def test_adding_a_source_leaves_the_other_realisations_unchanged():
+    """One SeedSequence per (satellite, source): the interferometer-driven output is the same with or
+    without thruster noise switched on, to round-off of the linear superposition."""
+    cl = one_dof_loop(lead_lag_pid(0.05), 2000.0, 0.0)
+    ifo = {"interferometer": AsdModel(1e-12, (), "m", "n")}
+    a = simulate([[(0.0, cl)]], ifo, 4.0, 4000, seed=7).values
+    both = simulate([[(0.0, cl)]], {**ifo, "thruster_force": AsdModel(1e-7, (), "N", "n")}, 4.0, 4000, seed=7).values
+    thr = simulate([[(0.0, cl)]], {"thruster_force": AsdModel(1e-7, (), "N", "n")}, 4.0, 4000, seed=7).values
+    assert np.max(np.abs(both - (a + thr))) <= 1e-9 * np.max(np.abs(both))
+
+
+def test_streaming_blocks_equal_one_block():
+    """The state carries across blocks: blocks of 1000 samples give the same series as one block."""
+    p, wp = _model("tianqin")
+    cl = build_closed_loop(p, wp, default_controllers("tianqin"))
+    noise = default_noise("tianqin")
+    a = simulate([[(0.0, cl)]], noise, 4.0, 3000, seed=1, block_size=1000).values
+    b = simulate([[(0.0, cl)]], noise, 4.0, 3000, seed=1, block_size=3000).values
+    assert np.max(np.abs(a - b)) <= 1e-9 * np.max(np.abs(b), axis=0).max()
+
+
+@pytest.fixture(scope="module")
+def tianqin_runs():
+    import tqdyn
+
+    over = {"run.duration": "2h", "integrator.step": 600}
+    return (tqdyn.propagate("tianqin", over),
+            tqdyn.propagate("tianqin", {**over, "spacecraft.self_gravity": "off"}))
+
+
+def test_dc_limit_reproduces_the_nominal_split_of_a_coupled_run(tianqin_runs):
+    """DC self-gravity (Table IV, the file's tm/self_gravity) injected as TM force noise at 1e-9 Hz: the
+    loop's thrust / M and suspension / m equal the difference of the nominal control of two coupled runs
+    (Table IV minus no self-gravity; compiled kernel, three control conditions) -- the signs and the
+    split.  Difference: the loop includes the reaction of the suspension on the spacecraft (m/M =
+    4e-3 of A), the nominal control does not; the bound is 2 m/M of |A|."""
+    from tqdyn.analysis.closed_loop import closed_loop_model
+
+    with_sg, without = tianqin_runs
+    model = closed_loop_model(with_sg)
+    row = len(with_sg["t"]) // 2
+    cl = model.loops[0][0][1]
+    sg = with_sg["tm/self_gravity"][0]                              # (2, 3) OA_l
+    G = closed_loop_response(cl, [1e-9], ["thrust_force_x", "thrust_force_y", "thrust_force_z"]
+                             + [f"tm{l}_es_force_{a}" for l in (1, 2) for a in "xyz"],
+                             [f"tm_force[{k}]" for k in range(6)])[:, :, 0].real
+    out = G @ sg.reshape(6)
+    T = with_sg["sat/T_S_I"][row, 0]
+    dG = T @ (with_sg["sat/a_dragfree"][row, 0] - without["sat/a_dragfree"][row, 0])
+    dA = with_sg["tm/a_suspension"][row, 0] - without["tm/a_suspension"][row, 0]
+    M, m = default_plant("tianqin")["sc_mass"], default_plant("tianqin")["tm_mass"]
+    tol = 2 * m / M * np.max(np.abs(dA))
+    assert np.max(np.abs(out[:3] / M - dG)) < tol
+    assert np.max(np.abs(out[3:].reshape(2, 3) / m - dA)) < tol
+
+
+def test_entry_point_refuses_a_pure_gravity_run():
+    import tqdyn
+    from tqdyn.analysis.closed_loop import ClosedLoopError, closed_loop_model
+
+    tr = tqdyn.propagate("tianqin-gravity", {"run.duration": "1h", "integrator.step": 600})
+    with pytest.raises(ClosedLoopError, match="missing") as e:
+        closed_loop_model(tr)
+    assert "\n" not in str(e.value)
+
+
+def test_entry_point_budget_and_series_are_xarray(tianqin_runs):
+    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_model, closed_loop_timeseries
+
+    model = closed_loop_model(tianqin_runs[0])
+    ds = closed_loop_budget(model, f=np.logspace(-4, 0, 20))
+    assert ds["asd"].dims == ("segment", "sat", "output", "source", "frequency")
+    assert set(ds["source"].values) == set(SOURCES)
+    ts = closed_loop_timeseries(model, duration_s=600.0, fs=2.0)
+    assert ts["values"].dims == ("time", "sat", "output") and ts["values"].shape[:2] == (1200, 3)
+
+
+def test_docs_numbers_json_is_what_design_numbers_computes():
+    """docs/data/closed-loop-numbers.json (the numbers docs/closed-loop.md quotes) equals a fresh
+    tqdyn.closedloop.study.design_numbers() to 1e-6 relative (regenerate it with that function)."""
+    import json
+    import pathlib
+
+    from tqdyn.closedloop.study import design_numbers
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "docs" / "data" / "closed-loop-numbers.json"
+    stored = json.loads(path.read_text())
+    fresh = json.loads(json.dumps(design_numbers()))
+    for m in stored["missions"]:
+        for key in ("tm_acceleration_total", "actuation_force", "stiffness_times_jitter", "sc_tm_jitter_m"):
+            assert np.allclose(stored["missions"][m][key], fresh["missions"][m][key], rtol=1e-6), (m, key)
+    # the DC self-gravity's path (actuation noise x cross-talk) is far below the requirement at 1 mHz
+    for m in stored["missions"]:
+        assert fresh["missions"][m]["actuation_force"][0] < 1e-3 * requirement(m).asd(1e-3)
