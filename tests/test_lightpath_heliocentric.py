@@ -37,7 +37,10 @@ with pytest -s).
 
 from __future__ import annotations
 
+import copy
 import hashlib
+import re
+import tomllib
 
 import mpmath
 import numpy as np
@@ -667,3 +670,31 @@ def test_trajectory_gm_guard(traj):
         LP.light_travel_times_of(traj, gm=3.986004415e14)
     with pytest.raises(ValueError, match="allowed"):
         LP.light_travel_times_of(traj, shapiro_bodies=["pluto"])
+
+
+
+def test_light_paths_use_the_runs_gm_sun(traj):
+    """A run's Sun GM (``forces.gm_sun``) is the one of its light paths and BCRS export, not the shipped
+    DE430 value: the Sun's Shapiro delay is linear in GM (2 GM/c^3 ln(...)), so with GM scaled by k the
+    light times move by (k - 1) times the Sun's delay."""
+    from tqdyn.lightpath.lisa_bcrs import lisa_orbit_quantities_bcrs
+    from tqdyn.astro.ephemeris import planetary_gm
+
+    gm0 = float(planetary_gm()["sun"])
+    k = 1.001
+    text = re.sub(r"(?m)^gm_sun = .*$", f"gm_sun = {gm0 * k!r}", traj.scenario_toml)  # the resolved scenario's key
+    assert tomllib.loads(text)["forces"]["gm_sun"] == gm0 * k
+    other = copy.copy(traj)  # the same arrays, another scenario text
+    other.scenario_toml = text
+    base = LP.light_travel_times_of(traj, shapiro=True)
+    flat = LP.light_travel_times_of(traj, shapiro=False)
+    scaled = LP.light_travel_times_of(other, shapiro=True)
+    delay = (base.tau[0] - flat.tau[0]) + (base.tau[1] - flat.tau[1])
+    moved = (scaled.tau[0] - base.tau[0]) + (scaled.tau[1] - base.tau[1])
+    ok = np.isfinite(delay)
+    gap = np.max(np.abs(moved[ok] - (k - 1) * delay[ok]))
+    print(f"\nSun's Shapiro delay {np.nanmax(delay):.3e} s; moved by {np.nanmax(np.abs(moved)):.3e} s with GM x {k}; "
+          f"linearity gap {gap:.1e} s")
+    assert np.nanmax(np.abs(moved)) > 0.5 * (k - 1) * np.nanmax(delay)
+    assert gap < 3e-20  # s: measured 4.4e-21 s, the Shapiro terms are float64 (1.6e-7 s x 2e-16 x ln ratio terms)
+    assert lisa_orbit_quantities_bcrs(other)["gm_sun"] == gm0 * k

@@ -30,6 +30,7 @@ import tomllib
 
 import numpy as np
 
+from ..forces.body_gms import BODY_GM_KEYS
 from ..astro.ephemeris import HELIOCENTRIC_BODIES, Ephemeris, default_ephemeris, planetary_gm
 from ..astro.reference import HELIOCENTRIC
 from ..numerics.dd import np_dd_add_d
@@ -93,11 +94,22 @@ def resolve_bodies(spec, trajectory=None) -> tuple[str, ...]:
     return tuple(out)
 
 
-def gm_of(bodies) -> np.ndarray:
-    """(K,) GMs [m^3/s^2] of ``bodies`` (TDB-compatible DE430/DE431 values,
-    planets as systems: :func:`tqdyn.astro.ephemeris.planetary_gm`)."""
+def gm_of(bodies, trajectory=None) -> np.ndarray:
+    """(K,) GMs [m^3/s^2] of ``bodies``, TDB-compatible, planets as systems:
+    the run's own (its scenario's ``forces.gm_sun``, ``gm_earth_tdb``,
+    ``gm_moon``, ``gm_<planet>``; :data:`tqdyn.forces.body_gms.BODY_GM_KEYS`)
+    when ``trajectory`` has them, else the DE430/DE431 values of
+    :func:`tqdyn.astro.ephemeris.planetary_gm` (the keys' defaults)."""
     gm = planetary_gm()
-    return np.array([gm[b] for b in bodies], dtype=np.float64)
+    forces = _scenario(trajectory).get("forces", {}) if trajectory is not None else {}
+    out = []
+    for b in bodies:
+        value = forces.get(BODY_GM_KEYS.get(b, ""))
+        try:
+            out.append(float(value) if value is not None else float(gm[b]))
+        except (TypeError, ValueError):
+            out.append(float(gm[b]))
+    return np.array(out, dtype=np.float64)
 
 
 def _times(t) -> tuple[np.ndarray, np.ndarray]:

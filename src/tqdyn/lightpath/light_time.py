@@ -457,7 +457,7 @@ def light_travel_times_of(trajectory, *, shapiro_bodies=None, ephemeris=None, **
     run's ``forces.third_bodies``), ``"all"`` (Earth, Moon, Mercury ..
     Neptune) or a list of names of
     :data:`tqdyn.astro.ephemeris.HELIOCENTRIC_BODIES`; their positions at
-    the grid (reception) times, GMs of DE430.  Geocentric trajectories
+    the grid (reception) times, GMs the run's (``forces.gm_*``, default DE430).  Geocentric trajectories
     refuse ``shapiro_bodies`` (GCRS: tidal potentials only).  Other
     ``kwargs`` (``shapiro``, ``gm``, ``tol``, ``max_iter``, ``gamma``) go
     to :func:`light_travel_times`.
@@ -473,8 +473,10 @@ def light_travel_times_of(trajectory, *, shapiro_bodies=None, ephemeris=None, **
                              "is shapiro=True)")
         return light_travel_times(t, r, v, a, **kwargs)
     gm = kwargs.get("gm")
-    if gm is not None:
-        gm_sun = float(_helio.gm_of(("sun",))[0])
+    gm_sun = float(_helio.gm_of(("sun",), trajectory)[0])  # the run's
+    if gm is None:
+        kwargs["gm"] = gm_sun
+    else:
         if not abs(float(gm) / gm_sun - 1.0) < 1e-3:
             raise ValueError(f"gm = {gm!r} m^3/s^2: a heliocentric trajectory's Shapiro delay is the Sun's "
                              f"(GM ~ {gm_sun:.6e} m^3/s^2); pass gm=None for the default")
@@ -483,6 +485,6 @@ def light_travel_times_of(trajectory, *, shapiro_bodies=None, ephemeris=None, **
     _, vo, ao = _helio.sun_barycentric_motion(eph, epoch, t, ref)
     bodies = _helio.resolve_bodies(shapiro_bodies, trajectory)
     pos, _ = _helio.body_states(eph, epoch, t, bodies, ref, velocity=False)
-    defl = [(b, g, pos[:, k]) for k, (b, g) in enumerate(zip(bodies, _helio.gm_of(bodies)))]
+    defl = [(b, g, pos[:, k]) for k, (b, g) in enumerate(zip(bodies, _helio.gm_of(bodies, trajectory)))]
     return light_travel_times(t, r, v, a, reference=ref, origin_velocity=vo, origin_acceleration=ao,
                               deflectors=defl, **kwargs)

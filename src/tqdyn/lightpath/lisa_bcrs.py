@@ -40,11 +40,10 @@ import erfa
 import numpy as np
 
 from ..astro.constants import J2000_JD
-from ..astro.ephemeris import default_ephemeris, planetary_gm
 from ..astro.geocentric import TDB_TO_TT_SCALE, gcrs_to_bcrs_states
 from ..astro.timescales import TCB_SCALE, tcb_origin_offset, tdb_jd, tdb_to_tcb
 from ..numerics.dd import np_dd_add_d
-from .heliocentric import ssb_states
+from .heliocentric import ephemeris_of, gm_of, ssb_states
 from .light_time import _layout_of, _trajectory_arrays, light_travel_times, satellite_states
 from .proper_time import pseudorange_quantities, scenario_gm_earth
 from .proper_time_bcrs import proper_time_deviation_geocentric_tcb, proper_time_deviation_of
@@ -74,7 +73,9 @@ def lisa_orbit_quantities_bcrs(trajectory, *, shapiro: bool | None = None, gm_ea
     ``forces.gm_earth``, else GM_EARTH_EGM2008).  axes: one of
     :data:`BCRS_AXES`; time_origin: one of
     :data:`tqdyn.astro.timescales.TCB_ORIGINS`; ephemeris: an
-    :class:`tqdyn.astro.ephemeris.Ephemeris` (default the shipped DE421).
+    :class:`tqdyn.astro.ephemeris.Ephemeris` (default the run's,
+    ``forces.ephemeris``).  The Sun's GM (Shapiro delay) is the run's
+    ``forces.gm_sun``, the other bodies' (proper times) their ``forces.gm_*``.
 
     Returns a dict, all arrays for the N rows of the trajectory's grid (rows
     whose emission time precedes the first sample have NaN light times):
@@ -92,9 +93,9 @@ def lisa_orbit_quantities_bcrs(trajectory, *, shapiro: bool | None = None, gm_ea
     ref = trajectory.reference
     helio = ref.origin == "sun"
     shapiro = helio if shapiro is None else bool(shapiro)
-    eph = default_ephemeris() if ephemeris is None else ephemeris
+    eph = ephemeris_of(trajectory) if ephemeris is None else ephemeris
     epoch = trajectory.epoch
-    gm_sun = float(planetary_gm()["sun"])  # TDB-compatible (DE430/DE431), the heliocentric force model's value
+    gm_sun = float(gm_of(("sun",), trajectory)[0])  # TDB-compatible, the run's (forces.gm_sun)
     t, lr, lv, la, _ = _trajectory_arrays(trajectory)
     layout = _layout_of(np.shape(lr[0]), "tm/r")
     sat = satellite_states(trajectory)

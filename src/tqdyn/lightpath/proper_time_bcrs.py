@@ -226,7 +226,7 @@ def proper_time_deviation_of(trajectory, *, against: str | None = None, bodies="
       Sun's barycentric motion and the potential of ``bodies`` ("all"
       (default), "third_bodies" = the run's, None = the Sun alone, or a
       list of names) from ``ephemeris`` (default the run's); ``gm`` is the
-      Sun's (default DE430).
+      Sun's; the GMs default to the run's (its scenario's ``forces.gm_*``).
 
     Returns (delta_tau, rate, rate_dot), each (N, 3) float64: [s], [s/s],
     [1/s] per second of the time scale against which delta_tau is taken.
@@ -245,5 +245,6 @@ def proper_time_deviation_of(trajectory, *, against: str | None = None, bodies="
     names = _helio.resolve_bodies(bodies, trajectory)
     pk, vk = _helio.body_states(eph, epoch, t, names, ref)
     return proper_time_deviation_bcrs(t, x, vel, acc, origin_velocity=vo, origin_acceleration=ao, bodies_r=pk,
-                                      bodies_v=vk, bodies_gm=_helio.gm_of(names), gm_sun=gm,
+                                      bodies_v=vk, bodies_gm=_helio.gm_of(names, trajectory),
+                                      gm_sun=float(_helio.gm_of(("sun",), trajectory)[0]) if gm is None else gm,
                                       against="TCB" if against is None else against, c4=c4)
