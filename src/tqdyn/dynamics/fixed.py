@@ -29,7 +29,7 @@ from . import layout as _lay
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
-__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "chunk_plan", "propagate_fixed", "warm_up"]
+__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "chunk_plan", "input_pipeline", "propagate_fixed", "warm_up"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -155,6 +155,34 @@ def chunk_plan(n: int, n_total: int, chunk: int, checkpoint_every: int) -> list[
     return plan
 
 
+def input_pipeline(plan, inputs, block: int):
+    """The chunks of ``plan`` with their time-only inputs computed one block
+    ahead in a second thread (the inputs of the next block overlap the
+    compiled loop of this one).
+
+    plan: [(n0, m)] chunks of steps; inputs(b0, mb, (n0, m)) -> the inputs of
+    steps b0 .. b0 + mb of chunk (n0, m); block: steps per block.  Yields
+    (n0, m, parts) per chunk, where parts yields (o, e, tdat): the block's
+    rows o:e inside the chunk and its inputs, in order.  Each chunk's parts
+    must be consumed before the next chunk is taken."""
+    blocks = [(b0, min(block, n0 + m - b0), (n0, m)) for n0, m in plan for b0 in range(n0, n0 + m, block)]
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        queue = {"next": 0, "pending": pool.submit(inputs, *blocks[0]) if blocks else None}
+
+        def parts(n0, m):
+            while queue["next"] < len(blocks) and blocks[queue["next"]][2] == (n0, m):
+                b0, mb, _ = blocks[queue["next"]]
+                tdat = queue["pending"].result()
+                queue["next"] += 1
+                i = queue["next"]
+                queue["pending"] = pool.submit(inputs, *blocks[i]) if i < len(blocks) else None
+                yield b0 - n0, b0 - n0 + mb, tdat
+                del tdat  # before the next block's inputs arrive
+
+        for n0, m in plan:
+            yield n0, m, parts(n0, m)
+
+
 def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
                      start=None, checkpoint=None, checkpoint_every=0, system=None, checkpoint_interval_s=0.0):
     coef = dp87.step_coefficients(tab, scenario.integrator.step_s, precision)
@@ -218,43 +246,33 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         return tdat[:m] if extra else tdat
 
     cpu = {"inputs": 0.0, "loop": 0.0}
-    blocks = [(b0, min(INPUT_BLOCK, n0 + m - b0), (n0, m)) for n0, m in plan
-              for b0 in range(n0, n0 + m, INPUT_BLOCK)]
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        pending = pool.submit(inputs, *blocks[0]) if blocks else None
-        ib = 0
-        for n0, m in plan:
-            t_out = np.empty((m, 2))
-            _grid_times(n0, m, h, coef.c, t_out, np.empty((0, 13, 2)))
-            out_y = np.empty((m,) + y.shape)
-            out_a = np.empty((m,) + acc_shape)
-            out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
-            while ib < len(blocks) and blocks[ib][2] == (n0, m):
-                b0, mb, _ = blocks[ib]
-                tdat = pending.result()
-                ib += 1
-                pending = pool.submit(inputs, *blocks[ib]) if ib < len(blocks) else None
-                o, e = b0 - n0, b0 - n0 + mb
-                t_cpu = _time.thread_time()
-                _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
-                             coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, mb, out_y[o:e],
-                             out_a[o:e], out_aux[o:e])
-                cpu["loop"] += _time.thread_time() - t_cpu
-                del tdat
-            if sink is not None:
-                sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
-            if n_aux:
-                update_extremes(extremes, out_aux, system)
-            del out_y, out_a, out_aux
-            n = n0 + m
-            if progress is not None:
-                progress(m)
-            now = _time.perf_counter()
-            due = ((checkpoint_every and n % checkpoint_every == 0)
-                   or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
-            if checkpoint is not None and due and n < n_total:
-                checkpoint(Checkpoint(n, y.copy(), comp.copy()))
-                t_ckpt = now
+    for n0, m, parts in input_pipeline(plan, inputs, INPUT_BLOCK):
+        t_out = np.empty((m, 2))
+        _grid_times(n0, m, h, coef.c, t_out, np.empty((0, 13, 2)))
+        out_y = np.empty((m,) + y.shape)
+        out_a = np.empty((m,) + acc_shape)
+        out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
+        for o, e, tdat in parts:
+            t_cpu = _time.thread_time()
+            _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                         coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, e - o, out_y[o:e],
+                         out_a[o:e], out_aux[o:e])
+            cpu["loop"] += _time.thread_time() - t_cpu
+            del tdat
+        if sink is not None:
+            sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
+        if n_aux:
+            update_extremes(extremes, out_aux, system)
+        del out_y, out_a, out_aux
+        n = n0 + m
+        if progress is not None:
+            progress(m)
+        now = _time.perf_counter()
+        due = ((checkpoint_every and n % checkpoint_every == 0)
+               or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
+        if checkpoint is not None and due and n < n_total:
+            checkpoint(Checkpoint(n, y.copy(), comp.copy()))
+            t_ckpt = now
     # the final state and its acceleration
     t_end = np.empty((1, 2))
     t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))

@@ -30,7 +30,6 @@ diagnostics): a resumed run is bit-identical.
 from __future__ import annotations
 
 import time as _time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numba import njit
@@ -38,7 +37,7 @@ from numba import njit
 from ..numerics import dp87
 from ..numerics import multistep as _ms
 from . import layout as _lay
-from .fixed import _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan
+from .fixed import _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, input_pipeline
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
@@ -273,45 +272,35 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
 
     ypred = np.zeros_like(st.y)
     kbuf = np.zeros_like(st.y)
-    blocks = [(b0, min(INPUT_BLOCK, n0 + m - b0), (n0, m)) for n0, m in plan
-              for b0 in range(n0, n0 + m, INPUT_BLOCK)]
     t_ckpt = _time.perf_counter()
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        pending = pool.submit(inputs, *blocks[0]) if blocks else None
-        ib = 0
-        for n0, m in plan:
-            t_out = np.empty((m, 2))
-            _grid_times(n0, m, h, c_dummy, t_out, np.empty((0, 1, 2)))
-            out_y = np.empty((m,) + st.y.shape)
-            out_a = np.empty((m,) + st.F.shape[1:])
-            out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
-            while ib < len(blocks) and blocks[ib][2] == (n0, m):
-                b0, mb, _ = blocks[ib]
-                tdat = pending.result()
-                ib += 1
-                pending = pool.submit(inputs, *blocks[ib]) if ib < len(blocks) else None
-                o, e = b0 - n0, b0 - n0 + mb
-                t_cpu = _time.thread_time()
-                _multistep_chunk(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux,
-                                 stats, n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, mb,
-                                 out_y[o:e], out_a[o:e], out_aux[o:e])
-                cpu["loop"] += _time.thread_time() - t_cpu
-                del tdat
-            if sink is not None:
-                sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
-            if n_aux:
-                update_extremes(extremes, out_aux, system)
-            del out_y, out_a, out_aux
-            n = n0 + m
-            n_rhs += m * (n_corr + (1 if evaluated else 0))
-            if progress is not None:
-                progress(m)
-            now = _time.perf_counter()
-            due = ((checkpoint_every and n % checkpoint_every == 0)
-                   or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
-            if checkpoint is not None and due and n < n_total:
-                checkpoint(Checkpoint(n, st.y.copy(), np.zeros_like(st.y), st.table()))
-                t_ckpt = now
+    for n0, m, parts in input_pipeline(plan, inputs, INPUT_BLOCK):
+        t_out = np.empty((m, 2))
+        _grid_times(n0, m, h, c_dummy, t_out, np.empty((0, 1, 2)))
+        out_y = np.empty((m,) + st.y.shape)
+        out_a = np.empty((m,) + st.F.shape[1:])
+        out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
+        for o, e, tdat in parts:
+            t_cpu = _time.thread_time()
+            _multistep_chunk(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux,
+                             stats, n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, e - o,
+                             out_y[o:e], out_a[o:e], out_aux[o:e])
+            cpu["loop"] += _time.thread_time() - t_cpu
+            del tdat
+        if sink is not None:
+            sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
+        if n_aux:
+            update_extremes(extremes, out_aux, system)
+        del out_y, out_a, out_aux
+        n = n0 + m
+        n_rhs += m * (n_corr + (1 if evaluated else 0))
+        if progress is not None:
+            progress(m)
+        now = _time.perf_counter()
+        due = ((checkpoint_every and n % checkpoint_every == 0)
+               or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
+        if checkpoint is not None and due and n < n_total:
+            checkpoint(Checkpoint(n, st.y.copy(), np.zeros_like(st.y), st.table()))
+            t_ckpt = now
     # the final state: its acceleration and diagnostics are the last evaluation's
     t_end = np.empty((1, 2))
     _grid_times(n_total, 1, h, c_dummy, t_end, np.empty((0, 1, 2)))
