@@ -21,9 +21,10 @@ if [ $QUICK = 1 ]; then
     tqdyn bench --model kepler --model lisa --model lisa-coupled --model kernels --model default-run \
         --model startup --model lisa-10y --json "$DATA/bench.json"
     tqdyn bench --model full --model coupled --duration 2d --json "$DATA/bench.json"
-    tqdyn bench --model tianqin-5y --duration 10d --json "$DATA/bench.json"
+    tqdyn bench --model tianqin-5y --model tianqin-5y-multistep --duration 10d --json "$DATA/bench.json"
 else
-    tqdyn bench --model all --model default-run --model startup --model tianqin-5y --model lisa-10y \
+    tqdyn bench --model all --model default-run --model startup --model tianqin-5y --model tianqin-5y-multistep \
+        --model lisa-10y \
         --json "$DATA/bench.json"
 fi
 

@@ -249,6 +249,13 @@ def gen_readme_bench(records, arg=None) -> str:
                 + f", {_f(t5['peak_rss_mb'], '.0f')} MB "
                 f"peak; resident set {_f(t5['rss_run_min_mb'], '.0f')}-{_f(t5['rss_run_max_mb'], '.0f')} MB after "
                 f"the first 10 % of the run | - | - |")
+    t5m = _bench(records, "tianqin-5y-multistep")["result"] if "tianqin-5y-multistep" in records["bench"]["models"] \
+        else None
+    if t5m is not None:
+        rows.append(f"| coupled TianQin, multistep method, {_span(t5m)} (`--model tianqin-5y-multistep`: "
+                    f"`{t5m['command']}`, {_f(t5m.get('n_steps'), ',d')} steps) | {_f(t5m['wall_s'], '.0f')} s"
+                    + (f" ({_f(t5m['wall_s'] / 60, '.1f')} min)" if t5m["wall_s"] > 120 else "")
+                    + f", {_f(t5m['peak_rss_mb'], '.0f')} MB peak | - | - |")
     ld, lf = li["runs"]["lisa, dd"], li["runs"]["lisa, float64"]
     rows.append(f"| LISA, heliocentric `lisa-esa` scenario (point masses), {_span(li)} at "
                 f"{li['step_s'] / 3600:g} h, {_f(li['n_steps'], ',d')} steps (`--model lisa`) | "

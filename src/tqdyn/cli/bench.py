@@ -22,7 +22,7 @@ __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
 #: Every model, in the order they run.
 MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels", "default-run", "startup", "tianqin-5y",
-          "lisa-10y")
+          "tianqin-5y-multistep", "lisa-10y")
 #: What ``--model all`` runs (the mission-length commands are asked for by name).
 ALL_MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels")
 
@@ -49,7 +49,7 @@ def _check_json_path(path) -> Path:
 @click.command("bench")
 @click.option("--duration", default=None,
               help="Propagated span [default: 90d; lisa: 3652.5d = 10 years; lisa-coupled: 365d; rounded up to "
-                   "whole 6 h steps; default-run: the scenario's 10 d; tianqin-5y: 1826d; lisa-10y: 3653d].")
+                   "whole 6 h steps; default-run: the scenario's 10 d; tianqin-5y(-multistep): 1826d; lisa-10y: 3653d].")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s] of the kepler model.")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
 @click.option("--model", "which", type=click.Choice(MODELS + ("all",)), multiple=True,
@@ -59,7 +59,8 @@ def _check_json_path(path) -> Path:
                    "lisa scenario (LISA architecture and drag-free scheme, one year); kernels: the time-only inputs "
                    "of one chunk, term by term, and the compiled kernels per evaluation; default-run: the command "
                    "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with an empty kernel cache, then "
-                   "with it filled; tianqin-5y: `tqdyn run tianqin` for five years; lisa-10y: `tqdyn run "
+                   "with it filled; tianqin-5y: `tqdyn run tianqin` for five years; tianqin-5y-multistep: the same "
+                   "with the multistep method; lisa-10y: `tqdyn run "
                    "lisa` for ten years; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
 @click.option("--json", "json_path", metavar="PATH",
               help="Also write the results to this JSON record: the entries of the models run are replaced, "
