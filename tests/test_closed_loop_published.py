@@ -87,7 +87,7 @@ def test_lpf_readout_dominates_delta_g_above_the_published_60_mhz(record_number)
 def test_dg_estimator_is_independent_of_the_loop_design(record_number):
     """Delta g = a_2 - a_1 + (s^2 + k2) n_12 + (k2 - k1) n_1 and nothing from the thrusters, whatever the
     controllers and the spacecraft mass (docs/closed-loop-validation.md): the closed loop agrees with the
-    analytic transfers to 1e-6 (measured ~1e-9) for crossovers and masses changed by 3x; without the
+    analytic transfers to 3e-8 (measured 3e-9) for crossovers and masses changed by 3x; without the
     (k2 - k1) o1 correction the thruster noise appears as (k2 - k1) x1 (recorded, with the x1 jitter)."""
     f = np.logspace(-4, 0, 80)
     s = 2j * math.pi * f
@@ -98,7 +98,7 @@ def test_dg_estimator_is_independent_of_the_loop_design(record_number):
         H = _dg_response(_lpf(df, sus, mass), f)
         worst = max(worst, float(np.max(np.abs(H[0]) * THRUSTER / DG_FLOOR)),
                     float(np.max(np.abs(H[1:] - expect[1:]) / np.abs(expect[1:]))))
-    assert worst < 1e-6
+    assert worst < 3e-8
     # the uncorrected stiffness term: (k2 - k1) x1 from the thruster noise
     cl = _lpf()
     fr = np.array([1e-3, 1e-2])
@@ -147,14 +147,14 @@ def test_dc_suspension_limit_in_the_science_budget_is_crosstalk_times_sensitivit
     """Along the sensitive axis (drag-free: no electrostatic force by design) the DC force's actuation
     noise arrives only through cross-talk, after the suspension command has cancelled it in band:
     ASD = crosstalk eps A_dc |S_sus|; the model's budget (source actuation_force, output
-    tm1_acceleration) agrees within 1e-3 (measured ~1e-4)."""
+    tm1_acceleration) agrees within 5e-4 (measured 9e-5)."""
     p, cl = lisa_dc_limit
     noise = default_noise("lisa")
     b, sources = noise_budget(cl, {"actuation_force": noise["actuation_force"]}, F_DC, ["tm1_acceleration"])
     s = 2j * math.pi * F_DC
     S = 1.0 / (1.0 + lead_lag_pid(CROSSOVER_HZ["suspension"]).tf()(s) / (s ** 2 + p.stiffness[0, 1]))
     analytic = p.crosstalk * noise["actuation_force"].level * 1e-10 * np.abs(S)
-    assert np.max(np.abs(b[0, 0] / analytic - 1)) < 1e-3
+    assert np.max(np.abs(b[0, 0] / analytic - 1)) < 5e-4
     record_number("closed_loop_published.dc_limit_science_budget", b[0, 0].tolist(), "m/s^2/Hz^1/2")
 
 
@@ -163,8 +163,8 @@ def test_mosa_actuator_path_to_the_science_axis_is_crosstalk_of_the_suspension_f
     """The MOSA actuator noise tau (SOURCES.md: 1e-9 N m/Hz^1/2, assumption) turns the MOSA by
     tau/(I_m w^2) |S_mosa|; the housing, |rho| = 0.3 m from the pivot, moves along p_1 by that times
     |rho|; the suspension makes TM 1 follow with |T_sus| of that acceleration; cross-talk (1e-3) puts it on
-    the sensitive axis: a = crosstalk |T_sus| |rho| (tau/I_m) |S_mosa|.  The budget agrees within 1 %
-    (measured 0.03 % at 1-20 mHz) at LISA's representative working point."""
+    the sensitive axis: a = crosstalk |T_sus| |rho| (tau/I_m) |S_mosa|.  The budget agrees within 0.3 %
+    (measured 0.05 % at 1-20 mHz) at LISA's representative working point."""
     wp = representative_working_point("lisa")
     p = _plant("lisa")
     cl = build_closed_loop(p, wp, default_controllers("lisa"))
@@ -177,7 +177,7 @@ def test_mosa_actuator_path_to_the_science_axis_is_crosstalk_of_the_suspension_f
     Ts = Ls / (1.0 + Ls)
     rho = float(np.linalg.norm(p.lever_arms[0]))
     analytic = p.crosstalk * np.abs(Ts) * rho * noise["mosa_actuator"].level / p.mosa_inertia * np.abs(Sm)
-    assert np.max(np.abs(b[0, 0] / analytic - 1)) < 0.01
+    assert np.max(np.abs(b[0, 0] / analytic - 1)) < 3e-3
     record_number("closed_loop_published.mosa_path_budget", b[0, 0].tolist(), "m/s^2/Hz^1/2")
     record_number("closed_loop_published.mosa_path_analytic", analytic.tolist(), "m/s^2/Hz^1/2")
     mosa = np.abs(closed_loop_response(cl, f, ["mosa_angle_1"], ["mosa_actuator[0]"])[0, 0]) \
