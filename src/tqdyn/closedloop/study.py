@@ -1,6 +1,9 @@
 """Numbers for the docs: the default designs' margins and the paths from the DC working point to in-band noise.
 
-:func:`design_numbers` returns a JSON-ready dict (docs/closed-loop.md renders it; a test checks it):
+:func:`dc_paths` splits the residual TM acceleration at a working point into the paths from the DC
+forces, the cross-talk, the stiffness and the gravity gradient (``tqdyn report --closed-loop`` writes
+them for the working points of coupled runs; docs/closed-loop.md renders them).
+:func:`design_numbers` returns a JSON-ready dict of the same kind at first-principles working points:
 per mission, the loop-at-a-time margins of the default design at a representative working point, and
 the residual TM acceleration along the sensitive axis at 1 and 10 mHz split into
 

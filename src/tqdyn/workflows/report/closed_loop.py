@@ -141,8 +141,9 @@ def _mission_values(mission: str, model, run_text: str) -> tuple[dict, dict]:
 
 
 def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
-                       progress: Callable[[str], None] | None = None) -> Report:
-    """Figures, summary rows and values of the closed loop of ``missions`` (module docstring).
+                       progress: Callable[[str], None] | None = None, figures: bool = True) -> Report:
+    """Figures (unless ``figures`` is False), summary rows and values of the closed loop of ``missions``
+    (module docstring).
     Returns :class:`~tqdyn.workflows.report.summary.Report` (``values``: ``missions`` -> the values of
     :func:`_mission_values`, and the frequencies, bands and limit they refer to)."""
     say = progress or (lambda msg: None)
@@ -162,6 +163,9 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
         say(f"{mission}: loops, margins and budgets")
         v, a = _mission_values(mission, model, text)
         rep.values["missions"][mission] = v
+        _rows(rep, mission, v)
+        if not figures:
+            continue
         where = f"{mission}, Sat1 at t = {v['working_point']['t_s'] / 3600:.3g} h of a coupled run"
         outs = list(BUDGET_OUTPUTS)
         idx = [a["names"].index(o) for o in outs]
@@ -175,7 +179,6 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
             a["requirement"], fig_dir, f"{mission}-tm-acceleration",
             f"{mission}: residual TM acceleration, default noises and controllers ({where})",
             REQUIREMENT_TEXT[mission], tm_force=a["tm_force"], band=MISSION_BAND_HZ)
-        _rows(rep, mission, v)
     _finish(rep, "tqdyn report --closed-loop", [f"{m}: {RUNS[m][2]}" for m in missions])
     return rep
 
