@@ -218,20 +218,15 @@ def test_entry_point_budget_and_series_are_xarray(tianqin_runs):
     assert ts["values"].dims == ("time", "sat", "output") and ts["values"].shape[:2] == (1200, 3)
 
 
-def test_docs_numbers_json_is_what_design_numbers_computes():
-    """docs/data/closed-loop-numbers.json (the numbers docs/closed-loop.md quotes) equals a fresh
-    tqdyn.closedloop.study.design_numbers() to 1e-6 relative (regenerate it with that function)."""
-    import json
-    import pathlib
-
+def test_design_numbers_dc_path_is_far_below_the_requirement():
+    """tqdyn.closedloop.study.design_numbers() at the first-principles working points (Table IV
+    self-gravity, DC suspension 8.4e-11 m/s^2): the DC self-gravity's path (1e-6 actuation noise x
+    the DC force x 1e-3 cross-talk, ~1e-19 m/s^2/Hz^1/2 by that product) is below 1e-3 of the
+    requirement at 1 mHz for every mission; the stiffness path is |K| x jitter."""
     from tqdyn.closedloop.study import design_numbers
 
-    path = pathlib.Path(__file__).resolve().parents[1] / "docs" / "data" / "closed-loop-numbers.json"
-    stored = json.loads(path.read_text())
-    fresh = json.loads(json.dumps(design_numbers()))
-    for m in stored["missions"]:
-        for key in ("tm_acceleration_total", "actuation_force", "stiffness_times_jitter", "sc_tm_jitter_m"):
-            assert np.allclose(stored["missions"][m][key], fresh["missions"][m][key], rtol=1e-6), (m, key)
-    # the DC self-gravity's path (actuation noise x cross-talk) is far below the requirement at 1 mHz
-    for m in stored["missions"]:
-        assert fresh["missions"][m]["actuation_force"][0] < 1e-3 * requirement(m).asd(1e-3)
+    fresh = design_numbers()
+    for m, v in fresh["missions"].items():
+        assert v["actuation_force"][0] < 1e-3 * requirement(m).asd(1e-3)
+        assert 1e-20 < v["actuation_force"][0] < 1e-18            # 1e-6 x 8.4e-11 x 1e-3 = 8.4e-20
+

@@ -36,6 +36,12 @@ tqdyn report --studies "${SCALE[@]}" --out "$WORK/studies-tianqin" -q > "$WORK/s
 cp "$WORK/studies-tianqin/summary.json" "$DATA/studies-tianqin.json"
 tqdyn report --studies --mission lisa "${SCALE[@]}" --out "$WORK/studies-lisa" -q > "$WORK/studies-lisa.log"
 cp "$WORK/studies-lisa/summary.json" "$DATA/studies-lisa.json"
+# the closed loop's default designs at the working points of short coupled runs (figures: docs/figures/closed-loop-*)
+tqdyn report --closed-loop --out "$WORK/closed-loop" -q > "$WORK/closed-loop.log"
+cp "$WORK/closed-loop/summary.json" "$DATA/closed-loop.json"
+for f in tianqin-tm-acceleration lisa-tm-acceleration taiji-tm-acceleration tianqin-budget tianqin-loops; do
+    cp "$WORK/closed-loop/closed-loop/$f.png" "docs/figures/closed-loop-$f.png"
+done
 
 # 3. the pages from the new benchmark and study records (so that the suite's page checks pass)
 python tools/render_docs.py

@@ -17,7 +17,7 @@ time axis (``traj.reference.time_scale`` since the epoch).  Frames: :data:`tqdyn
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -48,6 +48,9 @@ class ClosedLoopModel:
     loops : list over satellites of lists of (t_start [s], ClosedLoop), one per segment.
     noise : {source: AsdModel}; mission : str; settings : dict (fs [Hz], duration [s] or None, seed,
     segment [s], f_min, f_max [Hz], n_freq); satellite_names : tuple; t_span : (t0, t1) [s].
+    parts : list over satellites of lists (one per segment, as ``loops``) of (PlantParameters,
+    WorkingPoint) the loops were built from; controllers : {loop: Controller} (to rebuild a loop with
+    changed parameters, e.g. without cross-talk).
     """
 
     loops: list
@@ -56,6 +59,8 @@ class ClosedLoopModel:
     settings: dict
     satellite_names: tuple
     t_span: tuple
+    parts: list = field(default_factory=list)
+    controllers: dict = field(default_factory=dict)
 
 
 def _config(traj, config):
@@ -128,6 +133,7 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
     azs = cfg.value("attitude_z_sensor", "dws")
     n_sat = len(wps[0])
     loops = [[] for _ in range(n_sat)]
+    parts = [[] for _ in range(n_sat)]
     for k, (a, _b, _m) in enumerate(rows):
         for i in range(n_sat):
             wp = wps[k][i]
@@ -144,13 +150,15 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
             if validate:
                 check_stable(cl)
             loops[i].append((float(t[a]), cl))
+            parts[i].append((p, wp))
     settings = {"fs": float(cfg.value("fs", 4.0)), "duration": cfg.value("duration", None),
                 "seed": int(cfg.value("seed", 0)), "segment": segment, "f_min": float(cfg.value("f_min", 1e-5)),
                 "f_max": float(cfg.value("f_max", 1.0)), "n_freq": int(cfg.value("n_freq", 300)),
                 "attitude_z_sensor": azs}
     names = tuple(getattr(traj, "satellite_names", ())) or tuple(f"Sat{i + 1}" for i in range(n_sat))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,
-                           satellite_names=names, t_span=(float(t[0]), float(t[-1])))
+                           satellite_names=names, t_span=(float(t[0]), float(t[-1])), parts=parts,
+                           controllers=dict(ctl))
 
 
 def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None):

@@ -12,7 +12,11 @@ composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
   and regenerates its figures and the summary table (paper value vs tqdyn
   value); with ``--mission lisa`` the same studies on LISA and Taiji
   (:mod:`tqdyn.workflows.studies_lisa`, :mod:`tqdyn.workflows.report.lisa`:
-  one-year runs, reference = first-order estimates and ESA's files).
+  one-year runs, reference = first-order estimates and ESA's files);
+* ``tqdyn report --closed-loop [--out DIR]``: the default closed-loop designs of TianQin, LISA and
+  Taiji at the working points of short coupled runs (:mod:`tqdyn.workflows.report.closed_loop`):
+  ``DIR/closed-loop/*.png|pdf`` (budget stacks, loop gains with margins, residual TM acceleration
+  against the requirement), ``DIR/summary.md`` and ``DIR/summary.json``.
 
 Bad input (a missing file, a file that is not a tqdyn trajectory, an unknown
 study, bad overrides, conflicting options) exits with status 2 and one line
@@ -41,6 +45,9 @@ __all__ = ["report"]
                    "tqdyn-studies).")
 @click.option("--studies", is_flag=True,
               help="Run (or reuse) the study runs of the paper's section V and regenerate its figures and table.")
+@click.option("--closed-loop", "closed_loop", is_flag=True,
+              help="The default closed-loop designs of the three missions at the working points of short coupled "
+                   "runs: budget stacks, loop gains with margins, residual TM acceleration (docs/closed-loop.md).")
 @click.option("--mission", type=click.Choice(["tianqin", "lisa"]), default=None,
               help="With --studies: the study set, tianqin (the paper's section V, default) or lisa (the same "
                    "studies on LISA and Taiji, one-year runs).")
@@ -56,7 +63,7 @@ __all__ = ["report"]
 @click.option("--workers", type=int, metavar="N",
               help="With --studies: worker processes for the runs (default: the CPU cores; 1 = in this process).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress on stderr.")
-def report(runs, out, studies, mission, runs_dir, quick, duration_scale, only, sets, workers, quiet):
+def report(runs, out, studies, closed_loop, mission, runs_dir, quick, duration_scale, only, sets, workers, quiet):
     """Figures and a summary table of trajectory files RUN.h5, or (--studies)
     of the paper's section V: pointing laws (Fig. 5), range ASDs (Figs. 6,
     10, 11), electrostatic control (Figs. 7, 8), drag-free and self-gravity
@@ -67,6 +74,18 @@ def report(runs, out, studies, mission, runs_dir, quick, duration_scale, only, s
         if not quiet:
             click.echo(msg, err=True)
 
+    if closed_loop:
+        if runs:
+            _fail(f"RUN.h5: {runs[0]!r} given with --closed-loop; allowed: either trajectory files or --closed-loop")
+        if studies:
+            _fail("--closed-loop: conflicts with --studies; allowed: one of them")
+        for name, given in (("--mission", mission is not None), ("--runs-dir", runs_dir is not None),
+                            ("--quick", quick), ("--duration-scale", duration_scale is not None),
+                            ("--study", bool(only)), ("--set", bool(sets)), ("--workers", workers is not None)):
+            if given:
+                _fail(f"{name}: only applies with --studies")
+        _run_closed_loop(out or "tqdyn-closed-loop", say)
+        return
     if studies:
         if runs:
             _fail(f"RUN.h5: {runs[0]!r} given with --studies; allowed: either trajectory files or --studies")
@@ -91,6 +110,22 @@ def report(runs, out, studies, mission, runs_dir, quick, duration_scale, only, s
         _fail("interrupted", _EXIT_INTERRUPTED)
     rp.write_summary_json(rep, " ".join(["tqdyn report", *runs] + (["--out", out] if out else [])),
                           runs={str(r): _file_facts(r) for r in runs})
+    _print_report(rep)
+
+
+def _run_closed_loop(out, say):
+    from ..workflows import report as rp
+    from ..workflows.report.closed_loop import RUNS, report_closed_loop
+
+    try:
+        rep = report_closed_loop(out, progress=say)
+    except ValueError as exc:
+        _fail(str(exc))
+    except KeyboardInterrupt:
+        _fail("interrupted", _EXIT_INTERRUPTED)
+    rp.write_summary_json(rep, f"tqdyn report --closed-loop --out {out}",
+                          runs={m: {"scenario": r[0], "overrides": list(r[1]), "description": r[2]}
+                                for m, r in RUNS.items()})
     _print_report(rep)
 
 

@@ -23,8 +23,8 @@ import numpy as np
 from .controllers import LOOPS
 from .loop import SOURCES, ClosedLoop, output_names, source_inputs
 
-__all__ = ["DesignError", "LoopMargins", "check_stable", "closed_loop_response", "loop_margins", "noise_budget",
-           "dominant_sources"]
+__all__ = ["DesignError", "LoopMargins", "check_stable", "closed_loop_response", "loop_gains", "loop_margins",
+           "noise_budget", "dominant_sources"]
 
 
 class DesignError(ValueError):
@@ -95,20 +95,28 @@ class LoopMargins:
     f_phase_margin: float
 
 
-def loop_margins(cl: ClosedLoop, f_min: float = 1e-6, f_max: float = 10.0, n: int = 1500) -> list[LoopMargins]:
-    """:class:`LoopMargins` of every controller channel (module docstring); one MIMO frequency response
-    (d -> c) on ``n`` log-spaced points in [f_min, f_max] Hz."""
+def loop_gains(cl: ClosedLoop, f) -> tuple[list[str], np.ndarray]:
+    """Loop-at-a-time gains L_k = -T_kk / (1 + T_kk) (module docstring) of every controller channel at
+    ``f`` [Hz] (one MIMO frequency response d -> c): (channel names, complex L (n_channel, n_f))."""
     sys = cl.system
-    f = np.logspace(math.log10(f_min), math.log10(f_max), n)
-    w = 2 * math.pi * f
+    w = 2 * math.pi * np.asarray(f, dtype=np.float64)
     ii = [sys.input_labels.index(f"d_{ch}") for ch in cl.channel_names]
     oi = [sys.output_labels.index(f"c_{ch}") for ch in cl.channel_names]
     sub = control.ss(sys.A, sys.B[:, ii], sys.C[oi, :], sys.D[np.ix_(oi, ii)])
-    T = np.asarray(control.frequency_response(sub, w).complex).reshape(len(oi), len(ii), n)
+    T = np.asarray(control.frequency_response(sub, w).complex).reshape(len(oi), len(ii), len(w))
+    Tkk = np.array([T[k, k] for k in range(len(oi))])
+    return list(cl.channel_names), -Tkk / (1.0 + Tkk)
+
+
+def loop_margins(cl: ClosedLoop, f_min: float = 1e-6, f_max: float = 10.0, n: int = 1500) -> list[LoopMargins]:
+    """:class:`LoopMargins` of every controller channel (module docstring); the loop gains
+    (:func:`loop_gains`) on ``n`` log-spaced points in [f_min, f_max] Hz."""
+    f = np.logspace(math.log10(f_min), math.log10(f_max), n)
+    w = 2 * math.pi * f
+    chans, L = loop_gains(cl, f)
     out = []
-    for k, ch in enumerate(cl.channel_names):
-        L = -T[k, k] / (1.0 + T[k, k])
-        gm, pm, _sm, wg, wp, _ws = control.stability_margins(control.frd(L, w))
+    for k, ch in enumerate(chans):
+        gm, pm, _sm, wg, wp, _ws = control.stability_margins(control.frd(L[k], w))
         out.append(LoopMargins(ch, float(gm), float(pm), float(wg) / (2 * math.pi), float(wp) / (2 * math.pi)))
     return out
 
