@@ -47,7 +47,7 @@ def _accel(term, reference, epoch, t, r, v):
 # 1. heliocentric: EIH_1PN(spacecraft) - EIH_1PN(Sun)
 
 @pytest.mark.parametrize("seed", [1, 2, 3, 4])
-def test_heliocentric_term_against_numpy_eih(seed):
+def test_heliocentric_term_against_numpy_eih(seed, record_number):
     """The heliocentric term at 5 random instants of 2035-2040 and states (0.7 .. 1.3 au, ~30 km/s, random
     directions) per seed against the numpy EIH of the ten bodies: EIH_1PN(particle at rho + x_sun, rhod +
     v_sun) - EIH_1PN(Sun), barycentric states from jplephem at the TDB date epoch + t.  Measured: the term
@@ -59,6 +59,7 @@ def test_heliocentric_term_against_numpy_eih(seed):
     term = HeliocentricEIH(names=HELIOCENTRIC_BODIES)
     mu = np.array([gm_f(b) for b in EIH_BODIES])
     rng = np.random.default_rng(seed)
+    errs, rels = [], []
     for _ in range(5):
         t = float(np.round(rng.uniform(0.0, 5 * 365.25) * 86400.0, 3))
         pos, vel = bary_states(EIH_BODIES, np.array([2464328.5 + np.floor(t / 86400.0)]),
@@ -76,6 +77,10 @@ def test_heliocentric_term_against_numpy_eih(seed):
         print(f"t = {t:.0f} s: |a| = {np.linalg.norm(ref):.3e} m/s^2, |tqdyn - numpy| = {err:.1e} "
               f"({err / np.linalg.norm(ref):.1e})")
         assert err < 1e-24 and err < 5e-15 * np.linalg.norm(ref)
+        errs.append(float(err))
+        rels.append(float(err / np.linalg.norm(ref)))
+    record_number(f"eih.helio_vs_numpy_abs.s{seed}", max(errs), "m/s^2")
+    record_number(f"eih.helio_vs_numpy_rel.s{seed}", max(rels))
 
 
 def test_heliocentric_option_replaces_schwarzschild():
@@ -127,7 +132,7 @@ def _term_along(rows, scen, scen_iers):
     return t, out
 
 
-def test_lisa_ten_days_moves_by_the_double_integral():
+def test_lisa_ten_days_moves_by_the_double_integral(record_number):
     """`lisa-gravity` (ESA's start, 2036-12-09; the Sun, Earth, Moon and planets) for 10 days at 6 h with
     relativity on: eih against iers2010.  The positions differ by the double time integral of the term's
     difference, EIH - Schwarzschild (1.9e-14 .. 2.3e-14 m/s^2 here), along the run: 8.0e-3 .. 8.2e-3 m
@@ -137,9 +142,12 @@ def test_lisa_ten_days_moves_by_the_double_integral():
     (r0, _, scen0), (r1, rows, scen) = runs["iers2010"], runs["eih"]
     t, da = _term_along(rows, scen, scen0)
     size = np.linalg.norm(da, axis=-1)
+    record_number("eih.lisa_10d_term", [size.min(), size.max()], "m/s^2")
     for s in range(3):
         moved = np.linalg.norm(r1[s] - r0[s])
         expect = _double_integral(t, da[:, s])
+        record_number(f"eih.lisa_10d_moved.LISA{s + 1}", moved, "m")
+        record_number(f"eih.lisa_10d_rel.LISA{s + 1}", abs(moved / expect - 1), "|moved / double integral - 1|")
         print(f"LISA{s + 1}: |da| {size[:, s].min():.2e} .. {size[:, s].max():.2e} m/s^2, moved {moved:.4e} m, "
               f"double integral {expect:.4e} m, max |da| t^2/2 = {size[:, s].max() * t[-1] ** 2 / 2:.3e} m")
         assert abs(moved / expect - 1) < 0.03
@@ -151,7 +159,7 @@ def test_lisa_ten_days_moves_by_the_double_integral():
 
 @pytest.mark.parametrize("iso, days", [("2004-06-06T00:00:00", (0.0, 11.3, 23.7)),
                                        ("2035-03-01T00:00:00", (0.0, 40.2))])
-def test_gcrs_term_against_the_transformed_eih(iso, days):
+def test_gcrs_term_against_the_transformed_eih(iso, days, record_number):
     """The GCRS term (the model's dispatcher, all nine third bodies) against ``gcrs_reference`` -- the EIH
     equations of the satellite, the Earth and the bodies transformed to the GCRS and differentiated
     numerically in mpmath, minus the Newtonian third bodies at their GCRS positions, Schwarzschild and de
@@ -164,6 +172,7 @@ def test_gcrs_term_against_the_transformed_eih(iso, days):
     epoch = Epoch.from_utc(iso)
     term = GeocentricEIH(names=BODIES)
     rng = np.random.default_rng(len(days))
+    sizes, errs = [], []
     for d in days:
         t = d * 86400.0
         j1, j2 = tdb_jd(epoch, t)
@@ -179,10 +188,14 @@ def test_gcrs_term_against_the_transformed_eih(iso, days):
         print(f"{iso} + {d} d: |a| = {np.linalg.norm(ref):.3e} m/s^2, |tqdyn - reference| = {err:.1e} m/s^2")
         assert err < 2e-16
         assert np.linalg.norm(ref) > 1e-14  # the term is there
+        sizes.append(float(np.linalg.norm(ref)))
+        errs.append(float(err))
+    record_number(f"eih.gcrs_vs_transformed_size.{iso[:10]}", sizes, "m/s^2")
+    record_number(f"eih.gcrs_vs_transformed_diff.{iso[:10]}", errs, "m/s^2")
 
 
 @pytest.mark.parametrize("speed_factor", [1.0, 2.0])
-def test_gcrs_term_is_the_tidal_tensor_of_general_relativity(speed_factor):
+def test_gcrs_term_is_the_tidal_tensor_of_general_relativity(speed_factor, record_number):
     """The Sun alone, at rest, a massless Earth at R = 1 au moving at v perpendicular to the Sun's direction n
     (circular speed, and twice it), a satellite at rest at +-h e (h = 1e8 m) along n, v and their normal.
     The Riemann tensor of the Schwarzschild field in the frame moving at v (boosted from the static frame,
@@ -204,6 +217,7 @@ def test_gcrs_term_is_the_tidal_tensor_of_general_relativity(speed_factor):
     _fill_geocentric(pos, vel, np.array([v * ev]), delta, mu, C_LIGHT, tdat)
     params = np.concatenate([[TDB_TO_TT_SCALE, C_LIGHT, 0.0, 2, 0], mu])
     u, b2, h = gm / (C**2 * big_r), v**2 / C**2, 1e8
+    rels = []
     for e, coef in ((n, 3 * u + 3 * b2), (ev, -1.5 * u), (ez, -1.5 * u - 3 * b2)):
         plus = np.array(geocentric_eih_accel(*(h * e * TDB_TO_TT_SCALE), 0.0, 0.0, 0.0, tdat[0], params))
         minus = np.array(geocentric_eih_accel(*(-h * e * TDB_TO_TT_SCALE), 0.0, 0.0, 0.0, tdat[0], params))
@@ -212,9 +226,11 @@ def test_gcrs_term_is_the_tidal_tensor_of_general_relativity(speed_factor):
         print(f"v = {speed_factor} v_circ, along {e}: {np.linalg.norm(got):.4e} m/s^2 vs GR {np.linalg.norm(want):.4e} "
               f"({rel:.1e})")
         assert rel < 3e-6
+        rels.append(float(rel))
+    record_number(f"eih.gcrs_tidal_tensor_rel.v{speed_factor:g}", rels)
 
 
-def test_gcrs_term_size_at_tianqin():
+def test_gcrs_term_size_at_tianqin(record_number):
     """Size of the 1PN n-body terms beyond eq. 10.12 on TianQin's orbits (the brief of the term: a 1PN term
     above 1e-15 m/s^2 at 1e5 km belongs in the model): the three satellites of `tianqin-gravity` over one
     orbit (3.65 d from 2004-06-06), 3 h samples on their Kepler orbits, all nine bodies: 1.39e-13 ..
@@ -245,6 +261,8 @@ def test_gcrs_term_size_at_tianqin():
                             out.append(np.linalg.norm(m))
     print(f"TianQin, one orbit: |a| {min(sizes):.2e} .. {max(sizes):.2e} m/s^2; the Moon's part "
           f"{min(moon):.2e} .. {max(moon):.2e}, the planets' {min(others):.2e} .. {max(others):.2e} m/s^2")
+    record_number("eih.gcrs_size_tianqin", {"all": [min(sizes), max(sizes)], "moon": [min(moon), max(moon)],
+                                            "planets": [min(others), max(others)]}, "m/s^2")
     assert 5e-14 < min(sizes) and max(sizes) < 5e-13
     assert 5e-16 < min(moon) and max(moon) < 5e-14
     assert max(others) < 1e-15
@@ -261,7 +279,7 @@ def _kepler(r0, v0, gm, t):
     return sol.y[:3, -1], sol.y[3:, -1]
 
 
-def test_tianqin_two_hours_move_by_the_double_integral():
+def test_tianqin_two_hours_move_by_the_double_integral(record_number):
     """`tianqin-gravity` for two hours (50 s steps) with relativity_model = "eih" against "iers2010": each
     satellite moves by the double time integral of the term along the run (1.5e-13 .. 1.7e-13 m/s^2 here),
     3.9e-6 .. 4.4e-6 m (measured: within 0.15 % of it; two hours are 0.023 orbits, (n t)^2 = 0.02: the orbit's gravity
@@ -274,6 +292,8 @@ def test_tianqin_two_hours_move_by_the_double_integral():
     for s in range(3):
         moved = np.linalg.norm(r1[s] - r0[s])
         expect = _double_integral(t, da[:, s])
+        record_number(f"eih.tianqin_2h_moved.Sat{s + 1}", moved, "m")
+        record_number(f"eih.tianqin_2h_rel.Sat{s + 1}", abs(moved / expect - 1), "|moved / double integral - 1|")
         print(f"Sat{s + 1}: |da| {size[:, s].min():.2e} .. {size[:, s].max():.2e} m/s^2, moved {moved:.4e} m, "
               f"double integral {expect:.4e} m, max |da| t^2/2 = {size[:, s].max() * t[-1] ** 2 / 2:.3e} m")
         assert abs(moved / expect - 1) < 0.05

@@ -105,7 +105,7 @@ def test_helio_attributes_and_grid(helio):
 
 
 @pytest.mark.filterwarnings("ignore:ERFA function:UserWarning")  # astropy's 'dubious year' after 2027
-def test_helio_tcb_times_vs_astropy(helio):
+def test_helio_tcb_times_vs_astropy(helio, record_number):
     from astropy.time import Time, TimeDelta
 
     epoch = Time(EPOCH_TDB, scale="tdb", format="isot")
@@ -117,6 +117,7 @@ def test_helio_tcb_times_vs_astropy(helio):
         t_tdb = (k + 1) * STEP  # the exported rows are the trajectory's rows 1 ..
         err = np.abs(t_file - np.array([ref(epoch + TimeDelta(tt, format="sec")) for tt in t_tdb]))
         print(f"\n{key}: TCB times vs astropy: {err.max():.2e} s")
+        record_number(f"export_bcrs.tcb_times_vs_astropy_s.{key}", err.max(), "s")
         assert err.max() < (1e-9 if key == "plain" else 5e-7)  # j2000: the float64 resolution of t ~ 1.1e9 s
     attrs, _ = _read(helio["unix"].path)
     first = (epoch + TimeDelta(STEP, format="sec")).tcb
@@ -143,7 +144,7 @@ def test_helio_positions_are_scaled_ssb(helio):
     np.testing.assert_allclose(ecl["tcb/x"], data["tcb/x"] @ erfa.ecm06(2451545.0, 0.0).T, rtol=1e-15, atol=1e-3)
 
 
-def test_helio_ltt_vs_lisaorbits_and_shapiro(helio):
+def test_helio_ltt_vs_lisaorbits_and_shapiro(helio, record_number):
     lisaorbits = pytest.importorskip("lisaorbits")
     from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
     from tqdyn.astro.timescales import Epoch, tdb_after
@@ -157,6 +158,7 @@ def test_helio_ltt_vs_lisaorbits_and_shapiro(helio):
         ltt = orb.compute_ltt(t[5:-5])
     worst = np.max(np.abs(ltt - data["tcb/ltt"][5:-5]))
     print(f"\nBCRS ltt vs lisaorbits (geometric, TCB): {worst:.2e} s (ltt ~{data['tcb/ltt'].mean():.2f} s)")
+    record_number("export_bcrs.ltt_vs_lisaorbits_s", worst, "s")
     assert worst < 1e-12  # measured 2.6e-13 s: lisaorbits' cubic splines of the 600 s positions
     # the Sun's Shapiro delay: 2 GM_TCB/c^3 ln(...) from the Sun's centre, / (1 - n.v_e/c)
     _, sh = _read(helio["shapiro"].path)
@@ -174,6 +176,7 @@ def test_helio_ltt_vs_lisaorbits_and_shapiro(helio):
     s = s / (1 - np.einsum("nlk,nlk->nl", data["tcb/n"], ve) / C_LIGHT)  # the emitter moves during the delay
     diff = sh["tcb/ltt"] - data["tcb/ltt"]
     print(f"Sun's Shapiro delay {diff.mean():.3e} s; vs 2GM/c^3 ln(...): {np.max(np.abs(diff - s)):.1e} s")
+    record_number("export_bcrs.helio_shapiro_s", {"mean": diff.mean(), "vs_formula": np.max(np.abs(diff - s))}, "s")
     assert 1.0e-7 < diff.min() and np.max(np.abs(diff - s)) < 1e-13
 
 
@@ -201,7 +204,7 @@ def test_helio_read_by_lisainstrument_and_pytdi(helio):
                                    rtol=0, atol=1e-14)
 
 
-def test_helio_clocks(helio):
+def test_helio_clocks(helio, record_number):
     # d tau / dTCB = 1 - (U + v^2/2)/c^2 with v the barycentric velocity (heliocentric + the Sun's, 13 m/s) and U
     # the Sun's potential plus the planets' (tqdyn.lightpath.proper_time_bcrs, checked against mpmath in
     # tests/test_lightpath_heliocentric.py): against the Sun-only formula with the barycentric velocity the file's
@@ -217,12 +220,13 @@ def test_helio_clocks(helio):
     rate = np.gradient(data["tcb/delta_tau"], attrs["dt"], axis=0, edge_order=2)
     res = rate + F[1:]
     print(f"\nTCB clock rate vs -(GM_S/r + v_B^2/2)/c^2: {np.abs(res).min():.2e} .. {np.abs(res).max():.2e}")
+    record_number("export_bcrs.clock_rate_vs_sun_only", [np.abs(res).min(), np.abs(res).max()])
     assert 1e-12 < np.abs(res).min() and np.abs(res).max() < 8e-12
     # ppr - ltt = delta_tau_r(t) - delta_tau_e(t - ltt): the clocks drift apart by ~1e-10 s/s (eccentricities)
     assert np.max(np.abs(data["tcb/ppr"] - data["tcb/ltt"])) < 1e-4
 
 
-def test_tianqin_bcrs_positions(geo):
+def test_tianqin_bcrs_positions(geo, record_number):
     from tqdyn.astro.ephemeris import default_ephemeris
     from tqdyn.astro.geocentric import TDB_TO_TT_SCALE, gcrs_to_bcrs_states
     from tqdyn.astro.timescales import tdb_jd
@@ -236,6 +240,7 @@ def test_tianqin_bcrs_positions(geo):
     naive = (xe[:, None] + (tr["sat/r"] / TDB_TO_TT_SCALE)) / (1 - L_B)  # geocentre + scaled GCRS position
     d = np.linalg.norm(data["tcb/x"] - naive[1:], axis=-1)
     print(f"\nTianQin BCRS - (x_E + X/K)/(1 - L_B): {d.min():.3f} .. {d.max():.3f} m (1PN terms + grid shift)")
+    record_number("export_bcrs.tianqin_1pn_shift_m", [d.min(), d.max()], "m")
     assert 0.05 < d.max() < 3.0
     # the exported positions invert tqdyn's BCRS -> GCRS transformation (bcrs_to_gcrs)
     from tqdyn.astro.ephemeris import planetary_gm
@@ -255,13 +260,15 @@ def test_tianqin_bcrs_positions(geo):
     X = bcrs_to_gcrs(r_all, v_all, st["v_e"], np.array([0.0] * 3 + [gms[b] for b in names]))[:, :3]
     err = np.abs(X - (rq[..., 0] + rq[..., 1])).max()
     print(f"round trip through bcrs_to_gcrs: {err:.1e} m")
+    record_number("export_bcrs.tianqin_round_trip_m", err, "m")
     assert err < 2e-7
     # velocities: the Earth's barycentric velocity + the geocentric one (+ 1PN terms ~1e-5 m/s)
     dv = np.abs(data["tcb/v"] - (st["v_e"][:, None] + tr["sat/v"])[1:]).max()
+    record_number("export_bcrs.tianqin_dv_mps", dv, "m/s")
     assert 1e-7 < dv < 1e-3
 
 
-def test_tianqin_bcrs_ppr_invariance(geo):
+def test_tianqin_bcrs_ppr_invariance(geo, record_number):
     # proper pseudoranges are coordinate-independent: around a loop (12 + 23 + 31, 13 + 32 + 21) the clock
     # synchronisation cancels, so the loop sums of the GCRS file (TT) and of the BCRS file (TCB) agree although
     # the light times differ by v_E.D/c^2 ~ 4e-5 s and the Sun's Shapiro delay (1.1e-8 s) is only in the BCRS
@@ -277,6 +284,8 @@ def test_tianqin_bcrs_ppr_invariance(geo):
     sun = (b["tcb/ltt"] - b0["tcb/ltt"]).mean()
     print(f"\nltt BCRS - GCRS up to {diff_ltt:.2e} s; PPR loop sums BCRS - GCRS: {worst:.1e} s "
           f"(without the Sun's Shapiro delay: {nosh:.1e} s; Sun + Earth Shapiro per link {sun:.2e} s)")
+    record_number("export_bcrs.tianqin_ppr_loops_s", {"ltt_bcrs_vs_gcrs": diff_ltt, "loop_sums": worst,
+                                                      "loop_sums_no_shapiro": nosh, "shapiro_sun_earth": sun}, "s")
     assert 1e-5 < diff_ltt < 1e-4
     assert worst < 2e-11 and nosh > 1e-8
 

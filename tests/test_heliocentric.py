@@ -445,7 +445,7 @@ def _missing_1pn(j1, j2, rho, rhod):
             "sun_indirect": -sun, "schwarzschild": schw, "lense_thirring": _lense_thirring(rho, rhod)}
 
 
-def test_eih_static_sun_is_schwarzschild():
+def test_eih_static_sun_is_schwarzschild(record_number):
     """Reference check of :func:`eih_1pn`: a test particle around the Sun alone at rest (the only mass) gets
     exactly the Schwarzschild term of IERS 2010 eq. 10.12 (harmonic gauge, beta = gamma = 1); numpy
     round-off, 1.5e-16 relative (measured; bound 1e-15)."""
@@ -456,10 +456,11 @@ def test_eih_static_sun_is_schwarzschild():
     got, ref = eih_1pn(r, v, zero, zero, zero, mu), schwarzschild(r, v, mu[0])
     rel = np.max(np.linalg.norm(got - ref, axis=0) / np.linalg.norm(ref, axis=0))
     print(f"EIH, Sun alone at rest, vs Schwarzschild: {rel:.1e} relative")
+    record_number("eih.static_sun_vs_schwarzschild_rel", float(rel))
     assert rel < 1e-15
 
 
-def test_eih_sun_motion_is_the_lorentz_boost():
+def test_eih_sun_motion_is_the_lorentz_boost(record_number):
     """Reference check of the velocity terms of :func:`eih_1pn`: the Sun alone moving uniformly at V (here
     13.5 m/s, LISA's case, and 3000 km/s to make the terms large) with a test particle at the heliocentric
     rho, u.  In the Sun's rest frame the particle obeys Schwarzschild(rho, u); the frame where the Sun moves
@@ -474,6 +475,7 @@ def test_eih_sun_motion_is_the_lorentz_boost():
     n = rho / np.linalg.norm(rho)
     k = mu[0] / (C**2 * np.linalg.norm(rho) ** 3)
     zero = np.zeros((1, 3, 1))
+    seen = []
     for speed in (13.5, 3.0e6):
         vs = speed * np.array([[0.6], [-0.48], [0.64]])
 
@@ -489,9 +491,11 @@ def test_eih_sun_motion_is_the_lorentz_boost():
         print(f"V = {speed} m/s: odd part {np.linalg.norm(odd):.3e} (boost {np.linalg.norm(boost):.3e}), "
               f"even {np.linalg.norm(even):.3e} m/s^2; differences {e_odd:.1e}, {e_even:.1e} of the largest term")
         assert e_odd < 1e-14 and e_even < 1e-14
+        seen += [float(e_odd), float(e_even)]
+    record_number("eih.lorentz_boost_rel", seen, "of the largest term (odd, even at 13.5 m/s, then at 3000 km/s)")
 
 
-def test_eih_reproduces_de421_mercury():
+def test_eih_reproduces_de421_mercury(record_number):
     """Reference check of :func:`eih_1pn` against JPL's integrator: Mercury's barycentric acceleration in
     DE421 (4th-order central difference, h = 600 s, of its Chebyshev velocity, at the centres of 24
     consecutive 8-day Chebyshev granules from 2035-01-09, two Mercury years) minus the Newtonian point-mass
@@ -527,12 +531,15 @@ def test_eih_reproduces_de421_mercury():
     rms, rms_schw = np.sqrt(np.mean(res**2)), np.sqrt(np.mean(res_schw**2))
     print(f"Mercury 1PN {size.min():.2e} .. {size.max():.2e}; EIH residual {res.min():.2e} .. {res.max():.2e} "
           f"(rms {rms:.2e}, max relative {np.max(res / size):.1e}); Schwarzschild only rms {rms_schw:.2e} m/s^2")
+    record_number("eih.de421_mercury", {"size": [size.min(), size.max()], "residual": [res.min(), res.max()],
+                                        "residual_rel_max": np.max(res / size), "rms": rms,
+                                        "rms_schwarzschild": rms_schw}, "m/s^2")
     assert np.all(res < 2e-12) and np.all(res < 6e-4 * size)
     assert rms < rms_schw
 
 
 @pytest.mark.parametrize("day", [0, 365, 800, 1500, 2100])
-def test_missing_1pn_at_lisa(day):
+def test_missing_1pn_at_lisa(day, record_number):
     """(a) The 1PN acceleration tqdyn's default (relativity_model = "iers2010") leaves out at LISA's position (1
     au, 20 deg behind the Earth, 2035-01-01 + day TDB): |EIH_1PN(particle) - EIH_1PN(Sun) - Schwarzschild(Sun)|
     = 1.9e-14 .. 1.1e-13 m/s^2 (measured at these five dates), of Schwarzschild's 1.76e-10: the Sun's own terms
@@ -544,6 +551,8 @@ def test_missing_1pn_at_lisa(day):
     rho, rhod = (x[:, None] for x in _lisa_state(j1, 0.0))
     parts = {k: float(np.linalg.norm(v)) for k, v in _missing_1pn(np.array([j1]), np.zeros(1), rho, rhod).items()}
     print(f"2035-01-01 + {day} d: " + ", ".join(f"{k} {v:.2e}" for k, v in parts.items()) + " m/s^2")
+    for k, v in parts.items():  # one key per part and date: the pages quote each part's range over the dates
+        record_number(f"eih.missing_1pn.{k}.d{day}", v, "m/s^2")
     assert 5e-15 < parts["total"] < 5e-13
     assert 1e-15 < parts["lense_thirring"] < 1e-14
     assert abs(parts["schwarzschild"] - 3 * gm_f("sun") ** 2 / (C**2 * AU**3)) < 1e-3 * parts["schwarzschild"]
@@ -568,7 +577,7 @@ def _linearised_one_year(ts, da, r0, v0):
     return sol.y[6:9, -1]
 
 
-def test_missing_1pn_one_year():
+def test_missing_1pn_one_year(record_number):
     """(b) Effect on a one-year orbit: the linearised equation dr'' = -GM/r^3 [dr - 3 (u.dr) u] + da(t) along a
     Kepler orbit (scipy DOP853) from the LISA-like circular state of 2035-01-01, da sampled every 6 h and
     splined.  Measured |dr(1 yr)|: the missing 1PN total 3.45 m (sun_motion 8.2 m, planets 10.1 m,
@@ -610,6 +619,10 @@ def test_missing_1pn_one_year():
     print(f"Sun: {v_sun.min():.2f} .. {v_sun.max():.2f} m/s, {a_sun.min():.2e} .. {a_sun.max():.2e} m/s^2; its "
           f"acceleration's terms <= {sun_acc_share:.2e} m/s^2; planets' 1PN terms, max over the year: "
           + ", ".join(f"{k} {v:.1e}" for k, v in per_body.items()))
+    rest = max(v for k, v in per_body.items() if k not in ("jupiter", "earth", "venus", "saturn"))
+    record_number("eih.sun_in_bcrs_one_year", {"v": [v_sun.min(), v_sun.max()], "a": [a_sun.min(), a_sun.max()],
+                                               "acceleration_terms_max": sun_acc_share}, "m/s, m/s^2")
+    record_number("eih.planets_1pn_max", {**per_body, "rest": rest}, "m/s^2")
     assert 12.0 < v_sun.min() and v_sun.max() < 15.5 and 1.7e-7 < a_sun.min() and a_sun.max() < 3.0e-7
     assert 3e-15 < sun_acc_share < 5e-14
     assert 5e-15 < per_body["jupiter"] < 1e-13 and 4e-15 < per_body["earth"] < 6e-14
@@ -620,12 +633,13 @@ def test_missing_1pn_one_year():
         out[name] = float(np.linalg.norm(_linearised_one_year(ts, parts[name], r0, v0)))
         print(f"one year: {name:14s} max |da| {np.max(np.linalg.norm(parts[name], axis=0)):.2e} m/s^2 -> "
               f"|dr| = {out[name]:.3e} m")
+    record_number("eih.missing_1pn_one_year_m", out, "m")
     assert abs(out["schwarzschild"] / (12 * np.pi * mu / C**2) - 1) < 1e-3
     assert 0.5 < out["total"] < 20.0
     assert 0.15 < out["lense_thirring"] < 4.0
 
 
-def test_eih_option_one_year_is_the_linearised_estimate():
+def test_eih_option_one_year_is_the_linearised_estimate(record_number):
     """(c) ``forces.relativity_model = "eih"`` applies what (a) and (b) measure (tqdyn.forces.eih; its term
     against the numpy EIH: tests/test_eih.py).  From the same LISA-like state (2035-01-01 TDB), the full
     model (Sun in dd, the nine bodies, the Sun's J2) for one year at 1 h steps, eih minus iers2010 (the
@@ -654,6 +668,10 @@ def test_eih_option_one_year_is_the_linearised_estimate():
     gap = np.linalg.norm(moved - estimate)
     print(f"one year, eih - iers2010: {np.linalg.norm(moved):.4f} m; linearised estimate "
           f"{np.linalg.norm(estimate):.4f} m; vectors differ by {gap:.2e} m ({gap / np.linalg.norm(estimate):.1e})")
+    est = np.linalg.norm(estimate)
+    record_number("eih.option_one_year", {"moved": np.linalg.norm(moved), "estimate": est,
+                                          "length_rel": abs(np.linalg.norm(moved) / est - 1), "gap": gap,
+                                          "gap_rel": gap / est}, "m")
     assert 3.0 < np.linalg.norm(moved) < 4.0
     assert gap < 2e-2 * np.linalg.norm(estimate)
 

@@ -194,7 +194,7 @@ def stability_limit(order, corrector):
 
 
 @pytest.mark.parametrize("order", (8, 10, 12, 16))
-def test_stability_intervals(order):
+def test_stability_intervals(order, record_number):
     """Stability on r'' = -w^2 r (no root of the step's companion matrix
     above 1 + 1e-9 in modulus): every scheme is stable at h w = 0.01, more
     than twice LISA's h n = 4.3e-3 at 6 h steps (TianQin: 1.0e-3), and the
@@ -209,4 +209,5 @@ def test_stability_intervals(order):
     got_pe = stability_limit(order, (0, True))
     got_pece = stability_limit(order, (1, True))
     print(f"\nK = {order}: h w <= {got_pe:.3f} (PE), {got_pece:.3f} (PECE)")
+    record_number(f"multistep.stability.K{order}", {"pe": got_pe, "pece": got_pece}, "h w")
     assert 0.01 <= got_pe < got_pece < 2.0

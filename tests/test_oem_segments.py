@@ -155,7 +155,7 @@ def _leave_one_out(tr, rows):
     return np.array(out)
 
 
-def test_interpolation_near_the_boundary_as_accurate_as_elsewhere(nov):
+def test_interpolation_near_the_boundary_as_accurate_as_elsewhere(nov, record_number):
     """Reference (3).  The 4 records on each side of the boundary, each left out and interpolated from the
     joined file (the windows then end at the boundary), miss by at most 171 / 163 / 208 m and 1.5e-3 /
     1.5e-3 / 1.7e-3 m/s (lisa1/2/3, measured; the worst: segment 1's second-to-last record, one of the
@@ -165,6 +165,8 @@ def test_interpolation_near_the_boundary_as_accurate_as_elsewhere(nov):
     A window crossing the boundary (segment 1's records but its last, then segment 2's) would move the
     states of segment 1's last interval by <= 27 m and 3.8e-4 m/s (measured), inside the 187 m / 6.4e-4
     m/s, so windows inside one segment lose nothing visible."""
+    seen = {k: [] for k in ("near_r_max", "near_v_max", "far_r_max", "far_r_median", "far_v_max", "crossing_r_max",
+                            "crossing_v_max")}
     for tr in nov:
         near = _leave_one_out(tr, list(range(N1 - 5, N1 - 1)) + list(range(N1 + 1, N1 + 5)))
         far = _leave_one_out(tr, range(1, N1 - 5, 7))
@@ -177,13 +179,21 @@ def test_interpolation_near_the_boundary_as_accurate_as_elsewhere(nov):
         ra, va = st.states_at(tr, np.full(19, tr.jd1[N1 - 2]), j2)
         rb, vb = st.states_at(crossing, np.full(19, tr.jd1[N1 - 2]), j2)
         assert np.linalg.norm(ra - rb, axis=1).max() < 100.0 and np.linalg.norm(va - vb, axis=1).max() < 2e-3
+        for key, x in (("near_r_max", near[:, 0].max()), ("near_v_max", near[:, 1].max()),
+                       ("far_r_max", far[:, 0].max()), ("far_r_median", np.median(far[:, 0])),
+                       ("far_v_max", far[:, 1].max()), ("crossing_r_max", np.linalg.norm(ra - rb, axis=1).max()),
+                       ("crossing_v_max", np.linalg.norm(va - vb, axis=1).max())):
+            seen[key].append(float(x))
+    for key, xs in seen.items():  # per file (lisa1, lisa2, lisa3)
+        record_number(f"oem_segments.{key}", xs, "m/s" if "_v_" in key else "m")
 
 
-def test_the_tolerance_at_the_boundary(nov):
+def test_the_tolerance_at_the_boundary(nov, record_number):
     """The continuity tolerance (astro.oem_states module docstring): sqrt(3)/2 (1 mm + 1 mm) of the digits
     plus the largest leave-one-out miss of the 4 records of each segment nearest the boundary: 171 / 163 /
     208 m and 1.6e-3 / 1.7e-3 / 1.9e-3 m/s (measured), 8000 times the 2.1-cm jump; a 1-km shift of segment
     2 is 5-6 times the tolerance."""
+    tols = []
     for tr in nov:
         (j, k, p, text), = list(st._takeovers(tr))
         assert (j, k, text) == (0, 1, f"{T_SHARED} TDB") and p == tr.segments[1].start
@@ -191,6 +201,9 @@ def test_the_tolerance_at_the_boundary(nov):
         tol_r = np.sqrt(3) * 1e-3 + max(m[0] for m in miss)
         assert 100.0 < tol_r < 250.0
         assert st.require_continuous(tr) is tr
+        tols.append([float(tol_r), float(np.sqrt(3) * 1e-4 + max(m[1] for m in miss))])
+    record_number("oem_segments.boundary_tolerance_r", [t[0] for t in tols], "m")  # per file (lisa1, lisa2, lisa3)
+    record_number("oem_segments.boundary_tolerance_v", [t[1] for t in tols], "m/s")
 
 
 # ------------------------------------------------------------------ refused

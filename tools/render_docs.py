@@ -244,6 +244,14 @@ def gen_readme_bench(records, arg=None) -> str:
                 f"{_f(co['dd_over_kepler_float64'], '.0f')}x the Kepler float64 run of the same invocation; "
                 f"CPU per simulated day {_f(cd['cpu_inputs_per_day_s'], '.2f')} s of time-only inputs + "
                 f"{_f(cd['cpu_loop_per_day_s'], '.2f')} s of compiled loop) | {_f(cf['wall_s'], '.3g')} s | - |")
+    md, mf = cr.get("coupled, dd, multistep"), cr.get("coupled, float64, multistep")
+    if md and mf:  # records written before the multistep method have no such runs
+        rows.append(f"| the same with `integrator.method = \"multistep\"` ({co['multistep']}), {_span(co)} "
+                    f"(`--model coupled`) | {_f(md['wall_s'], '.3g')} s ({_f(md['peak_rss_mb'], '.0f')} MB; "
+                    f"{_f(co['multistep_dd_over_kepler_float64'], '.0f')}x the Kepler float64 run; DP87 takes "
+                    f"{_f(co['dp87_over_multistep_dd'], '.1f')}x as long; CPU per simulated day "
+                    f"{_f(md['cpu_inputs_per_day_s'], '.2g')} s of time-only inputs + "
+                    f"{_f(md['cpu_loop_per_day_s'], '.2g')} s of compiled loop) | {_f(mf['wall_s'], '.3g')} s | - |")
     rows.append(f"| coupled TianQin, {_span(t5)} (`--model tianqin-5y`: `{t5['command']}`, "
                 f"{_f(t5.get('n_steps'), ',d')} steps, {_f(t5['file_mb'], '.2g')} MB file) | "
                 f"{_f(t5['wall_s'], '.0f')} s" + (f" ({_f(t5['wall_s'] / 60, '.0f')} min)" if t5["wall_s"] > 120 else "")
