@@ -208,7 +208,7 @@ def test_helio_clocks(helio, record_number):
     # d tau / dTCB = 1 - (U + v^2/2)/c^2 with v the barycentric velocity (heliocentric + the Sun's, 13 m/s) and U
     # the Sun's potential plus the planets' (tqdyn.lightpath.proper_time_bcrs, checked against mpmath in
     # tests/test_lightpath_heliocentric.py): against the Sun-only formula with the barycentric velocity the file's
-    # TCB clock rate differs by the planets' potential, 2.5e-12 .. 2.6e-12 (and 1/c^4 terms, ~1e-16)
+    # TCB clock rate differs by the planets' potential, 2.7e-12 .. 2.8e-12 (and 1/c^4 terms, ~1e-16)
     from tqdyn.astro.ephemeris import default_ephemeris, planetary_gm
     from tqdyn.astro.timescales import Epoch, tdb_after
 
