@@ -164,11 +164,17 @@ def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 655
     t0 = time.perf_counter()
     ds = closed_loop_budget(job.model) if budget is None else budget
     t1 = time.perf_counter()
-    with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
-        writer.write_budget(ds)
-        sink = _Counting(writer if wrap is None else wrap(writer), progress)
-        closed_loop_timeseries(job.model, duration_s=job.duration_s, fs=job.fs, seed=job.seed, sink=sink,
-                               block_size=block_size)
+    try:
+        with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
+            writer.write_budget(ds)
+            sink = _Counting(writer if wrap is None else wrap(writer), progress)
+            closed_loop_timeseries(job.model, duration_s=job.duration_s, fs=job.fs, seed=job.seed, sink=sink,
+                                   block_size=block_size)
+    except OSError as exc:                 # the writer removed its temporary file (with-block)
+        if isinstance(exc, io.OutputError):
+            raise
+        raise io.OutputIOError(f"cannot write the closed-loop file {str(job.output)!r}: "
+                               f"{exc.strerror or exc}") from None
     t2 = time.perf_counter()
     path = writer.path
     return ClosedLoopSummary(path=path, size_bytes=os.path.getsize(path), n_samples=job.attrs["n_samples"],
