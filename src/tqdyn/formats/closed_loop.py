@@ -68,7 +68,7 @@ ROOT_ATTRS = {
 }
 
 _CHUNK_ROWS = 65536          # time rows per chunk of the time series (a 3-satellite output: 1.5 MB)
-_RDCC_NBYTES = 4 << 20
+_RDCC_NBYTES = 0             # blocks are whole chunks: no chunk cache (memory stays bounded)
 
 
 class ClosedLoopFormatError(ValueError):
