@@ -22,10 +22,10 @@ if [ $QUICK = 1 ]; then
         --model startup --model lisa-10y --json "$DATA/bench.json"
     tqdyn bench --model full --model coupled --duration 2d --json "$DATA/bench.json"
     tqdyn bench --model tianqin-5y --model tianqin-5y-multistep --duration 10d --json "$DATA/bench.json"
+    tqdyn bench --model closed-loop --duration 6h --json "$DATA/bench.json"
 else
     tqdyn bench --model all --model default-run --model startup --model tianqin-5y --model tianqin-5y-multistep \
-        --model lisa-10y \
-        --json "$DATA/bench.json"
+        --model lisa-10y --model closed-loop --json "$DATA/bench.json"
 fi
 
 # 2. the paper's studies on TianQin and on LISA (summary.json of tqdyn report --studies), in fresh

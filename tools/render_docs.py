@@ -277,6 +277,13 @@ def gen_readme_bench(records, arg=None) -> str:
                 f"{_f(l10.get('n_steps'), ',d')} steps of {l10['step_s'] / 3600:g} h, {_f(l10['file_mb'], '.2g')} MB "
                 f"file) | {_f(l10.get('propagation_wall_s'), '.2g')} s ({_f(l10['wall_s'], '.2g')} s with start-up and "
                 f"output; {_f(l10['peak_rss_mb'], '.0f')} MB peak) | - | - |")
+    cl = records["bench"]["models"].get("closed-loop")
+    if cl is not None:
+        c = cl["result"]
+        rows.append(f"| closed loop: {c['n_sat']} TianQin spacecraft, {_span(c)} at {c['fs']:g} Hz, "
+                    f"{_f(c['n_samples'], ',d')} samples x {c['n_outputs']} outputs streamed to a "
+                    f"{_f(c['file_mb'], '.0f')} MB file (`--model closed-loop`) | {_f(c['wall_s'], '.3g')} s "
+                    f"({_f(c['samples_per_s'], ',.0f')} samples/s; {_f(c['peak_rss_mb'], '.0f')} MB peak) | - | - |")
     return "\n".join(rows)
 
 

@@ -10,7 +10,9 @@ The front door (:mod:`tqdyn.api`)::
 
 :func:`load_scenario`, :func:`builtin_scenarios`, :func:`propagate`,
 :func:`run`, :func:`open_trajectory`, :func:`light_travel_times`,
-:func:`range_asd`, :func:`requirement_asd`, :func:`breathing_angles` and the
+:func:`range_asd`, :func:`requirement_asd`, :func:`breathing_angles`, the closed loop
+(:func:`closed_loop_model`, :func:`closed_loop_budget`, :func:`closed_loop_timeseries`,
+:func:`read_closed_loop`) and the
 classes :class:`Scenario`, :class:`Trajectory`, :class:`LightTravelTimes`.
 They are imported on first use, so ``import tqdyn`` stays cheap.
 """
@@ -18,8 +20,9 @@ They are imported on first use, so ``import tqdyn`` stays cheap.
 from ._version import __version__
 
 __all__ = ["__version__", "LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory",
-           "breathing_angles", "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory",
-           "propagate", "range_asd", "requirement_asd", "run"]
+           "breathing_angles", "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
+           "light_travel_times", "load_scenario", "open_trajectory", "propagate", "range_asd", "read_closed_loop",
+           "requirement_asd", "run"]
 
 
 def __getattr__(name):

@@ -35,8 +35,9 @@ from .scenario.toml_text import toml_value
 from .workflows.run import RunSummary, load_run_scenario, output_attrs, run_to_file
 
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
-           "builtin_scenarios", "light_travel_times", "load_scenario", "open_trajectory", "propagate",
-           "range_asd", "requirement_asd", "run"]
+           "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
+           "light_travel_times", "load_scenario", "open_trajectory", "propagate", "range_asd", "read_closed_loop",
+           "requirement_asd", "run"]
 
 
 def _overrides(overrides) -> list[str]:
@@ -179,3 +180,36 @@ def breathing_angles(trajectory: Trajectory) -> np.ndarray:
     run of 3 satellites, coupled or pure gravity; ValueError for other
     counts)."""
     return _metrics.breathing_angles_of(trajectory)
+
+
+def closed_loop_model(trajectory: Trajectory, config=None, validate: bool = True):
+    """The closed loops of a coupled run (docs/closed-loop.md):
+    :func:`tqdyn.analysis.closed_loop.closed_loop_model` (imported on first use)."""
+    from .analysis.closed_loop import closed_loop_model as f
+
+    return f(trajectory, config, validate)
+
+
+def closed_loop_budget(model, f=None, dt: float | None = None):
+    """The noise budget, margins and dominant sources as an ``xarray.Dataset``:
+    :func:`tqdyn.analysis.closed_loop.closed_loop_budget`."""
+    from .analysis.closed_loop import closed_loop_budget as g
+
+    return g(model, f, dt)
+
+
+def closed_loop_timeseries(model, duration_s: float | None = None, fs: float | None = None, seed: int | None = None,
+                           sink=None, block_size: int = 65536):
+    """Seeded time series of every output (``xarray.Dataset``, or streamed to ``sink``):
+    :func:`tqdyn.analysis.closed_loop.closed_loop_timeseries`."""
+    from .analysis.closed_loop import closed_loop_timeseries as g
+
+    return g(model, duration_s, fs, seed, sink, block_size)
+
+
+def read_closed_loop(path):
+    """Open a closed-loop file (docs/closed-loop-file.md): ``.budget`` (xarray.Dataset), ``.timeseries()``,
+    ``.attrs``, ``.configuration`` -- :func:`tqdyn.formats.closed_loop.read_closed_loop`."""
+    from .formats.closed_loop import read_closed_loop as g
+
+    return g(path)

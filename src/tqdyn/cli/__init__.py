@@ -1,8 +1,8 @@
-"""Command line: ``tqdyn run | info | forces | bench | export | sweep | report``.
+"""Command line: ``tqdyn run | info | forces | bench | export | sweep | report | closed-loop``.
 
 The click group and the entry point :func:`main`; every command lives in its
 own module (:mod:`.run`, :mod:`.forces`, :mod:`.info`, :mod:`.bench`,
-:mod:`.export`, :mod:`.sweep`, :mod:`.report`) and only composes library
+:mod:`.export`, :mod:`.sweep`, :mod:`.report`, :mod:`.closed_loop`) and only composes library
 calls.  Bad input exits with status 2 and one line on stderr (no traceback,
 no partial output file).
 """
@@ -15,6 +15,7 @@ from .._version import __version__
 from ..workflows.heap import bound_heap_retention
 from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 from .bench import bench as _bench_command
+from .closed_loop import closed_loop as _closed_loop_command
 from .export import export as _export_command
 from .forces import forces as _forces_command
 from .info import info as _info_command
@@ -39,6 +40,7 @@ cli.add_command(_bench_command)
 cli.add_command(_export_command)
 cli.add_command(_sweep_command)
 cli.add_command(_report_command)
+cli.add_command(_closed_loop_command)
 
 
 def main(argv=None):

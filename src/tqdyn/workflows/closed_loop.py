@@ -1,0 +1,181 @@
+"""The closed loop of a run file to a closed-loop file (``tqdyn closed-loop``; docs/closed-loop-file.md).
+
+:func:`check_closed_loop_inputs` resolves everything a run needs and refuses bad input in one line
+before anything is written; :func:`closed_loop_to_file` then computes the budget, streams the time
+series into a :class:`~tqdyn.formats.closed_loop.ClosedLoopWriter` and renames the file into place
+(nothing at the output path after a failure or an interrupt).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from dataclasses import dataclass
+
+from ..formats import trajectory as io
+from ..formats.closed_loop import ClosedLoopWriter
+
+__all__ = ["ClosedLoopJob", "ClosedLoopSummary", "check_closed_loop_inputs", "closed_loop_to_file",
+           "resolved_configuration"]
+
+
+@dataclass
+class ClosedLoopJob:
+    """What :func:`check_closed_loop_inputs` resolved: the trajectory, the model, the output path and
+    the time-domain settings (duration [s], fs [Hz], seed), the configuration and the root attributes."""
+
+    traj: object
+    model: object
+    output: object
+    duration_s: float
+    fs: float
+    seed: int
+    attrs: dict
+
+
+@dataclass(frozen=True)
+class ClosedLoopSummary:
+    """The result of :func:`closed_loop_to_file`: the file, its size [bytes], the samples written,
+    the wall times [s] of the budget and of the streamed time series."""
+
+    path: object
+    size_bytes: int
+    n_samples: int
+    n_sat: int
+    budget_s: float
+    timeseries_s: float
+
+
+def _positive(name: str, text, parse) -> float:
+    try:
+        v = float(parse(text))
+    except Exception:  # noqa: BLE001 - any unparsable value
+        v = float("nan")
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{name}: {text!r} is not allowed; allowed: a finite number > 0"
+                         + (" (seconds, or with a unit: 3d, 6h, 30min, 3600s)" if name == "--duration" else " (Hz)"))
+    return v
+
+
+def resolved_configuration(config, architecture: str, settings: dict) -> dict:
+    """The resolved closed-loop configuration as plain JSON types: settings, plant, controllers
+    (zeros, poles [rad/s] as [re, im], gain) and noise (level [unit/Hz^1/2], knees [[Hz, slope]], unit)."""
+    from ..closedloop.missions import resolve
+
+    mission, plant, ctl, noise = resolve(config, architecture)
+    return {"mission": mission, "settings": dict(settings),
+            "plant": {k: (list(v) if isinstance(v, (tuple, list)) else float(v)) for k, v in plant.items()},
+            "controllers": {k: {"zeros": [[complex(z).real, complex(z).imag] for z in c.zeros],
+                                "poles": [[complex(p).real, complex(p).imag] for p in c.poles], "gain": float(c.gain)}
+                            for k, c in ctl.items()},
+            "noise": {k: {"level": float(a.level), "knees": [list(x) for x in a.knees], "unit": a.unit}
+                      for k, a in noise.items()}}
+
+
+def _sha256(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 22), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=()) -> ClosedLoopJob:
+    """Resolve a ``tqdyn closed-loop`` job; raise (one line) FileNotFoundError, ValueError
+    (TrajectoryFormatError, ScenarioError, ClosedLoopError, DesignError: a bad option, a run without
+    test masses or a pure-gravity run, an unknown loop or source, a bad ASD, an unstable design naming
+    the loop and its margin) or OutputError (the output path) before anything is written.
+    ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``."""
+    from ..analysis.closed_loop import closed_loop_model
+    from ..scenario import loads_scenario
+    from ..scenario.loader import parse_duration
+
+    dur = None if duration is None else _positive("--duration", duration, parse_duration)
+    rate = None if fs is None else _positive("--fs", fs, float)
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise ValueError(f"--seed: {seed!r} is not allowed; allowed: an integer >= 0")
+    for o in overrides:
+        if not str(o).startswith("closed_loop."):
+            raise ValueError(f"--set: {o!r} is not a closed-loop key; allowed: closed_loop.KEY=VALUE "
+                             "(docs/scenarios.md#closed-loop)")
+    out = io.check_writable(output)
+    src = os.path.abspath(os.path.expanduser(os.fspath(run_file)))
+    if not os.path.isfile(src):
+        raise FileNotFoundError(f"RUN.h5: trajectory file {src!r} does not exist or is not a file")
+    if out.exists() and os.path.samefile(out, src):
+        raise ValueError(f"--output: {str(out)!r} is the run file itself; allowed: another file")
+    traj = io.read_trajectory(src)
+    scen = loads_scenario(traj.scenario_toml, list(overrides), source=f"{src} (attribute scenario) and --set")
+    model = closed_loop_model(traj, scen.closed_loop, validate=True)
+    s = model.settings
+    dur = dur if dur is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
+    rate = rate if rate is not None else s["fs"]
+    seed = seed if seed is not None else s["seed"]
+    n = int(round(float(dur) * rate))
+    if n < 1:
+        raise ValueError(f"--duration: {dur!r} s at {rate!r} Hz is less than one sample; allowed: duration x fs >= 1")
+    settings = {**s, "fs": rate, "duration": float(dur), "seed": int(seed)}
+    conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings)
+    ta = traj.attrs
+    attrs = {"mission": model.mission, "source_file": os.path.basename(src), "source_path": src,
+             "source_sha256": _sha256(src),
+             "source_scenario_sha256": hashlib.sha256(traj.scenario_toml.encode("utf-8")).hexdigest(),
+             "source_format_version": int(ta.get("format_version", 0)),
+             "source_tqdyn_version": str(ta.get("tqdyn_version", "")),
+             "source_epoch_utc": str(ta.get("epoch_utc", "")), "source_time_scale": str(ta.get("time_scale", "")),
+             "configuration": json.dumps(conf), "closed_loop_toml": "\n".join(scen.closed_loop.to_toml_lines()),
+             "seed": int(seed), "fs": float(rate), "duration_s": n / rate, "n_samples": n,
+             "t0": float(model.t_span[0]), "satellite_names": json.dumps(list(model.satellite_names))}
+    return ClosedLoopJob(traj=traj, model=model, output=out, duration_s=n / rate, fs=float(rate), seed=int(seed),
+                         attrs=attrs)
+
+
+class _Counting:
+    """A sink forwarding to ``sink`` and calling ``progress(n_rows)`` after each block."""
+
+    def __init__(self, sink, progress):
+        self.sink, self.progress = sink, progress
+
+    def start(self, meta):
+        self.sink.start(meta)
+
+    def write(self, block):
+        self.sink.write(block)
+        if self.progress is not None:
+            self.progress(len(block.t))
+
+    def close(self):
+        return self.sink.close()
+
+
+def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 65536, budget=None,
+                        wrap=None) -> ClosedLoopSummary:
+    """Write the closed-loop file of ``job`` (:func:`check_closed_loop_inputs`): the budget
+    (:func:`~tqdyn.analysis.closed_loop.closed_loop_budget`, or ``budget`` if given), then the time
+    series streamed block by block (``progress(n)`` after each block of n samples).  ``wrap``: a
+    function of the writer returning the sink the simulation writes to (tests inject failures).
+    On any failure or interrupt no file is left at the output path."""
+    from ..analysis.closed_loop import closed_loop_budget, closed_loop_timeseries
+    from ..closedloop.loop import OUTPUTS
+
+    t0 = time.perf_counter()
+    ds = closed_loop_budget(job.model) if budget is None else budget
+    t1 = time.perf_counter()
+    try:
+        with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
+            writer.write_budget(ds)
+            sink = _Counting(writer if wrap is None else wrap(writer), progress)
+            closed_loop_timeseries(job.model, duration_s=job.duration_s, fs=job.fs, seed=job.seed, sink=sink,
+                                   block_size=block_size)
+    except OSError as exc:                 # the writer removed its temporary file (with-block)
+        if isinstance(exc, io.OutputError):
+            raise
+        raise io.OutputIOError(f"cannot write the closed-loop file {str(job.output)!r}: "
+                               f"{exc.strerror or exc}") from None
+    t2 = time.perf_counter()
+    path = writer.path
+    return ClosedLoopSummary(path=path, size_bytes=os.path.getsize(path), n_samples=job.attrs["n_samples"],
+                             n_sat=len(job.model.loops), budget_s=t1 - t0, timeseries_s=t2 - t1)
