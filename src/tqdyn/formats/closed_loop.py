@@ -33,7 +33,7 @@ import numpy as np
 from .._version import __version__ as _TQDYN_VERSION
 from ..closedloop.simulate import Block, Sink
 from .trajectory import OutputError, OutputIOError, check_writable
-from .trajectory._h5safe import _close_h5, _io_reason
+from .trajectory._h5safe import _cleanup, _close_h5, _io_reason
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError", "ClosedLoopWriter",
            "ROOT_ATTRS", "read_closed_loop"]
@@ -97,16 +97,6 @@ def _put(group, name: str, value, dims=(), attrs=None):
     for k, v in (attrs or {}).items():
         ds.attrs[k] = v if not isinstance(v, (list, tuple, dict)) else json.dumps(v)
     return ds
-
-
-def _cleanup(state: dict) -> None:
-    _close_h5(state, keep=False)
-    tmp = state.pop("tmp", None)
-    if tmp is not None:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
 
 
 class ClosedLoopWriter(Sink):

@@ -76,6 +76,17 @@ def _close_h5(state: dict, keep: bool) -> None:
     state.pop("fd", None)
 
 
+def _cleanup(state: dict) -> None:
+    """Close the HDF5 handle and delete the temporary file (idempotent)."""
+    _close_h5(state, keep=False)
+    tmp = state.pop("tmp", None)
+    if tmp is not None:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+
+
 def _io_reason(exc: BaseException) -> str:
     """The cause of an HDF5 / OS write failure in a few words (strerror)."""
     num = getattr(exc, "errno", None)

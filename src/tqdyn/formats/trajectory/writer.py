@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 from . import _h5safe
-from ._h5safe import _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
+from ._h5safe import _cleanup, _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
 from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, dataset_attrs
 
 __all__ = ["check_writable", "hdf5_poisoned", "TrajectoryWriter"]
@@ -64,17 +64,6 @@ def _split_dd(value, name: str, shape: tuple) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"field {name!r}: hi shape {_fmt_shape(hi.shape)} != lo shape "
                          f"{_fmt_shape(lo.shape)}")
     return hi, lo
-
-
-def _cleanup(state: dict) -> None:
-    """Close the HDF5 handle and delete the temporary file (idempotent)."""
-    _close_h5(state, keep=False)
-    tmp = state.pop("tmp", None)
-    if tmp is not None:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
 
 
 def _fsync_path(path, directory: bool = False) -> None:
