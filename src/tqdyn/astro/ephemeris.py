@@ -514,6 +514,16 @@ class Ephemeris:
         self._pairs[(_SSB, 10)].evaluate(j1, j2, True, pos, vel, 0, pos, vel, 0, 0.0)
         return pos[:, 0].reshape(shape + (3,)), vel[:, 0].reshape(shape + (3,))
 
+    def geocentric_positions_dd(self, bodies, tdb_hi, tdb_lo) -> tuple[np.ndarray, np.ndarray]:
+        """Geocentric positions of ``bodies`` (as :meth:`geocentric_states`)
+        in double-double, smooth functions of time: Clenshaw's recurrence and
+        the segment sums in dd at the dd time tdb_hi + tdb_lo [s TDB past
+        J2000] (any broadcast shape S; :mod:`tqdyn.astro.ephemeris_dd`).
+        Returns (hi, lo), each S + (n_bodies, 3) float64 [m], ICRF axes."""
+        from .ephemeris_dd import geocentric_positions_dd
+
+        return geocentric_positions_dd(self, self.validate_bodies(bodies), tdb_hi, tdb_lo)
+
     def geocentric(self, body, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
         """Geocentric position [m] and velocity [m/s] of ``body``.
 
