@@ -31,7 +31,7 @@ from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache bef
 from ..numerics.dd import add, div, mul, np_dd_add, np_dd_add_d, np_two_prod, sub
 from .constants import DAY_S, J2000_JD
 
-__all__ = ["geocentric_positions_dd", "tdb_seconds_dd"]
+__all__ = ["chain_positions_dd", "tdb_seconds_dd"]
 
 _KM = 1000.0
 _J2000 = float(J2000_JD)
@@ -103,31 +103,24 @@ def _pair_eval(pair, th, tl, out, ob, base, bb, bsign) -> None:
             todo &= ~m
 
 
-def geocentric_positions_dd(eph, names, tdb_hi, tdb_lo):
-    """Geocentric positions of ``names`` (validated names of ``eph``'s
-    bodies) at the TDB instants tdb_hi + tdb_lo [s past J2000 TDB, dd; any
-    broadcast shape S]: (hi, lo), each S + (n_bodies, 3) float64 [m], ICRF
-    axes, TDB-compatible (the chains of :class:`tqdyn.astro.ephemeris.Ephemeris`
-    summed in dd).  ValueError for an instant outside ``eph.span_jd``."""
-    from .ephemeris import _BASE_INDEX, _CHAIN, _EARTH_CHAIN
+def chain_positions_dd(base_ops, ops, th, tl):
+    """Sums of segment positions in dd at the dd instants th + tl ((n,)
+    float64 each, TDB seconds past J2000, inside the segments' span).
 
-    th, tl = np.broadcast_arrays(np.asarray(tdb_hi, dtype=np.float64), np.asarray(tdb_lo, dtype=np.float64))
-    shape = th.shape
-    th = np.ascontiguousarray(th.reshape(-1))
-    tl = np.ascontiguousarray(tl.reshape(-1))
-    eph._check_span(np.full(th.shape, _J2000), (th + tl) / _DAY)
+    base_ops, ops: sequences of (pair, row, base_row, sign) with ``pair`` an
+    ephemeris ``_Pair`` (its ``segments`` with ``load()``, ``start_jd``,
+    ``end_jd``): base_ops fill the scratch rows base[:, row] (2 rows) in
+    order, ops the output rows out[:, row] = pair + sign * base[:, base_row]
+    (the chains of :class:`tqdyn.astro.ephemeris.Ephemeris`).  Returns (hi,
+    lo), each (n, len(ops), 3) float64 [m]."""
     n = th.shape[0]
-    out = np.empty((n, len(names), 3, 2))
-    base = np.zeros((n, 2, 3, 2))  # [:, 0] = EMB -> Earth, [:, 1] = SSB -> Earth
-    bases = {_CHAIN[name][1] for name in names}
-    if bases:
-        _pair_eval(eph._pairs[_EARTH_CHAIN[1]], th, tl, base, 0, base, 0, 0.0)
-    if "earth" in bases:
-        _pair_eval(eph._pairs[_EARTH_CHAIN[0]], th, tl, base, 1, base, 0, 1.0)
-    for b, name in enumerate(names):
-        key, which = _CHAIN[name]
-        _pair_eval(eph._pairs[key], th, tl, out, b, base, _BASE_INDEX[which], -1.0)
-    return out[..., 0].reshape(shape + (len(names), 3)), out[..., 1].reshape(shape + (len(names), 3))
+    out = np.empty((n, len(ops), 3, 2))
+    base = np.zeros((n, 2, 3, 2))
+    for pair, row, brow, sign in base_ops:
+        _pair_eval(pair, th, tl, base, row, base, brow, sign)
+    for pair, row, brow, sign in ops:
+        _pair_eval(pair, th, tl, out, row, base, brow, sign)
+    return out[..., 0], out[..., 1]
 
 
 def tdb_seconds_dd(epoch, t_hi, t_lo, tdb_minus_tt):
