@@ -23,7 +23,8 @@ import numpy as np
 from ..astro.ephemeris import BODIES, Ephemeris, default_ephemeris, planetary_gm
 from ..astro.geocentric import TDB_TO_TT_SCALE, bcrs_to_gcrs_offsets
 from ..astro.ephemeris_dd import tdb_seconds_dd
-from ..astro.timescales import tdb_jd, tdb_minus_tt, tt_jd
+from ..astro import timescales
+from ..astro.timescales import tdb_jd, tt_jd
 from ..numerics.dd import np_dd_add_d, np_fast_two_sum, np_two_prod
 from ..numerics.lagrange import MARGIN, grid_interp
 from .third_body import ThirdBodies
@@ -63,7 +64,7 @@ class EphemerisPositions:
         1PN part delta (float64, interpolated: smooth) added and K applied in
         dd."""
         jd1, jd2 = tt_jd(epoch, t_hi, t_lo)
-        th, tl = tdb_seconds_dd(epoch, t_hi, t_lo, tdb_minus_tt(jd1, jd2))
+        th, tl = tdb_seconds_dd(epoch, t_hi, t_lo, timescales.tdb_minus_tt(jd1, jd2))  # as tdb_jd looks it up
         hi, lo = self.ephemeris.geocentric_positions_dd(self.names, th, tl)
         if not self.gcrs:
             return hi, lo
