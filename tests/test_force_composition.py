@@ -108,12 +108,12 @@ def _model():
 def test_composition_sums_terms():
     """gravity() = monopole (dd) + third body (float64), layout from ForceModel."""
     model = _model()
-    assert model.n_tdat == 3 and model.time_dependent
+    assert model.n_tdat == 6 and model.time_dependent  # 3 coordinates and their low parts (zero here)
     assert [t.name for t in model.terms] == ["earth_monopole", "third_body"]
     r = (7.0e7, 2.0e7, -6.0e7)
     s = _moon_position(None, np.array(1234.0), np.array(0.0))[0]
     tdat = model.precompute(None, np.array(1234.0), np.array(0.0))
-    np.testing.assert_array_equal(tdat, s)
+    np.testing.assert_array_equal(tdat, np.concatenate((s, np.zeros(3))))  # a plain callable: no low parts
     dd = [(x, 0.0) for x in r]  # dd inputs: the monopole is evaluated in dd
     total = gravity(*dd, *dd, tdat, model.params, model.layout)
     mono_only = ForceModel([EarthMonopole()])

@@ -25,6 +25,7 @@ from __future__ import annotations
 import warnings
 
 import erfa
+import mpmath
 import numpy as np
 import pytest
 
@@ -84,8 +85,18 @@ def test_vs_erfa_composition(ep, eop):
     # same interpolant; abscissae differ by the float64 MJD rounding (~1e-6 s)
     assert np.abs(res.xp - v.xp).max() < 1e-18 and np.abs(res.yp - v.yp).max() < 1e-18
     # angles from the compiled kernel vs ERFA at the module's own UT1/TT
-    assert _angle_diff(res.era, erfa.era00(*res.ut1)).max() < 1e-14
-    assert _angle_diff(res.gmst, erfa.gmst06(res.ut1[0], res.ut1[1], res.tt[0], res.tt[1])).max() < 1e-14
+    # ERA: ERFA's float64 sum rounds to ~1e-14 rad here (the module sums the turns in dd);
+    # against TN36 eq. 5.15 in mpmath (the IAU decimals, the exact two-part UT1 date): the final rounding
+    assert _angle_diff(res.era, erfa.era00(*res.ut1)).max() < 5e-14
+    with mpmath.workdps(40):
+        for i in range(0, t.size, 97):
+            tu = (mpmath.mpf(float(res.ut1[0][i])) - 2451545) + mpmath.mpf(float(res.ut1[1][i]))
+            turns = mpmath.mpf("0.7790572732640") + mpmath.mpf("1.00273781191135448") * tu
+            exact = 2 * mpmath.pi * (turns - mpmath.floor(turns))
+            d = mpmath.mpf(float(res.era[i])) - exact
+            assert abs(float(d - 2 * mpmath.pi * mpmath.nint(d / (2 * mpmath.pi)))) < 2e-15  # measured <= 4.4e-16
+    # GMST = ERA + polynomial: ERFA's ERA rounding again
+    assert _angle_diff(res.gmst, erfa.gmst06(res.ut1[0], res.ut1[1], res.tt[0], res.tt[1])).max() < 5e-14
 
 
 def test_vs_c2t06a_without_pole_offsets(ep, eop):

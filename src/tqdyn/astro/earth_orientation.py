@@ -60,6 +60,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache, before any @njit)
+from ..numerics.dd import add, mul, to_f64, two_prod
 from ..numerics.lagrange import MARGIN, POINTS, grid_interp
 from ..readers.iers_tables import load_tidal_eop_terms
 from .eop import EOP, tidal_arguments, tidal_eop_corrections
@@ -160,6 +161,10 @@ def _interp_grid(t_hi: np.ndarray, t_lo: np.ndarray, epoch, eop, tides) -> np.nd
 # the rotation matrix and the angles
 
 _D2PI = 2.0 * math.pi
+_D2PI_LO = 2.4492935982947064e-16  # 2 pi - _D2PI
+#: TN36 eq. 5.15's decimals 0.00273781191135448 and 0.7790572732640 as dd pairs (hi + lo).
+_ERA_RATE = (0.00273781191135448, 1.1969606404306886e-19)
+_ERA_0 = (0.779057273264, 1.6884986507648136e-17)
 _DJ00 = 2451545.0
 _DAS2R = math.pi / 648000.0
 
@@ -177,13 +182,22 @@ def _orientation_kernel(jd1, ut2, tt2, X, Y, s, xp, yp, T, era_out, gmst_out):
     """Per instant: ERA (IAU 2000), GMST (IAU 2006), s' (IAU 2000) and
     T_ITRS_GCRS = R1(-yp) R2(-xp) R3(ERA + s' - s) M(X, Y)^T (TN36 eqs 5.1, 5.10)."""
     for i in range(X.size):
-        # Earth rotation angle, IAU 2000 (TN36 eq. 5.15), fraction of the day kept exact
+        # Earth rotation angle, IAU 2000 (TN36 eq. 5.15), in turns summed in dd: ERFA's float64
+        # sum (~34 turns in 2034, tu rounded to 1.6e-7 s) rounds to ~4e-14 rad, a non-smooth
+        # function of time; here only the final rounding of the angle (< 4.4e-16 rad) is left
         d1, d2 = ut2[i], jd1[i]
         if d1 > d2:
             d1, d2 = d2, d1
-        tu = d1 + (d2 - _DJ00)
-        f = np.fmod(d1, 1.0) + np.fmod(d2, 1.0)
-        era = _anp(_D2PI * (f + 0.7790572732640 + 0.00273781191135448 * tu))
+        a = d2 - _DJ00  # exact (half-integer days)
+        p, pe = two_prod(_ERA_RATE[0], a)
+        p -= math.floor(p)  # exact
+        q, qe = two_prod(_ERA_RATE[0], d1)
+        turns = add(add(add((p, pe + _ERA_RATE[1] * a), (q, qe + _ERA_RATE[1] * d1)), np.fmod(d1, 1.0)),
+                    np.fmod(d2, 1.0))
+        turns = add(turns, _ERA_0)
+        w = math.floor(turns[0])
+        turns = add((turns[0] - w, 0.0), turns[1])  # turns[0] - w: exact
+        era = _anp(to_f64(mul(turns, (_D2PI, _D2PI_LO))))
         # GMST, IAU 2006 (TN36 eq. 5.32), t in TT Julian centuries
         t = ((jd1[i] - _DJ00) + tt2[i]) / 36525.0
         poly = -0.000029956 + (-0.0000000368) * t

@@ -514,6 +514,26 @@ class Ephemeris:
         self._pairs[(_SSB, 10)].evaluate(j1, j2, True, pos, vel, 0, pos, vel, 0, 0.0)
         return pos[:, 0].reshape(shape + (3,)), vel[:, 0].reshape(shape + (3,))
 
+    def geocentric_positions_dd(self, bodies, tdb_hi, tdb_lo) -> tuple[np.ndarray, np.ndarray]:
+        """Geocentric positions of ``bodies`` (as :meth:`geocentric_states`)
+        in double-double, smooth functions of time: Clenshaw's recurrence and
+        the segment sums in dd at the dd time tdb_hi + tdb_lo [s TDB past
+        J2000] (any broadcast shape S; :mod:`tqdyn.astro.ephemeris_dd`).
+        Returns (hi, lo), each S + (n_bodies, 3) float64 [m], ICRF axes."""
+        from .ephemeris_dd import chain_positions_dd
+
+        names = self.validate_bodies(bodies)
+        th, tl = np.broadcast_arrays(np.asarray(tdb_hi, dtype=np.float64), np.asarray(tdb_lo, dtype=np.float64))
+        shape, th, tl = th.shape, np.ascontiguousarray(th.reshape(-1)), np.ascontiguousarray(tl.reshape(-1))
+        self._check_span(np.full(th.shape, _J2000), (th + tl) / _DAY)
+        bases = {_CHAIN[name][1] for name in names}  # base rows: 0 = EMB -> Earth, 1 = SSB -> Earth
+        base_ops = [(self._pairs[_EARTH_CHAIN[1]], 0, 0, 0.0)] if bases else []
+        if "earth" in bases:
+            base_ops.append((self._pairs[_EARTH_CHAIN[0]], 1, 0, 1.0))
+        ops = [(self._pairs[_CHAIN[n][0]], b, _BASE_INDEX[_CHAIN[n][1]], -1.0) for b, n in enumerate(names)]
+        hi, lo = chain_positions_dd(base_ops, ops, th, tl)
+        return hi.reshape(shape + (len(names), 3)), lo.reshape(shape + (len(names), 3))
+
     def geocentric(self, body, jd1, jd2) -> tuple[np.ndarray, np.ndarray]:
         """Geocentric position [m] and velocity [m/s] of ``body``.
 

@@ -57,7 +57,8 @@ from .constants import C_LIGHT, L_B, L_G
 from .timescales import geocentre_tdb_grid, tdb_jd
 
 __all__ = ["EXTERNAL_BODIES", "TDB_TO_TT_SCALE", "bcrs_to_gcrs", "earth_barycentric_field", "external_field",
-           "gcrs_to_bcrs_offsets", "gcrs_to_bcrs_states"]
+           "gcrs_to_bcrs_offsets", "gcrs_to_bcrs_states",
+           "bcrs_to_gcrs_offsets"]
 
 #: K = (1 - L_G) / (1 - L_B): TDB-compatible -> TT-compatible lengths and GMs [1].
 TDB_TO_TT_SCALE = 1.0 + (L_B - L_G) / (1.0 - L_B)  # written so that only the last rounding is left
@@ -77,6 +78,21 @@ def bcrs_to_gcrs(r, v, v_earth, gms) -> np.ndarray:
     TT-compatible (the module docstring), ICRF axes.
     """
     r = np.asarray(r, dtype=np.float64)
+    t1, t2 = _pn_terms(r, v, v_earth, gms)
+    return TDB_TO_TT_SCALE * ((r + t1) + t2)
+
+
+def bcrs_to_gcrs_offsets(r, v, v_earth, gms) -> np.ndarray:
+    """delta = X / K - r [m] (..., n, 3) of :func:`bcrs_to_gcrs` (same
+    arguments), formed without r, so without r's rounding: the 1PN part of
+    the transformation (<= 1.5e-8 |r|), a smooth function of the states."""
+    t1, t2 = _pn_terms(r, v, v_earth, gms)
+    return t1 + t2
+
+
+def _pn_terms(r, v, v_earth, gms):
+    """The two 1PN terms of :func:`bcrs_to_gcrs`: X / K = (r + t1) + t2."""
+    r = np.asarray(r, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
     ve = np.asarray(v_earth, dtype=np.float64)[..., None, :]
     d = np.linalg.norm(r, axis=-1)                                  # (..., n)
@@ -85,9 +101,9 @@ def bcrs_to_gcrs(r, v, v_earth, gms) -> np.ndarray:
     c2 = C_LIGHT * C_LIGHT
     ve_r = np.sum(ve * r, axis=-1)[..., None]                       # (..., n, 1)
     ae_r = np.sum(a_e * r, axis=-1)[..., None]
-    x = r + v * (ve_r / c2)                                         # simultaneity
-    x = x + (0.5 * ve_r * ve + u_ext * r + ae_r * r - 0.5 * a_e * (d ** 2)[..., None]) / c2
-    return TDB_TO_TT_SCALE * x
+    t1 = v * (ve_r / c2)                                            # simultaneity
+    t2 = (0.5 * ve_r * ve + u_ext * r + ae_r * r - 0.5 * a_e * (d ** 2)[..., None]) / c2
+    return t1, t2
 
 
 def external_field(r, gms) -> tuple[np.ndarray, np.ndarray]:

@@ -363,26 +363,37 @@ def degree2_accel_ext(rx, ry, rz, tdat, params):
     """
     one = const(1.0, 0.0, rx)
     gmr2, m_xx, m_yy, m_zz, m_xy, m_xz, m_yz = degree2_matrix(tdat, params, one)
+    # The float64 matrix T is orthogonal only to ~1e-16, not smoothly in time: |T r| - |r| ~ 1e-8 m
+    # would make the zonal term (~3e-7 m/s^2 at 1e8 m, gradient ~4 a / r) a noise of ~1e-22 m/s^2.
+    # So the zonal part, C20u (3 z^2 - r^2) / 2 of Q, is formed from the GCRS r itself and the pole
+    # p (T's third row) normalised in dd (its direction is smooth to ~1e-19 rad), and the radial
+    # term from r; only the small non-zonal terms M' = M - C20u diag(-1/2, -1/2, 1) go through T.
+    px, py, pz = mul(one, tdat[6]), mul(one, tdat[7]), mul(one, tdat[8])
+    pn = sqrt(add(add(mul(px, px), mul(py, py)), mul(pz, pz)))
+    px, py, pz = div(px, pn), div(py, pn), div(pz, pn)
     # r_ITRS = T r (T float64, r generic)
     x = add(add(mul(rx, tdat[0]), mul(ry, tdat[1])), mul(rz, tdat[2]))
     y = add(add(mul(rx, tdat[3]), mul(ry, tdat[4])), mul(rz, tdat[5]))
-    z = add(add(mul(rx, tdat[6]), mul(ry, tdat[7])), mul(rz, tdat[8]))
-    mx = add(add(mul(x, m_xx), mul(y, m_xy)), mul(z, m_xz))
-    my = add(add(mul(x, m_xy), mul(y, m_yy)), mul(z, m_yz))
-    mz = add(add(mul(x, m_xz), mul(y, m_yz)), mul(z, m_zz))
-    q = add(add(mul(x, mx), mul(y, my)), mul(z, mz))
-    r2 = add(add(mul(x, x), mul(y, y)), mul(z, z))
+    z = add(add(mul(rx, px), mul(ry, py)), mul(rz, pz))
+    half = mul(m_zz, 0.5)
+    n_xx, n_yy = add(m_xx, half), add(m_yy, half)
+    mx = add(add(mul(x, n_xx), mul(y, m_xy)), mul(z, m_xz))
+    my = add(add(mul(x, m_xy), mul(y, n_yy)), mul(z, m_yz))
+    mz = add(mul(x, m_xz), mul(y, m_yz))
+    r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz))
+    q = add(add(add(mul(x, mx), mul(y, my)), mul(z, mz)), mul(half, sub(mul(mul(z, z), 3.0), r2)))
     r5 = mul(mul(r2, r2), sqrt(r2))
-    # a = (2 GM R^2 / r^5) M x - (5 GM R^2 Q / r^7) x
+    # a = (2 GM R^2 / r^5) M x - (5 GM R^2 Q / r^7) x, with M x = M' x + (C20u / 2) (3 z p - r) (GCRS)
     s1 = div(mul(gmr2, 2.0), r5)
     s2 = div(mul(mul(gmr2, 5.0), q), mul(r5, r2))
-    ax = sub(mul(s1, mx), mul(s2, x))
-    ay = sub(mul(s1, my), mul(s2, y))
-    az = sub(mul(s1, mz), mul(s2, z))
-    # a_GCRS = T^T a_ITRS
-    return (add(add(mul(ax, tdat[0]), mul(ay, tdat[3])), mul(az, tdat[6])),
-            add(add(mul(ax, tdat[1]), mul(ay, tdat[4])), mul(az, tdat[7])),
-            add(add(mul(ax, tdat[2]), mul(ay, tdat[5])), mul(az, tdat[8])))
+    gx = add(add(mul(mx, tdat[0]), mul(my, tdat[3])), mul(mz, tdat[6]))  # T^T M' x
+    gy = add(add(mul(mx, tdat[1]), mul(my, tdat[4])), mul(mz, tdat[7]))
+    gz = add(add(mul(mx, tdat[2]), mul(my, tdat[5])), mul(mz, tdat[8]))
+    z3 = mul(z, 3.0)
+    gx = add(gx, mul(half, sub(mul(z3, px), rx)))
+    gy = add(gy, mul(half, sub(mul(z3, py), ry)))
+    gz = add(gz, mul(half, sub(mul(z3, pz), rz)))
+    return sub(mul(s1, gx), mul(s2, rx)), sub(mul(s1, gy), mul(s2, ry)), sub(mul(s1, gz), mul(s2, rz))
 
 
 @njit(cache=True, inline="always")

@@ -293,7 +293,8 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
         for k in range(n):
             if params[o + 1 + n + k] != 0.0:  # this body in extended precision
                 gx, gy, gz = third_body_accel_ext(x, y, z, tdat[c + 3 * k], tdat[c + 3 * k + 1],
-                                                  tdat[c + 3 * k + 2], params[o + 1 + k])
+                                                  tdat[c + 3 * k + 2], params[o + 1 + k], tdat[c + 3 * (n + k)],
+                                                  tdat[c + 3 * (n + k) + 1], tdat[c + 3 * (n + k) + 2])
                 ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
     if layout[SLOT_EARTH_FIELD, 0]:
         o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]

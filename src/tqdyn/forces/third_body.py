@@ -22,6 +22,23 @@ The bodies' positions are time-only inputs: a ``position`` callable
 (epoch, t_hi, t_lo) -> (..., 3) geocentric GCRS positions [m] at the times
 t = t_hi + t_lo [s TT since the epoch] (an ephemeris), evaluated by the
 propagator once per chunk for all stage times.
+
+Smooth inputs.  A body position rounded to float64 (ulp 3e-5 m at the
+Sun's 1.4e11 m, 6e-8 m at the Moon's 3.8e8 m) is not a smooth function of
+time; times the tidal gradient (~3 GM |r| / |s|^4: Sun 8e-17 s^-2, Moon
+7e-14 s^-2 at |r| = 1e8 m) it is a white noise of ~3e-21 m/s^2 in the force,
+which integrators sampling at other instants turn into different random
+walks.  So the positions come as dd pairs s = s_hi + s_lo when the provider
+has a ``position_dd`` method (the ephemeris does): the bodies evaluated in
+extended precision take s_hi + s_lo whole; the float64 bodies add the
+first-order effect of s_lo (|s_lo| <= ulp(s_hi) / 2),
+
+    a(r, s_hi + s_lo) = a(r, s_hi) + J(r, s_hi) s_lo + O(|s_lo|^2 / |s|^2),
+    J = da/ds = GM [(I - 3 e e^T) / |s - r|^3 - (I - 3 u u^T) / |s|^3],
+
+e = (s - r) / |s - r|, u = s / |s| (the derivative of x / |x|^3 is
+(I - 3 x x^T / |x|^2) / |x|^3); the neglected term is ~1e-16 of the
+correction.
 """
 
 from __future__ import annotations
@@ -36,7 +53,7 @@ from numba import njit
 from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
 
 __all__ = ["ThirdBodies", "pm_difference", "third_body_accel", "third_bodies_accel", "third_body_accel_ext",
-           "third_body_jerk"]
+           "third_body_jerk", "third_body_position_jacobian_times"]
 
 
 @njit(cache=True, inline="always")
@@ -70,13 +87,33 @@ def third_body_accel(rx, ry, rz, sx, sy, sz, gm):
     return k * (rx + f * sx), k * (ry + f * sy), k * (rz + f * sz)
 
 
+@njit(cache=True, inline="always")
+def third_body_position_jacobian_times(rx, ry, rz, sx, sy, sz, gm, ex, ey, ez):
+    """J(r, s) e [m/s^2]: the change of :func:`third_body_accel` when the
+    body moves from s to s + e (to first order), J = GM [(I - 3 d^ d^T) /
+    |d|^3 - (I - 3 s^ s^T) / |s|^3], d = s - r (module docstring).  r, s, e
+    [m], gm [m^3/s^2]: float64 scalars, one frame; returns (x, y, z)."""
+    dx, dy, dz = sx - rx, sy - ry, sz - rz
+    d2 = dx * dx + dy * dy + dz * dz
+    id3 = 1.0 / (d2 * math.sqrt(d2))
+    pd = 3.0 * (dx * ex + dy * ey + dz * ez) / d2
+    s2 = sx * sx + sy * sy + sz * sz
+    is3 = 1.0 / (s2 * math.sqrt(s2))
+    ps = 3.0 * (sx * ex + sy * ey + sz * ez) / s2
+    return (gm * ((ex - pd * dx) * id3 - (ex - ps * sx) * is3),
+            gm * ((ey - pd * dy) * id3 - (ey - ps * sy) * is3),
+            gm * ((ez - pd * dz) * id3 - (ez - ps * sz) * is3))
+
+
 @njit(cache=True)
-def third_body_accel_ext(rx, ry, rz, sx, sy, sz, gm):
+def third_body_accel_ext(rx, ry, rz, sx, sy, sz, gm, lx=0.0, ly=0.0, lz=0.0):
     """:func:`third_body_accel` in the number type of r (generic: dd tuples
     or float64): for extended-precision evaluation of the large third-body
     terms (Moon ~1e-5, Sun ~6e-6 m/s^2, whose float64 round-off, ~1e-21
-    m/s^2, accumulates to ~1e-12 m per day of orbit).  s, gm: float64."""
-    sx, sy, sz = const(sx, 0.0, rx), const(sy, 0.0, rx), const(sz, 0.0, rx)
+    m/s^2, accumulates to ~1e-12 m per day of orbit).  s + l: the body's
+    position as a dd pair (s, l float64 [m]; the float64 mode uses s alone);
+    gm: float64."""
+    sx, sy, sz = const(sx, lx, rx), const(sy, ly, rx), const(sz, lz, rx)
     s2 = add(add(mul(sx, sx), mul(sy, sy)), mul(sz, sz))
     q = div(add(add(mul(rx, sub(rx, mul(sx, 2.0))), mul(ry, sub(ry, mul(sy, 2.0)))),
                 mul(rz, sub(rz, mul(sz, 2.0)))), s2)
@@ -114,15 +151,19 @@ def third_body_jerk(gm, rx, ry, rz, vx, vy, vz, sx, sy, sz, ux, uy, uz):
 def third_bodies_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Sum of the point-mass terms of all bodies (the perturbation-kernel
     signature of :mod:`tqdyn.forces.model`): tdat = body positions (3 n,) [m]
-    at this instant, params = [n, gm_1, ..., gm_n, ext_1, ..., ext_n]; the
+    at this instant, then their low parts (3 n,) [m] (dd pairs, module
+    docstring), params = [n, gm_1, ..., gm_n, ext_1, ..., ext_n]; the
     bodies with ext_k != 0 are skipped here (evaluated in extended precision
     by the model).  float64, m/s^2."""
     ax, ay, az = 0.0, 0.0, 0.0
     n = int(params[0])
     for k in range(n):
         if params[1 + n + k] == 0.0:  # bodies flagged extended are evaluated by third_body_accel_ext
-            gx, gy, gz = third_body_accel(rx, ry, rz, tdat[3 * k], tdat[3 * k + 1], tdat[3 * k + 2], params[1 + k])
-            ax, ay, az = ax + gx, ay + gy, az + gz
+            sx, sy, sz = tdat[3 * k], tdat[3 * k + 1], tdat[3 * k + 2]
+            gx, gy, gz = third_body_accel(rx, ry, rz, sx, sy, sz, params[1 + k])
+            jx, jy, jz = third_body_position_jacobian_times(rx, ry, rz, sx, sy, sz, params[1 + k], tdat[3 * (n + k)],
+                                                            tdat[3 * (n + k) + 1], tdat[3 * (n + k) + 2])
+            ax, ay, az = ax + (gx + jx), ay + (gy + jy), az + (gz + jz)
     return ax, ay, az
 
 
@@ -136,6 +177,20 @@ class _OneBody:
     def __call__(self, epoch, t_hi, t_lo):
         return np.asarray(self.position(epoch, t_hi, t_lo))[..., self.k:self.k + 1, :]
 
+    def position_dd(self, epoch, t_hi, t_lo):
+        hi, lo = _positions_dd(self.position, epoch, t_hi, t_lo)
+        return hi[..., self.k:self.k + 1, :], lo[..., self.k:self.k + 1, :]
+
+
+def _positions_dd(position, epoch, t_hi, t_lo):
+    """(hi, lo) positions [m] of a provider: its ``position_dd`` if it has
+    one, else its float64 positions and zeros."""
+    if hasattr(position, "position_dd"):
+        hi, lo = position.position_dd(epoch, t_hi, t_lo)
+        return np.asarray(hi, dtype=np.float64), np.asarray(lo, dtype=np.float64)
+    hi = np.asarray(position(epoch, t_hi, t_lo), dtype=np.float64)
+    return hi, np.zeros_like(hi)
+
 
 @dataclass(frozen=True)
 class ThirdBodies:
@@ -145,7 +200,9 @@ class ThirdBodies:
     (epoch, t_hi, t_lo) -> (..., n_bodies, 3) float64 geocentric GCRS
     positions [m]; source: where the positions and GMs come from.
     Parameters handed to the compiled model: [n, gm_1, ..., gm_n];
-    time-only inputs: the 3 n coordinates.  extended: names of the bodies
+    time-only inputs: the 3 n coordinates, then their 3 n low parts (the
+    positions as dd pairs: ``position.position_dd`` if the provider has
+    it, else zeros).  extended: names of the bodies
     whose term is evaluated in the propagation's number type (dd) instead of
     float64 -- worth it for the Moon and the Sun, whose float64 round-off
     (~1e-21 m/s^2) moves a 1e8 m orbit by ~1e-12 m per day.
@@ -161,8 +218,8 @@ class ThirdBodies:
 
     @property
     def n_tdat(self) -> int:
-        """Time-only inputs per instant: 3 coordinates per body."""
-        return 3 * len(self.names)
+        """Time-only inputs per instant: 3 coordinates per body and their low parts."""
+        return 6 * len(self.names)
 
     def params(self) -> np.ndarray:
         """[n, gm_1, ..., gm_n, ext_1, ..., ext_n] float64 (ext_k = 1.0 for
@@ -181,9 +238,11 @@ class ThirdBodies:
 
     def precompute(self, epoch, t_hi, t_lo) -> np.ndarray:
         """Body positions at t_hi + t_lo [s TT since epoch], flattened to
-        (*shape(t_hi), 3 n) float64 [m]."""
-        pos = np.asarray(self.position(epoch, t_hi, t_lo), dtype=np.float64)
+        (*shape(t_hi), 6 n) float64 [m]: the 3 n coordinates (hi parts),
+        then their 3 n low parts."""
+        hi, lo = _positions_dd(self.position, epoch, t_hi, t_lo)
         expected = np.shape(t_hi) + (len(self.names), 3)
-        if pos.shape != expected:
-            raise ValueError(f"third-body positions: shape {pos.shape}, expected {expected}")
-        return pos.reshape(np.shape(t_hi) + (self.n_tdat,))
+        if hi.shape != expected or lo.shape != expected:
+            raise ValueError(f"third-body positions: shape {hi.shape}, expected {expected}")
+        shape = np.shape(t_hi) + (3 * len(self.names),)
+        return np.concatenate((hi.reshape(shape), lo.reshape(shape)), axis=-1)

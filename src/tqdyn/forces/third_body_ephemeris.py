@@ -21,8 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..astro.ephemeris import BODIES, Ephemeris, default_ephemeris, planetary_gm
-from ..astro.geocentric import TDB_TO_TT_SCALE, bcrs_to_gcrs
-from ..astro.timescales import tdb_jd
+from ..astro.geocentric import TDB_TO_TT_SCALE, bcrs_to_gcrs_offsets
+from ..astro.ephemeris_dd import tdb_seconds_dd
+from ..astro import timescales
+from ..astro.timescales import tdb_jd, tt_jd
+from ..numerics.dd import np_dd_add_d, np_fast_two_sum, np_two_prod
 from ..numerics.lagrange import MARGIN, grid_interp
 from .third_body import ThirdBodies
 
@@ -51,18 +54,38 @@ class EphemerisPositions:
         pos, _ = self.ephemeris.geocentric_states(self.names, jd1, jd2, velocity=False)
         if not self.gcrs:
             return pos
-        # X = K (r + delta): the 1PN part delta (<= 1.5e-8 r; periods >= 27 d)
-        # on an hourly TT grid, interpolated (error ~ (2 pi h / 27 d)^8 / 8! delta < 1e-19 m)
+        return TDB_TO_TT_SCALE * (pos + self._delta(epoch, t_hi, t_lo, pos.shape))
+
+    def position_dd(self, epoch, t_hi, t_lo=0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The positions of ``__call__`` as smooth functions of time: (hi,
+        lo), each (*shape(t_hi), n_bodies, 3) float64 [m], a dd pair.  The
+        ephemeris in dd at a dd TDB argument
+        (:meth:`tqdyn.astro.ephemeris.Ephemeris.geocentric_positions_dd`), the
+        1PN part delta (float64, interpolated: smooth) added and K applied in
+        dd."""
+        jd1, jd2 = tt_jd(epoch, t_hi, t_lo)
+        th, tl = tdb_seconds_dd(epoch, t_hi, t_lo, timescales.tdb_minus_tt(jd1, jd2))  # as tdb_jd looks it up
+        hi, lo = self.ephemeris.geocentric_positions_dd(self.names, th, tl)
+        if not self.gcrs:
+            return hi, lo
+        hi, lo = np_dd_add_d(hi, lo, self._delta(epoch, t_hi, t_lo, hi.shape))  # |delta| <= 1.5e-8 |pos|
+        p, e = np_two_prod(hi, np.float64(TDB_TO_TT_SCALE))
+        return np_fast_two_sum(p, e + lo * TDB_TO_TT_SCALE)
+
+    def _delta(self, epoch, t_hi, t_lo, shape) -> np.ndarray:
+        """The 1PN part delta [m] (shape) of X = K (r + delta) at t_hi + t_lo:
+        (<= 1.5e-8 r; periods >= 27 d) on an hourly TT grid, interpolated
+        (error ~ (2 pi h / 27 d)^8 / 8! delta < 1e-19 m)."""
         u = (np.asarray(t_hi, dtype=np.float64) + np.asarray(t_lo, dtype=np.float64)) / _GRID_S
-        u = np.broadcast_to(u, pos.shape[:-2]).ravel()
+        u = np.broadcast_to(u, shape[:-2]).ravel()
         if u.size == 0:
-            return TDB_TO_TT_SCALE * pos
+            return np.zeros(shape)
         k0 = int(math.floor(u.min())) - MARGIN
         k1 = int(math.floor(u.max())) + MARGIN + 1
         delta = self.correction(epoch, np.arange(k0, k1, dtype=np.float64) * _GRID_S)
         out = np.empty((u.size, delta.shape[1] * 3))
         grid_interp(u, k0, delta.reshape(delta.shape[0], -1), out)
-        return TDB_TO_TT_SCALE * (pos + out.reshape(pos.shape))
+        return out.reshape(shape)
 
     def correction(self, epoch, t) -> np.ndarray:
         """delta = X / K - r [m] (m, n_bodies, 3) at t (m,) [s TT since epoch]:
@@ -73,9 +96,10 @@ class EphemerisPositions:
         pos, vel = self.ephemeris.geocentric_states(bodies, jd1, jd2, velocity=True)
         _, v_earth = self.ephemeris.earth_barycentric(jd1, jd2)
         gm = dict(self.gms) if self.gms else planetary_gm()
-        x = bcrs_to_gcrs(pos, vel, v_earth, np.array([gm[b] for b in bodies]))
+        # formed without pos (X / K - pos would carry pos's rounding, ~3e-5 m for the Sun, into the
+        # nodes, and the interpolant would jump by that much from one grid interval to the next)
         n = len(self.names)
-        return x[:, :n] / TDB_TO_TT_SCALE - pos[:, :n]
+        return bcrs_to_gcrs_offsets(pos, vel, v_earth, np.array([gm[b] for b in bodies]))[:, :n]
 
 
 #: Step [s] of the grid of the 1PN correction.
