@@ -159,3 +159,30 @@ def test_interrupt_or_write_error_leaves_no_file(runs, made, tmp_path, capsys, m
         assert "no output file written" in err
         assert (out.read_bytes() == b"old") if existing else not out.exists()
         assert os.listdir(tmp_path) == (["cl.h5"] if existing else [])
+
+
+def test_the_progress_bars_follow_the_budget_then_the_samples():
+    """tqdyn.cli.closed_loop._Bars: a bar over the segment x spacecraft loops, closed when the last loop
+    is done; then a bar over the samples."""
+    from tqdyn.cli.closed_loop import _Bars
+
+    made = []
+
+    class Bar:
+        def __init__(self, total, unit, desc):
+            self.total, self.unit, self.n, self.closed = total, unit, 0, False
+            made.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def close(self):
+            self.closed = True
+
+    bars = _Bars(Bar, 6, 1000)
+    for _ in range(6):
+        bars.loops(1)
+    bars.samples(400)
+    bars.samples(600)
+    bars.close()
+    assert [(b.unit, b.total, b.n, b.closed) for b in made] == [("loop", 6, 6, True), ("sample", 1000, 1000, True)]

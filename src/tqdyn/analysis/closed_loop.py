@@ -161,13 +161,14 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
                            controllers=dict(ctl))
 
 
-def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None):
+def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, progress=None):
     """The noise budget as an ``xarray.Dataset``: ``asd`` (segment, sat, output, source, frequency) one-sided
     [output unit/Hz^1/2]; ``total`` (segment, sat, output, frequency); ``requirement`` (frequency) the
     mission's TM acceleration requirement [m/s^2/Hz^1/2]; ``dominant`` (segment, sat, output, band) the
     largest source per band (:data:`BANDS`); ``gain_margin`` [1] and ``phase_margin`` [deg] and
     ``crossover`` [Hz] per (segment, sat, channel).  ``dt`` [s]: the zero-order-hold discretised loops'
-    budget (what the time domain runs).  Coordinates carry units and frames (attrs)."""
+    budget (what the time domain runs).  ``progress``: called with 1 after each (segment, satellite) loop
+    (segments x satellites calls).  Coordinates carry units and frames (attrs)."""
     import xarray as xr
 
     s = model.settings
@@ -182,6 +183,8 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None):
             b, sources = noise_budget(model.loops[i][k][1], model.noise, f, dt=dt)
             per_sat.append(b)
             msat.append(loop_margins(model.loops[i][k][1]))
+            if progress is not None:
+                progress(1)
         asd = np.zeros((n_seg, len(model.loops)) + per_sat[0].shape) if asd is None else asd
         asd[k] = np.array(per_sat)
         margins.append(msat)

@@ -2,9 +2,10 @@
 
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.closed_loop`: the inputs are
 resolved and checked first (bad input: status 2, one line, nothing written), then the budget and the
-time series are written to the closed-loop file (docs/closed-loop-file.md) with a progress bar; a
-failed write exits with status 3, Ctrl-C with 130, and neither leaves a file at the output path (an
-existing file there is replaced only by a complete one, as ``tqdyn run`` does).
+time series are written to the closed-loop file (docs/closed-loop-file.md) with progress bars (the
+budget's loops, then the samples); a failed write exits with status 3, Ctrl-C with 130, and neither
+leaves a file at the output path (an existing file there is replaced only by a complete one, as
+``tqdyn run`` does).
 """
 
 from __future__ import annotations
@@ -18,6 +19,29 @@ from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO,
 __all__ = ["closed_loop"]
 
 
+class _Bars:
+    """Two progress bars one after the other: the budget's loops (segment x spacecraft), then the time
+    series' samples (opened when the budget's last loop is done, so that its rate counts samples only)."""
+
+    def __init__(self, make, n_loops: int, n_samples: int):
+        self.make, self.n_loops, self.n_samples = make, n_loops, n_samples
+        self.bar = make(n_loops, "loop", "budget")
+        self.done = 0
+
+    def loops(self, k: int) -> None:
+        self.bar.update(k)
+        self.done += k
+        if self.done >= self.n_loops:
+            self.bar.close()
+            self.bar = self.make(self.n_samples, "sample", "closed loop")
+
+    def samples(self, k: int) -> None:
+        self.bar.update(k)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
 @click.command("closed-loop")
 @click.argument("run_file", metavar="RUN.h5")
 @click.option("--output", "-o", required=True, help="Output closed-loop HDF5 file (replaced only by a complete one).")
@@ -28,7 +52,7 @@ __all__ = ["closed_loop"]
 @click.option("--set", "sets", multiple=True, metavar="closed_loop.KEY=VALUE",
               help="Override a closed-loop key of the run's scenario, e.g. --set closed_loop.n_freq=100 or "
                    "--set closed_loop.noise.thruster_force.level=1e-7 (repeatable; docs/scenarios.md).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bars.")
 def closed_loop(run_file, output, duration, fs, seed, sets, quiet):
     """The closed loop of the coupled run RUN.h5 (any mission): the drag-free, suspension, attitude
     and MOSA loops linearised around the run's working point (docs/closed-loop.md), their noise
@@ -47,20 +71,22 @@ def closed_loop(run_file, output, duration, fs, seed, sets, quiet):
     click.echo(f"tqdyn closed-loop: {job.attrs['source_file']}, mission {job.model.mission}, "
                f"{len(job.model.loops)} spacecraft x {len(job.model.loops[0])} segment(s); time series "
                f"{job.duration_s:g} s at {job.fs:g} Hz ({n} samples), seed {job.seed}", err=True)
-    bar = tqdm(total=n, disable=True if quiet else None, unit="sample", unit_scale=True, file=sys.stderr,
-               dynamic_ncols=True, desc="closed loop")
+    n_loops = len(job.model.loops) * len(job.model.loops[0])
+    bars = _Bars(lambda total, unit, desc: tqdm(total=total, disable=True if quiet else None, unit=unit,
+                                                unit_scale=unit == "sample", file=sys.stderr, dynamic_ncols=True,
+                                                desc=desc), n_loops, n)
     try:
-        summary = wf.closed_loop_to_file(job, progress=bar.update)
+        summary = wf.closed_loop_to_file(job, progress=bars.samples, budget_progress=bars.loops)
     except io.OutputIOError as exc:
-        bar.close()
+        bars.close()
         _fail(f"{exc}; no output file written", _EXIT_IO)
     except (ValueError, io.OutputError) as exc:
-        bar.close()
+        bars.close()
         _fail(str(exc))
     except KeyboardInterrupt:
-        bar.close()
+        bars.close()
         _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
-    bar.close()
+    bars.close()
     click.echo(f"budget: {summary.budget_s:.2f} s; time series: {summary.n_samples} samples x {summary.n_sat} "
                f"spacecraft in {summary.timeseries_s:.2f} s")
     click.echo(f"output: {summary.path} ({summary.size_bytes / 1e6:.1f} MB)")

@@ -152,17 +152,18 @@ class _Counting:
 
 
 def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 65536, budget=None,
-                        wrap=None) -> ClosedLoopSummary:
+                        wrap=None, budget_progress=None) -> ClosedLoopSummary:
     """Write the closed-loop file of ``job`` (:func:`check_closed_loop_inputs`): the budget
     (:func:`~tqdyn.analysis.closed_loop.closed_loop_budget`, or ``budget`` if given), then the time
-    series streamed block by block (``progress(n)`` after each block of n samples).  ``wrap``: a
+    series streamed block by block (``progress(n)`` after each block of n samples; ``budget_progress(1)``
+    after each of the budget's segment x spacecraft loops).  ``wrap``: a
     function of the writer returning the sink the simulation writes to (tests inject failures).
     On any failure or interrupt no file is left at the output path."""
     from ..analysis.closed_loop import closed_loop_budget, closed_loop_timeseries
     from ..closedloop.loop import OUTPUTS
 
     t0 = time.perf_counter()
-    ds = closed_loop_budget(job.model) if budget is None else budget
+    ds = closed_loop_budget(job.model, progress=budget_progress) if budget is None else budget
     t1 = time.perf_counter()
     try:
         with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
