@@ -58,7 +58,10 @@ How much the interpolation scheme matters (measured in ``tests/test_eop.py``,
 C04 nodes differ by up to ~7 us (rms ~2 us) in UT1 (5e-10 rad of Earth
 rotation angle) and ~2e-10 rad (45 uas) in polar motion at mid-day -- the
 day-to-day scatter of the series itself, below the C04's own stated errors
-(e.g. 2004-06-06: 14 us in UT1-UTC, 68 uas in x).  The IERS also recommends
+(e.g. 2004-06-06: 14 us in UT1-UTC, 68 uas in x).  The spline and the
+4-point interpolant differ by as much (every 0.05 d, 2004-2006): up to
+8.3 us (rms 1.4 us) in UT1 and 2.3e-10 rad (rms 6e-11 rad) in polar
+motion (``test_spline_vs_lagrange4_spread``).  The IERS also recommends
 removing the zonal tides from UT1 (TN36 Table 8.1, routine RG_ZONT2) before
 interpolating; that table is not shipped and this is not done (the cubic
 interpolation error of the largest zonal term, 13.66 d, ~0.4 ms, is < 0.4 us).

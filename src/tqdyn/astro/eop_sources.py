@@ -68,10 +68,10 @@ import numpy as np
 from ..readers.eop_c04 import EopSeries, iers_data_version, read_eop_c04, read_eop_c04_20
 from ..readers.eop_finals import read_finals2000a
 from .constants import MJD_JD0
-from .eop import DEFAULT_EOP_INTERPOLATION, EOP, EopSegment, EopSpanError, mean_pole_iers2010
+from .eop import DEFAULT_EOP_INTERPOLATION, EOP, EOP_INTERPOLATIONS, EopSegment, EopSpanError, mean_pole_iers2010
 from .timescales import Epoch, leap_seconds_note, tt_jd
 
-__all__ = ["DEFAULT_EOP_SOURCE", "EOP_SOURCES", "EOP_SOURCES_ALLOWED", "LONG_TERM_LAST_MJD", "LOD_WINDOW_DAYS",
+__all__ = ["DEFAULT_EOP_INTERPOLATION", "DEFAULT_EOP_SOURCE", "EOP_INTERPOLATIONS", "EOP_SOURCES", "EOP_SOURCES_ALLOWED", "LONG_TERM_LAST_MJD", "LOD_WINDOW_DAYS",
            "check_coverage", "coverage", "data_note", "describe_coverage", "describe_sources", "eop_table",
            "long_term_warning", "normalize_eop_source", "run_span_mjd", "truncate", "with_long_term"]
 
