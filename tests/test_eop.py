@@ -199,10 +199,13 @@ def test_installed_finals2000a():
 # interpolation
 
 
-def test_nodes_reproduced_exactly(eop):
-    v = eop.at(eop.mjd)
+@pytest.mark.parametrize("kind", ["spline", "lagrange4"])
+def test_nodes_reproduced_exactly(eop, kind):
+    tab = eop.with_interpolation(kind)
+    v = tab.at(tab.mjd)
     for name in ("xp", "yp", "dut1", "lod", "dx", "dy"):
-        assert np.array_equal(getattr(v, name), getattr(eop, name)), name
+        assert np.array_equal(getattr(v, name), getattr(tab, name)), name
+    assert np.array_equal(tab.ut1_minus_tai(tab.mjd), tab._table[:, 2])
 
 
 def _ref_interp(eop: EOP, x: float):
@@ -235,6 +238,8 @@ def _ref_interp(eop: EOP, x: float):
 
 
 def test_interpolation_vs_exact_lagrange(eop):
+    """The "lagrange4" interpolant (IERS interp.f) against exact rational 4-point Lagrange."""
+    eop = eop.with_interpolation("lagrange4")
     rng = np.random.default_rng(3)
     lo, hi = eop.span_mjd
     xs = list(rng.uniform(lo, hi, 60))
@@ -303,7 +308,7 @@ def test_interpolation_scheme_spread(eop):
     i0 = int(53005 - eop.mjd[0])
     i1 = int(54101 - eop.mjd[0])
     q = eop.mjd[i0:i1] + 0.5
-    four = eop._interp_columns(q)
+    four = eop.with_interpolation("lagrange4")._interp_columns(q)
     k = np.arange(i0, i1)[:, None] + np.arange(-3, 5)[None, :]  # 8 nodes around each mid-day
     s = 0.5
     offs = np.arange(-3, 5, dtype=float)
@@ -315,6 +320,74 @@ def test_interpolation_scheme_spread(eop):
           f"polar motion {d_pm:.1e} rad")
     # below the C04's own stated errors (2004-06-06: 14 us in UT1, 68 uas = 3.3e-10 rad in x)
     assert d_ut1 < 14e-6 and d_pm < 3.3e-10
+
+
+def _one_sided_derivatives(tab: EOP, nodes: np.ndarray) -> np.ndarray:
+    """(2 sides, 2 orders, n nodes, 6 columns): the first and second
+    derivatives [unit/d, unit/d^2] of the six interpolated columns at the node
+    MJDs from the left and from the right: from the exact cubic through the
+    interpolant's values at 4 points inside the day before / after each node
+    (each day's piece is a cubic, for both interpolants; the points are
+    multiples of 1/8 d, exact in float64 MJDs)."""
+    s = np.array([0.125, 0.375, 0.625, 0.875])
+    V = np.vander(s, 4)  # columns s^3, s^2, s, 1
+    out = []
+    for side in (-1.0, 0.0):
+        v = tab._interp_columns((nodes[:, None] + side + s[None, :]).ravel()).reshape(nodes.size, 4, 6)
+        c = np.linalg.solve(V, v.transpose(1, 0, 2).reshape(4, -1)).reshape(4, nodes.size, 6)
+        t0 = -side  # the node's offset in that day
+        out.append([3.0 * c[0] * t0**2 + 2.0 * c[1] * t0 + c[2], 6.0 * c[0] * t0 + 2.0 * c[1]])
+    return np.array(out)
+
+
+def test_spline_c2_at_nodes(eop):
+    """The spline's slope and curvature are continuous at the nodes: the
+    one-sided values differ by the round-off of the cubic fits (~1e3 eps of
+    the column's values per d, per d^2: ~1e-14 s/d^2 in UT1-TAI ~ -30 s); the
+    4-point Lagrange interpolant's slope jumps (by ~1/6 of the series' third
+    difference: >= 1e-3 of the slope itself; its curvature at a node is the
+    second central difference from either side)."""
+    nodes = eop.mjd[np.arange(15400, 16500, 7)]  # 2004..2007
+    scale = np.abs(eop._table[15400:16500]).max(axis=0)  # per column [rad, s]
+    left, right = _one_sided_derivatives(eop.with_interpolation("spline"), nodes)
+    spline = (np.abs(left - right).max(axis=1) / scale).max()
+    left, right = _one_sided_derivatives(eop.with_interpolation("lagrange4"), nodes)
+    l4_slope = (np.abs(left[0] - right[0]).max(axis=0) / np.abs(left[0]).max(axis=0)).min()
+    print(f"\nslope and curvature jumps at nodes: spline {spline:.1e} of the values (/d, /d^2), "
+          f"lagrange4 slope jump >= {l4_slope:.1e} of the slope")
+    assert spline < 1e-12
+    assert l4_slope > 1e-3
+
+
+def test_spline_vs_make_interp_spline(eop):
+    """The spline against an independent one: scipy's make_interp_spline
+    (B-spline basis, k = 3, not-a-knot) through the same 60 000 nodes; they
+    agree to the round-off of the two solves (~1e-15 relative)."""
+    from scipy.interpolate import make_interp_spline
+
+    tab = eop.with_interpolation("spline")
+    ref = make_interp_spline(tab.mjd, tab._table, k=3, axis=0)
+    rng = np.random.default_rng(11)
+    lo, hi = tab.span_mjd
+    x = np.concatenate([rng.uniform(lo, hi, 5000), [lo, lo + 0.3, hi - 0.7, hi]])
+    scale = np.abs(tab._table).max(axis=0)
+    dev = (np.abs(tab._interp_columns(x) - ref(x)) / scale).max()
+    assert dev < 1e-13, dev
+
+
+def test_spline_vs_lagrange4_spread(eop, record_number):
+    """The two interpolants between the nodes, 2004-2006 (every 0.05 d; C04 14):
+    they differ by the series' day-to-day scatter, as 4- vs 8-point Lagrange
+    (test_interpolation_scheme_spread), below the C04's own stated errors
+    (2004-06-06: 14 us in UT1-UTC, 68 uas = 3.3e-10 rad in x)."""
+    q = np.arange(53005.0, 54101.0, 0.05)
+    d = eop.with_interpolation("spline")._interp_columns(q) - eop.with_interpolation("lagrange4")._interp_columns(q)
+    ut1, pm = d[:, 2], np.hypot(d[:, 0], d[:, 1])
+    res = {"ut1_max_s": float(np.abs(ut1).max()), "ut1_rms_s": float(np.sqrt(np.mean(ut1**2))),
+           "pm_max_rad": float(pm.max()), "pm_rms_rad": float(np.sqrt(np.mean(pm**2)))}
+    print(f"\nspline vs lagrange4 2004-2006: {res}")
+    record_number("eop.spline_vs_lagrange4", res)
+    assert res["ut1_max_s"] < 14e-6 and res["pm_max_rad"] < 3.3e-10
 
 
 # ----------------------------------------------------------------------

@@ -163,3 +163,22 @@ def test_gm_keys_validated_in_one_line(tmp_path, capsys, value, words):
     assert status == 2 and len(err.strip().splitlines()) == 1, err
     assert all(w in err for w in words), err
     assert not out.exists()
+
+
+def test_old_file_without_eop_interpolation_reruns_with_lagrange4(tmp_path, capsys):
+    """A file written before forces.eop_interpolation existed (its resolved
+    scenario lacks the key) ran with the IERS 4-point scheme: re-running it
+    uses "lagrange4", not the default "spline"; an override still wins."""
+    a = tmp_path / "a.h5"
+    status, _, err = _run(["run", "tianqin-kepler", "--duration", "1h", "-o", str(a), "-q"], capsys)
+    assert status == 0, err
+    scen, _ = scenario_of_trajectory(a, [f"run.output={tmp_path / 'b.h5'}"])
+    assert scen.forces.eop_interpolation == "spline"
+    with h5py.File(a, "r+") as f:
+        text = f.attrs["scenario"]
+        assert 'eop_interpolation = "spline"' in text
+        f.attrs["scenario"] = "\n".join(x for x in text.splitlines() if not x.startswith("eop_interpolation"))
+    scen, _ = scenario_of_trajectory(a, [f"run.output={tmp_path / 'b.h5'}"])
+    assert scen.forces.eop_interpolation == "lagrange4"
+    scen, _ = scenario_of_trajectory(a, [f"run.output={tmp_path / 'b.h5'}", "forces.eop_interpolation=spline"])
+    assert scen.forces.eop_interpolation == "spline"

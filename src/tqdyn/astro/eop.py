@@ -21,13 +21,27 @@ What this module provides
 
 Interpolation
 -------------
-Four-point (cubic) Lagrange interpolation in MJD(UTC) between the daily
-nodes, the scheme of the IERS routine ``interp.f`` (IERS Gazette No. 13,
-"Interpolating IERS Earth orientation data", McCarthy, Gambis & Bizouard)
-recommended for the C04 series: for x in [MJD_i, MJD_i+1) the nodes
-i-1, i, i+1, i+2 are used (the first / last four nodes at the two ends of the
-table), so the interpolant reproduces every tabulated value exactly at its
-node and is continuous.
+Two interpolants of the same daily nodes in MJD(UTC), both exact at every
+node (:attr:`EOP.interpolation`, scenario key ``forces.eop_interpolation``):
+
+* ``"spline"`` (the default): the C2 cubic spline through all the nodes
+  (``scipy.interpolate.CubicSpline``, not-a-knot ends), its coefficients
+  computed once per table (24 numbers per day: ~10 MB for 1962-2099) and
+  evaluated by a small kernel.  Its value, slope and curvature are
+  continuous at the nodes, so the force model that rotates the Earth's field
+  with it is smooth in time: an integrator of order > 2 keeps its order
+  across the daily nodes (docs/precision.md, "The force model's own
+  noise").  Not-a-knot rather than natural ends: a natural spline forces
+  zero curvature at the table's two ends, an O(h^2) error there, where
+  not-a-knot keeps the O(h^4) of a cubic (the ends are the first days of
+  1962 and the long-term model's last days, far from any run; a node's
+  influence on the spline decays by 2 - sqrt(3) ~ 0.27 per day away from it).
+* ``"lagrange4"``: four-point (cubic) Lagrange interpolation, the scheme of
+  the IERS routine ``interp.f`` (IERS Gazette No. 13, "Interpolating IERS
+  Earth orientation data", McCarthy, Gambis & Bizouard) recommended for the
+  C04 series: for x in [MJD_i, MJD_i+1) the nodes i-1, i, i+1, i+2 are used
+  (the first / last four nodes at the two ends of the table).  It is
+  continuous, but its slope jumps at every node.
 
 UT1-UTC jumps by +1 s at every leap second.  It is therefore interpolated as
 UT1-TAI, which is smooth: the node values enter as
@@ -35,7 +49,7 @@ UT1-TAI, which is smooth: the node values enter as
 table (``erfa.dat``, which also carries the pre-1972 linear drifts), i.e. the
 interpolated quantity is UT1-TAI and TAI-UTC of the requested instant is
 added back.  For a query at a node the correction is zero and the tabulated
-UT1-UTC is returned exactly.  :meth:`EOP.ut1_minus_tai` gives UT1-TAI
+UT1-UTC is returned exactly (either interpolant).  :meth:`EOP.ut1_minus_tai` gives UT1-TAI
 directly (what :mod:`tqdyn.astro.earth_orientation` uses: UT1 = TAI + (UT1-TAI), no UTC
 needed).
 
@@ -44,7 +58,10 @@ How much the interpolation scheme matters (measured in ``tests/test_eop.py``,
 C04 nodes differ by up to ~7 us (rms ~2 us) in UT1 (5e-10 rad of Earth
 rotation angle) and ~2e-10 rad (45 uas) in polar motion at mid-day -- the
 day-to-day scatter of the series itself, below the C04's own stated errors
-(e.g. 2004-06-06: 14 us in UT1-UTC, 68 uas in x).  The IERS also recommends
+(e.g. 2004-06-06: 14 us in UT1-UTC, 68 uas in x).  The spline and the
+4-point interpolant differ by as much (every 0.05 d, 2004-2006): up to
+8.3 us (rms 1.4 us) in UT1 and 2.3e-10 rad (rms 6e-11 rad) in polar
+motion (``test_spline_vs_lagrange4_spread``).  The IERS also recommends
 removing the zonal tides from UT1 (TN36 Table 8.1, routine RG_ZONT2) before
 interpolating; that table is not shipped and this is not done (the cubic
 interpolation error of the largest zonal term, 13.66 d, ~0.4 ms, is < 0.4 us).
@@ -65,6 +82,7 @@ days of UTC (ERFA quasi-JD convention on leap-second days).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import warnings
@@ -85,7 +103,9 @@ from .constants import ARCSEC_RAD, J2000_JD, MJD_JD0
 __all__ = [
     "load_eop",
     "ARCSEC",
+    "DEFAULT_EOP_INTERPOLATION",
     "EOP",
+    "EOP_INTERPOLATIONS",
     "EOPValues",
     "EopSegment",
     "EopSpanError",
@@ -99,6 +119,11 @@ ARCSEC = ARCSEC_RAD  # rad per arcsec (astro.constants)
 
 _MJD_JD0 = MJD_JD0
 _DAY = 86400.0
+
+#: Interpolants of an :class:`EOP` table between its daily nodes (module docstring, "Interpolation").
+EOP_INTERPOLATIONS = ("spline", "lagrange4")
+#: The default: the C2 cubic spline (smooth force model in time).
+DEFAULT_EOP_INTERPOLATION = "spline"
 
 
 class EOPValues(NamedTuple):
@@ -218,6 +243,9 @@ class EOP(EopSeries):
     segments : tuple of :class:`EopSegment` (which source gave which rows, in
         order, covering every node); default: one "measured" segment named
         after ``source`` (or, with ``predicted``, its measured and predicted runs).
+    interpolation : one of :data:`EOP_INTERPOLATIONS` (default "spline"; the
+        IERS scheme is "lagrange4"); :meth:`with_interpolation` gives the
+        same table with the other one.
 
     TAI-UTC at the nodes (from ``erfa.dat``) is computed on construction and
     kept privately (it is what removes the leap-second jumps of UT1-UTC).
@@ -227,6 +255,7 @@ class EOP(EopSeries):
     source: str = "arrays"
     predicted: np.ndarray | None = None
     segments: tuple = ()
+    interpolation: str = DEFAULT_EOP_INTERPOLATION
     _dat0: np.ndarray = field(init=False, repr=False)
     _dlod: np.ndarray = field(init=False, repr=False)
     _daylen: np.ndarray = field(init=False, repr=False)
@@ -239,6 +268,9 @@ class EOP(EopSeries):
                    getattr(series, "predicted", None))
 
     def __post_init__(self):
+        if self.interpolation not in EOP_INTERPOLATIONS:
+            raise ValueError(f"EOP.interpolation: {self.interpolation!r} is not an interpolant; allowed: "
+                             + ", ".join(f'"{k}"' for k in EOP_INTERPOLATIONS))
         cols = {}
         for name in ("mjd", "xp", "yp", "dut1", "lod", "dx", "dy"):
             a = np.array(getattr(self, name), dtype=np.float64)  # own copy
@@ -311,6 +343,34 @@ class EOP(EopSeries):
             raise ValueError("EOP.segments: must cover the nodes in order, without gaps or overlaps")
         object.__setattr__(self, "segments", segs)
 
+    def with_interpolation(self, interpolation: str) -> "EOP":
+        """This table interpolated with ``interpolation`` (one of
+        :data:`EOP_INTERPOLATIONS`): ``self`` if it already is, else a copy
+        made once and kept (the same object on every call)."""
+        if interpolation == self.interpolation:
+            return self
+        variants = self.__dict__.setdefault("_variants", {})
+        if interpolation not in variants:
+            variants[interpolation] = dataclasses.replace(self, interpolation=interpolation)
+        return variants[interpolation]
+
+    @functools.cached_property
+    def _spline(self) -> np.ndarray:
+        """(n, 4, 6) float64: the not-a-knot cubic spline of the six columns of
+        ``_table`` on the unit-spaced nodes, row k = the cubic of [k, k+1) as
+        Horner coefficients in s = x - k (c0 s^3 + c1 s^2 + c2 s + c3, c3 the
+        node value itself); the last row re-expands the last cubic about the
+        last node (value exact there)."""
+        from scipy.interpolate import CubicSpline
+
+        n = self.mjd.size
+        sp = CubicSpline(np.arange(n, dtype=np.float64), self._table, axis=0, bc_type="not-a-knot")
+        c = np.empty((n, 4, self._table.shape[1]))
+        c[:-1] = np.moveaxis(sp.c, 0, 1)
+        c[-1] = [sp.c[0, -1], 0.5 * sp(n - 1.0, 2), sp(n - 1.0, 1), self._table[-1]]
+        c.setflags(write=False)
+        return c
+
     # ------------------------------------------------------------------
     @property
     def span_mjd(self) -> tuple[float, float]:
@@ -340,7 +400,7 @@ class EOP(EopSeries):
     def at(self, mjd_utc) -> EOPValues:
         """Interpolated EOP at ``mjd_utc`` [d, MJD in UTC], any shape.
 
-        4-point Lagrange interpolation (see the module docstring); UT1-UTC
+        Interpolated with :attr:`interpolation` (see the module docstring); UT1-UTC
         is interpolated as UT1-TAI (leap-second jumps removed) and TAI-UTC of
         the query instant is added back.  At a node the tabulated values are
         returned exactly.  Returns an :class:`EOPValues` of float64 arrays of
@@ -351,9 +411,14 @@ class EOP(EopSeries):
         shape = mjd.shape
         mjd = mjd.ravel()
         cols = self._interp_columns(mjd)
-        # UT1-UTC = sum_j w_j (UT1-UTC_j + (TAI-UTC(q) - TAI-UTC_j)): exact at nodes
         day = self._day_index(mjd)
         dat_q = self._tai_utc(mjd, day)
+        if self.interpolation == "spline":
+            # UT1-UTC_day + (UT1-TAI(q) - UT1-TAI_day) + (TAI-UTC(q) - TAI-UTC_day): exact at nodes
+            dut1 = self.dut1[day] + (cols[:, 2] - self._table[day, 2]) + (dat_q - self._dat0[day])
+            c = [cols[:, 0], cols[:, 1], dut1, cols[:, 3], cols[:, 4], cols[:, 5]]
+            return EOPValues(*(a.reshape(shape) for a in c))
+        # UT1-UTC = sum_j w_j (UT1-UTC_j + (TAI-UTC(q) - TAI-UTC_j)): exact at nodes
         vals = np.stack([self.dut1, self._dat0], axis=1)
         adj = np.empty((mjd.size, 4))
         k = np.empty(mjd.size, dtype=np.int64)
@@ -371,7 +436,7 @@ class EOP(EopSeries):
         return self._tai_utc(mjd, self._day_index(mjd))
 
     def ut1_minus_tai(self, mjd_utc) -> np.ndarray:
-        """UT1-TAI [s] at ``mjd_utc`` [d, UTC], 4-point Lagrange (smooth across leap seconds)."""
+        """UT1-TAI [s] at ``mjd_utc`` [d, UTC], :attr:`interpolation` (smooth across leap seconds)."""
         mjd = np.asarray(mjd_utc, dtype=np.float64)
         return self._interp_columns(mjd.ravel())[:, 2].reshape(mjd.shape)
 
@@ -380,7 +445,11 @@ class EOP(EopSeries):
         if check:
             self._check_span(mjd)
         out = np.empty((mjd.size, 6))
-        _lagrange4_table(np.ascontiguousarray(mjd - self.mjd[0]), self._table, out)
+        x = np.ascontiguousarray(mjd - self.mjd[0])
+        if self.interpolation == "spline":
+            _cubic_table(x, self._spline, out)
+        else:
+            _lagrange4_table(x, self._table, out)
         return out
 
     def mjd_utc_from_tai(self, mjd_tai) -> np.ndarray:
@@ -431,6 +500,22 @@ def _lagrange4_table(x, table, out):
         k, w0, w1, w2, w3 = _lagrange4(x[i], n_nodes)
         for c in range(m):
             out[i, c] = w0 * table[k, c] + w1 * table[k + 1, c] + w2 * table[k + 2, c] + w3 * table[k + 3, c]
+
+
+@njit(cache=True)
+def _cubic_table(x, coef, out):
+    """out[i, c] = the piecewise cubic of coef (n, 4, m) (row k: Horner
+    coefficients in s = x - k on [k, k+1)) at x[i], k clamped to 0..n-1."""
+    n, _, m = coef.shape
+    for i in range(x.size):
+        k = int(math.floor(x[i]))
+        if k < 0:
+            k = 0
+        if k > n - 1:
+            k = n - 1
+        s = x[i] - k
+        for c in range(m):
+            out[i, c] = ((coef[k, 0, c] * s + coef[k, 1, c]) * s + coef[k, 2, c]) * s + coef[k, 3, c]
 
 
 @njit(cache=True)

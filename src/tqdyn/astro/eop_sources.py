@@ -68,10 +68,10 @@ import numpy as np
 from ..readers.eop_c04 import EopSeries, iers_data_version, read_eop_c04, read_eop_c04_20
 from ..readers.eop_finals import read_finals2000a
 from .constants import MJD_JD0
-from .eop import EOP, EopSegment, EopSpanError, mean_pole_iers2010
+from .eop import DEFAULT_EOP_INTERPOLATION, EOP, EOP_INTERPOLATIONS, EopSegment, EopSpanError, mean_pole_iers2010
 from .timescales import Epoch, leap_seconds_note, tt_jd
 
-__all__ = ["DEFAULT_EOP_SOURCE", "EOP_SOURCES", "EOP_SOURCES_ALLOWED", "LONG_TERM_LAST_MJD", "LOD_WINDOW_DAYS",
+__all__ = ["DEFAULT_EOP_INTERPOLATION", "DEFAULT_EOP_SOURCE", "EOP_INTERPOLATIONS", "EOP_SOURCES", "EOP_SOURCES_ALLOWED", "LONG_TERM_LAST_MJD", "LOD_WINDOW_DAYS",
            "check_coverage", "coverage", "data_note", "describe_coverage", "describe_sources", "eop_table",
            "long_term_warning", "normalize_eop_source", "run_span_mjd", "truncate", "with_long_term"]
 
@@ -127,13 +127,14 @@ def _quiet_dat(mjd: np.ndarray) -> np.ndarray:
 _COLS = ("mjd", "xp", "yp", "dut1", "lod", "dx", "dy")
 
 
-def _table(parts: list[tuple[EopSeries, np.ndarray, list[EopSegment]]], source: str) -> EOP:
+def _table(parts: list[tuple[EopSeries, np.ndarray, list[EopSegment]]], source: str,
+           interpolation: str = DEFAULT_EOP_INTERPOLATION) -> EOP:
     """One EOP table from (series, row selection, segments) parts, in order."""
     cols = {c: np.concatenate([getattr(s, c)[sel] for s, sel, _ in parts]) for c in _COLS}
     pred = np.concatenate([np.zeros(int(sel.sum()), bool) if s.predicted is None else np.asarray(s.predicted)[sel]
                            for s, sel, _ in parts])
     segs = tuple(g for _, _, segs in parts for g in segs)
-    return EOP(*(cols[c] for c in _COLS), source=source, predicted=pred, segments=segs)
+    return EOP(*(cols[c] for c in _COLS), source=source, predicted=pred, segments=segs, interpolation=interpolation)
 
 
 def _runs(series: EopSeries, sel: np.ndarray, labels: tuple[str, str]) -> list[EopSegment]:
@@ -197,7 +198,7 @@ def with_long_term(eop: EOP, last_mjd: float = LONG_TERM_LAST_MJD, lod_window: i
     base = EopSeries(eop.mjd, eop.xp, eop.yp, eop.dut1, eop.lod, eop.dx, eop.dy, eop.source,
                      np.zeros(eop.mjd.size, bool) if eop.predicted is None else eop.predicted)
     return _table([(base, np.ones(eop.mjd.size, bool), list(eop.segments)),
-                   (model, np.ones(m.size, bool), [seg])], source or eop.source)
+                   (model, np.ones(m.size, bool), [seg])], source or eop.source, eop.interpolation)
 
 
 def truncate(eop: EOP, last_mjd: float, source: str | None = None) -> EOP:
@@ -210,18 +211,20 @@ def truncate(eop: EOP, last_mjd: float, source: str | None = None) -> EOP:
     segs = [g._replace(last=min(g.last, float(last_mjd))) for g in eop.segments if g.first <= last_mjd]
     base = EopSeries(eop.mjd, eop.xp, eop.yp, eop.dut1, eop.lod, eop.dx, eop.dy, eop.source,
                      np.zeros(eop.mjd.size, bool) if eop.predicted is None else eop.predicted)
-    return _table([(base, sel, segs)], source or eop.source)
+    return _table([(base, sel, segs)], source or eop.source, eop.interpolation)
 
 
-def eop_table(source: str | bool = DEFAULT_EOP_SOURCE) -> EOP | None:
-    """The EOP table of a source name (or True / False), built once and cached.
+def eop_table(source: str | bool = DEFAULT_EOP_SOURCE, interpolation: str = DEFAULT_EOP_INTERPOLATION) -> EOP | None:
+    """The EOP table of a source name (or True / False), built once and cached,
+    interpolated with ``interpolation`` (:data:`tqdyn.astro.eop.EOP_INTERPOLATIONS`).
 
     "auto": 20 C04 + finals2000A (measured, predicted) + the long-term model
     to 2099-12-31; "finals": without the long-term model; "c04-20"; "c04-14"
     (the shipped file); "off": None.  Raises ValueError for an unknown
     name, FileNotFoundError if astropy-iers-data is missing.
     """
-    return _eop_table(normalize_eop_source(source))
+    eop = _eop_table(normalize_eop_source(source))
+    return None if eop is None else eop.with_interpolation(interpolation)
 
 
 @functools.lru_cache(maxsize=None)

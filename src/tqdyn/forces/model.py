@@ -185,7 +185,8 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
     """ForceModel from a scenario's ``ForcesConfig`` (one shared ephemeris)
     in the reference system of the scenario's central body (the terms of
     this module are the geocentric ones).  ``eop``: the EOP table of
-    ``forces.eop`` (:func:`tqdyn.astro.eop_sources.eop_table`) unless an
+    ``forces.eop``, interpolated as ``forces.eop_interpolation``
+    (:func:`tqdyn.astro.eop_sources.eop_table`) unless an
     :class:`~tqdyn.astro.eop.EOP` table (or None: no EOP) is given, e.g. to
     compare sources."""
     if reference.central_body == "sun":
@@ -204,7 +205,7 @@ def build_force_model(forces, reference: ReferenceSystem = GEOCENTRIC, eop=_FROM
         from ..astro.eop_sources import eop_table
 
         source = forces.eop
-        eop = eop_table(source) if forces.earth_degree else None
+        eop = eop_table(source, forces.eop_interpolation) if forces.earth_degree else None
     else:
         source = "custom" if eop is not None else "off"
     orientation = _Orientation(eop)

@@ -17,7 +17,8 @@ from decimal import Decimal, localcontext
 
 from ..astro.reference import CENTRAL_BODIES, ReferenceSystem, reference_system
 from ..astro.constants import GM_EARTH_EGM2008
-from ..astro.eop_sources import DEFAULT_EOP_SOURCE, EOP_SOURCES, EOP_SOURCES_ALLOWED, normalize_eop_source
+from ..astro.eop_sources import (DEFAULT_EOP_INTERPOLATION, DEFAULT_EOP_SOURCE, EOP_INTERPOLATIONS, EOP_SOURCES,
+                                  EOP_SOURCES_ALLOWED, normalize_eop_source)
 from ..astro.timescales import Epoch
 from ..forces.body_gms import BODY_GM_KEYS, default_body_gm
 from ..numerics import multistep as _ms
@@ -30,16 +31,13 @@ __all__ = [
     "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig",
 ]
 
-_PRECISIONS = ("dd", "float64")
-_METHODS = ("dp87", "multistep")
-_MODES = ("fixed", "adaptive")
-_TABLEAUS = ("corrected", "published")
+_PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), \
+    ("corrected", "published")
 _RTOL_MAX = 1e-3
-#: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive
-#: mode) a run may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at the rates
-#: of ``tqdyn bench`` (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (the full TianQin model),
-#: and write ~1e11 bytes per satellite (output_every = 1).  A count above this is a mistyped
-#: duration or step (1e12 d at 50 s is 1.7e15 steps and would never finish); raise run.max_steps to override.
+#: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive mode) a run
+#: may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at ``tqdyn bench``'s rates
+#: (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (full TianQin model) and write ~1e11 bytes per
+#: satellite (output_every = 1): a count above is a mistyped duration or step; raise run.max_steps to override.
 MAX_STEPS = 1_000_000_000
 from .initial import BODY_RADII_M, check_above_surface  # noqa: F401
 from .spacecraft import SELF_GRAVITY_MODELS, TM_AXES, SpacecraftConfig  # noqa: F401  (re-exported)
@@ -188,7 +186,8 @@ class ForcesConfig:
     ``eop``: the source of polar motion, UT1-UTC and celestial-pole offsets,
     one of :data:`tqdyn.astro.eop_sources.EOP_SOURCES` (default "auto":
     measured, predicted, then the long-term model; true = "auto", false =
-    "off": none, for tests and comparisons); stored as the name.
+    "off": none, for tests and comparisons); stored as the name.  ``eop_interpolation``: "spline" (C2 cubic
+    spline of the daily values, the default: smooth in time) or "lagrange4" (IERS 4-point); :mod:`tqdyn.astro.eop`.
     """
 
     earth_monopole: bool = True
@@ -210,6 +209,7 @@ class ForcesConfig:
     relativity: bool = False
     earth_field_indirect: bool = False
     eop: str = DEFAULT_EOP_SOURCE
+    eop_interpolation: str = DEFAULT_EOP_INTERPOLATION
     # GMs of the point-mass bodies (BODY_GM_KEYS), TDB-compatible
     gm_sun: Decimal = _gm_field("sun")
     gm_earth_tdb: Decimal = _gm_field("earth")
@@ -256,6 +256,7 @@ class ForcesConfig:
             _require(getattr(self, key) > 0, f"forces.{key}", getattr(self, key), "is not positive",
                      f"{key} > 0 m^3/s^2 (default: DE430/DE431, data/gm_de431.tpc)")
         _require_choice(self.relativity_model, "forces.relativity_model", RELATIVITY_MODELS)
+        _require_choice(self.eop_interpolation, "forces.eop_interpolation", EOP_INTERPOLATIONS)
 
 
 POINTING_LAWS = ("none", "global", "taylor1", "taylor2", "iterative")
@@ -547,7 +548,7 @@ class Scenario:
                 f"pole_tides = {b(f.pole_tides)}", f"atmospheric_tides = {b(f.atmospheric_tides)}",
                 f"moon_degree = {f.moon_degree}", f"moon_libration = {toml_str(f.moon_libration)}", f"sun_j2 = {b(f.sun_j2)}",
                 f"relativity = {b(f.relativity)}", f"earth_field_indirect = {b(f.earth_field_indirect)}",
-                f"eop = {toml_str(f.eop)}",
+                f"eop = {toml_str(f.eop)}", f"eop_interpolation = {toml_str(f.eop_interpolation)}",
                 *(f"{key} = {toml_value(getattr(f, key))}  # m^3/s^2, TDB-compatible" for key in BODY_GM_KEYS.values())]
         if f.relativity_model != "iers2010":  # the default is left implicit
             out += [f"relativity_model = {toml_str(f.relativity_model)}"]

@@ -178,6 +178,9 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
     the file's constants record (root attribute ``constants``,
     :func:`tqdyn.scenario.record.compare_constants`, for the scenario without
     the overrides): none means the run reproduces the file bit for bit.
+    A file written before ``forces.eop_interpolation`` existed (its resolved
+    [forces] lacks the key) ran with the IERS 4-point scheme: it is re-run
+    with "lagrange4", not with today's default.
     ``writes``: the run will write ``run.output``, which must not be ``path``.
     Raises FileNotFoundError, ValueError (one line: not a trajectory, no
     scenario, the output would replace ``path``) or ScenarioError."""
@@ -191,7 +194,14 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
     src = f"{path} (attribute scenario)"
     if not isinstance(text, str) or not text.strip():
         raise ValueError(f"{path}: the trajectory records no scenario; allowed: a trajectory file written by tqdyn run")
-    scen = loads_scenario(text, source=src)
+    import tomllib
+
+    try:
+        old = "eop_interpolation" not in tomllib.loads(text).get("forces", {})
+    except tomllib.TOMLDecodeError:
+        old = False  # loads_scenario reports it
+    legacy = ["forces.eop_interpolation=lagrange4"] if old else []
+    scen = loads_scenario(text, legacy, source=src)
     notes = []
     recorded = attrs.get("constants")
     if recorded is None:
@@ -203,7 +213,7 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
             more = f" (and {len(diffs) - 1} more)" if len(diffs) > 1 else ""
             notes.append(f"{path}: this tqdyn will not reproduce the file's run: {diffs[0]}{more}")
     if overrides:
-        scen = loads_scenario(text, overrides, source=src)
+        scen = loads_scenario(text, [*legacy, *overrides], source=src)
     out = os.path.abspath(os.path.expanduser(scen.run.output))
     if writes and os.path.exists(out) and os.path.samefile(out, path):
         raise ValueError(f"run.output: {scen.run.output!r} is the trajectory the scenario is read from; allowed: "
