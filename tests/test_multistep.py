@@ -201,11 +201,11 @@ def test_orders_kepler_tianqin_and_lisa(record_number):
 def test_corrector_smooths_the_rows(record_number):
     """Coupled tianqin, 10 days, K = 10: the rows' positions are formed with
     the corrector's coefficients (sum of |CP_j| 3.9) instead of the
-    predictor's (122), which amplify the float64 noise of the inputs.  The
+    predictor's (122), which amplify the rounding noise of the force.  The
     rms of the fourth differences of (multistep - DP87) rows, over 70 (the
-    fourth differences' noise gain): measured 5.1e-16 m with the predictor
-    alone, 1.6e-17 m with PEC and PECE.  Bound: PEC and PECE at most 1/10
-    of PE's."""
+    fourth differences' noise gain): measured 1.5e-18 m with the predictor
+    alone, 4.8e-20 m with PEC and PECE (smooth inputs; 5.1e-16 / 1.6e-17 m
+    with float64 ones).  Bound: PEC and PECE at most 1/10 of PE's."""
     dp, _ = _rows("tianqin", ["run.duration=10d"])
     rms = {}
     for corrector in ("pe", "pec", "pece"):
@@ -302,10 +302,11 @@ def test_coupled_float64_mode():
 def test_coupled_smooth_model_ninety_days_acceptance(record_number):
     """Acceptance, on the smooth model: 90 days, satellites and TMs within
     1e-12 m of DP87 at 50 s, G and suspensions equal to 1e-6 relative.
-    Measured 1.6e-14 m and 6.0e-16 / 4.6e-16 relative (DP87 at 25 s
-    differs from DP87 at 50 s by 3.9e-13 m: the relativity term's CIP
-    direction is interpolated on nodes that depend on the block of
-    instants evaluated together; recorded, not asserted); bounds 1e-13 m, 5e-15."""
+    Measured 1.2e-14 m and 3.0e-16 / 3.1e-16 relative (DP87 at 25 s
+    differs from DP87 at 50 s by 1.7e-14 m; 3.9e-13 m while the relativity
+    term's CIP direction was interpolated on nodes that depended on the
+    block of instants evaluated together; recorded, not asserted); bounds
+    1e-13 m, 5e-15."""
     d, _ = _compare("tianqin", SMOOTH, "90d")
     print(f"\nsmooth coupled model, 90 days, multistep vs DP87: {d}")
     dp, _ = _rows("tianqin", ["run.duration=90d", *SMOOTH])
