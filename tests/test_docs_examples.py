@@ -1,4 +1,4 @@
-"""The Python examples of the documentation run (docs/python.md).
+"""The Python examples of the documentation run (README.md, docs/python.md, docs/lisa-toolchain.md).
 
 Each ```python block of the listed pages is executed in a fresh namespace in
 a temporary directory (matplotlib without a display); a block fails the test
@@ -13,11 +13,11 @@ import re
 import pytest
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs"
-PAGES = ("python.md", "lisa-toolchain.md")
+PAGES = ("../README.md", "python.md", "lisa-toolchain.md")
 
 
 def _blocks(page):
-    text = (DOCS / page).read_text(encoding="utf-8")
+    text = (DOCS / page).resolve().read_text(encoding="utf-8")
     return re.findall(r"```python\n(.*?)```", text, re.S)
 
 
