@@ -1,0 +1,232 @@
+"""Tilt-to-length (TTL) coupling of the six links, in LISA Instrument's convention.
+
+Indices (LISA Instrument 2.3, ``orbiting/constellation_enums.py`` ``MosaID``): MOSA ``ij`` sits on
+spacecraft ``i`` and points to spacecraft ``j``; it receives the beam emitted by MOSA ``ji``
+(``MosaID.distant``).  Link ``ij`` is named by its receiving MOSA.  Order :data:`MOSAS`.
+
+Angles: phi (yaw) and eta (pitch) of each MOSA, rad, as built by :func:`mosa_angles`.
+
+The TTL path-length term of link ``ij`` (m, positive = a longer apparent optical path, the sign with
+which LISA Instrument 2.3 subtracts ``nu (ttl - x) / c`` from the received carrier,
+``instru/instru_formulas.py`` ``distant_carrier_fluctuations`` and ``carrier_fluctuations``)::
+
+    s_ij(t) = P^local_ij(phi_ij(t), eta_ij(t)) + P^distant_ji(phi_ji(t - tau_ij), eta_ji(t - tau_ij))
+
+    P^k_m(phi, eta) = c^k_phi,m phi + c^k_eta,m eta + q^k_phiphi,m phi^2 + q^k_etaeta,m eta^2
+                      + q^k_phieta,m phi eta                                 (k = local, distant)
+
+The local term uses the receiving MOSA's own angles and its *local* coefficients; the distant term
+is formed at the emitting MOSA ``ji`` with *its* distant coefficients (LISA Instrument keys the
+distant coefficients by the emitting MOSA: ``distant_ttls[mosa.distant]``,
+``instru/instru_model.py`` ``_lock_on_distant``) and delayed by the light travel time tau_ij of the
+link (s, at the reception time t).  The linear part is LISA Instrument's ``local_ttls`` and
+``distant_ttls`` (``instru/instru_formulas.py``); the quadratic part is tqdyn's (zero by default).
+LISA Instrument feeds those functions angular velocities (rad/s) and gets m/s; with constant
+coefficients and no quadratic part that is the time derivative of s_ij.
+
+Fractional delay: the emitted term, sampled at t0 + k dt, is evaluated at t - tau_ij by the 8-point
+(degree 7) Lagrange interpolant on the nodes floor(u) - 3 .. floor(u) + 4 (u = k - tau/dt), those
+of :func:`tqdyn.numerics.lagrange.grid_interp` and of LISA Instrument's ``interp_order=7``; for a
+signal of frequency f its relative error is ~ (2 pi f dt)^8 / 8!.  Samples whose stencil leaves the series are NaN.
+
+Units SI (rad, m, s, m/rad, m/rad^2); time series are 1-D arrays of shape (n,) on one uniform grid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ..numerics.lagrange import MARGIN, POINTS
+
+__all__ = ["MOSAS", "MOSA_OPENING_ANGLES_RAD", "RANDOM_HALF_WIDTH_M_PER_RAD", "SPACECRAFT",
+           "TTLCoefficients", "distant_mosa", "link_ttl", "mosa_angles", "ttl_terms"]
+
+#: MOSA (and link) indices, LISA Instrument's order.
+MOSAS = ("12", "23", "31", "13", "32", "21")
+#: Spacecraft indices.
+SPACECRAFT = ("1", "2", "3")
+#: Oriented MOSA opening angles (rad): LISA Instrument 2.3 ``instru_defaults.MOSA_ANGLES`` (+/-30 deg).
+MOSA_OPENING_ANGLES_RAD = {m: (1.0 if m in ("12", "23", "31") else -1.0) * math.pi / 6 for m in MOSAS}
+#: Half-widths (m/rad) of the uniform draws of :meth:`TTLCoefficients.random`: LISA Instrument 2.3
+#: ``instru_defaults.random_ttl_coeffs_*`` (LISA-UKOB-INST-ML-0001-i2, 2.2 mm/rad local, 2.4 distant).
+RANDOM_HALF_WIDTH_M_PER_RAD = {"local": 2.2e-3, "distant": 2.4e-3}
+
+_HALF = POINTS // 2
+_NODES = tuple(range(-_HALF + 1, _HALF + 1))  # -3 .. 4 around floor(u)
+
+
+def distant_mosa(mosa: str) -> str:
+    """The MOSA that emits the beam received by ``mosa`` ("12" -> "21")."""
+    return mosa[::-1]
+
+
+def _check_keys(field: str, d, allowed: tuple) -> None:
+    if not isinstance(d, dict):
+        raise ValueError(f"{field} = {d!r}: expected a dict keyed by {', '.join(allowed)}")
+    for k in d:
+        if k not in allowed:
+            raise ValueError(f"{field}: unknown key {k!r} (allowed: {', '.join(allowed)})")
+    for k in allowed:
+        if k not in d:
+            raise ValueError(f"{field}: missing key {k!r} (needed: {', '.join(allowed)})")
+
+
+def _finite_float(field: str, v, unit: str) -> float:
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not math.isfinite(x):
+        raise ValueError(f"{field} = {v!r}: must be a finite number ({unit})")
+    return x
+
+
+@dataclass(frozen=True)
+class TTLCoefficients:
+    """TTL coefficients of the six MOSAs, each a dict MOSA -> value.
+
+    ``local_*`` act on the receiving MOSA's angles, ``distant_*`` on the emitting MOSA's (keyed by
+    the emitting MOSA, as LISA Instrument's ``ttl_coeffs``).  Linear ones in m/rad; the optional
+    quadratic ones (``*_phiphi``, ``*_etaeta``, ``*_phieta``) in m/rad^2, zero when None.
+    Validated on construction (six MOSA keys, finite values)."""
+
+    local_phi: dict
+    local_eta: dict
+    distant_phi: dict
+    distant_eta: dict
+    local_phiphi: dict | None = None
+    local_etaeta: dict | None = None
+    local_phieta: dict | None = None
+    distant_phiphi: dict | None = None
+    distant_etaeta: dict | None = None
+    distant_phieta: dict | None = None
+
+    def __post_init__(self):
+        for f in fields(self):
+            d = getattr(self, f.name)
+            quad = f.name.endswith(("phiphi", "etaeta", "phieta"))
+            if d is None:
+                d = {m: 0.0 for m in MOSAS}
+            _check_keys(f"ttl.{f.name}", d, MOSAS)
+            unit = "m/rad^2" if quad else "m/rad"
+            object.__setattr__(self, f.name, {m: _finite_float(f"ttl.{f.name}[{m!r}]", d[m], unit) for m in MOSAS})
+
+    @classmethod
+    def constant(cls, local_phi: float, local_eta: float, distant_phi: float, distant_eta: float) -> "TTLCoefficients":
+        """The same linear coefficients (m/rad) on every MOSA, no quadratic part."""
+        return cls(*({m: v for m in MOSAS} for v in (local_phi, local_eta, distant_phi, distant_eta)))
+
+    @classmethod
+    def random(cls, seed: int, local_half_width: float = RANDOM_HALF_WIDTH_M_PER_RAD["local"],
+               distant_half_width: float = RANDOM_HALF_WIDTH_M_PER_RAD["distant"]) -> "TTLCoefficients":
+        """Linear coefficients drawn uniformly in [-w, w) (m/rad) by ``numpy.random.default_rng(seed)``,
+        in the order local_phi, distant_phi, local_eta, distant_eta (LISA Instrument's), MOSAs in
+        :data:`MOSAS` order; w defaults to LISA Instrument 2.3's ranges."""
+        wl = _finite_float("ttl.local_half_width", local_half_width, "m/rad")
+        wd = _finite_float("ttl.distant_half_width", distant_half_width, "m/rad")
+        rng = np.random.default_rng(seed)
+        lp, dp, le, de = ({m: float(rng.uniform(-w, w)) for m in MOSAS} for w in (wl, wd, wl, wd))
+        return cls(local_phi=lp, local_eta=le, distant_phi=dp, distant_eta=de)
+
+    def polynomial(self, kind: str, mosa: str, phi: np.ndarray, eta: np.ndarray) -> np.ndarray:
+        """P^kind_mosa(phi, eta) (m); kind "local" or "distant"; phi, eta (rad), shape (n,)."""
+        c = lambda name: getattr(self, f"{kind}_{name}")[mosa]  # noqa: E731
+        out = c("phi") * phi + c("eta") * eta
+        q = (c("phiphi"), c("etaeta"), c("phieta"))
+        if any(q):
+            out = out + q[0] * phi * phi + q[1] * eta * eta + q[2] * phi * eta
+        return out
+
+
+def mosa_angles(sc_phi: dict, sc_eta: dict, sc_theta: dict, mosa_phi: dict, mosa_eta: dict,
+                opening_rad: dict | None = None) -> tuple[dict, dict]:
+    """The phi (yaw) and eta (pitch) angles (rad) of the six MOSAs.
+
+    LISA Instrument 2.3 ``instru/instru_formulas.py`` ``mosa_total_jitter_phis`` and
+    ``mosa_total_jitter_etas`` (called in ``instru/instru_model.py``, "Angular jitters")::
+
+        phi_ij = phi_i + phi^MOSA_ij
+        eta_ij = cos(a_ij) eta_i - sin(a_ij) theta_i + eta^MOSA_ij
+
+    phi_i, eta_i, theta_i: yaw, pitch, roll of spacecraft i (``sc_*``, keyed "1", "2", "3");
+    phi^MOSA, eta^MOSA: the MOSA's own angles (keyed by MOSA); a_ij the oriented opening angle
+    (rad; default :data:`MOSA_OPENING_ANGLES_RAD`).  Values: floats or arrays of one shape.
+    Returns (phi, eta), dicts keyed by MOSA."""
+    opening = MOSA_OPENING_ANGLES_RAD if opening_rad is None else opening_rad
+    for name, d, keys in (("sc_phi", sc_phi, SPACECRAFT), ("sc_eta", sc_eta, SPACECRAFT),
+                          ("sc_theta", sc_theta, SPACECRAFT), ("mosa_phi", mosa_phi, MOSAS),
+                          ("mosa_eta", mosa_eta, MOSAS), ("mosa_opening_rad", opening, MOSAS)):
+        _check_keys(name, d, keys)
+    a = {m: _finite_float(f"mosa_opening_rad[{m!r}]", opening[m], "rad") for m in MOSAS}
+    phi = {m: np.asarray(sc_phi[m[0]]) + np.asarray(mosa_phi[m]) for m in MOSAS}
+    eta = {m: math.cos(a[m]) * np.asarray(sc_eta[m[0]]) - math.sin(a[m]) * np.asarray(sc_theta[m[0]])
+           + np.asarray(mosa_eta[m]) for m in MOSAS}
+    return phi, eta
+
+
+def _delay(x: np.ndarray, dt: float, tau) -> np.ndarray:
+    """x(t_k - tau_k) by the 8-point Lagrange interpolant (NaN where its stencil leaves the series).
+
+    x, tau shape (n,).  The fraction is taken from the shift -tau/dt itself, not from k - tau/dt
+    (whose rounding at large k would cost ulp(k) times the slope of x)."""
+    n = x.size
+    shift = -np.broadcast_to(np.asarray(tau, dtype=np.float64), (n,)) / dt
+    fs = np.floor(shift)
+    frac = shift - fs
+    base = np.arange(n) + fs.astype(np.int64)  # floor(k - tau/dt)
+    ok = (base - (_HALF - 1) >= 0) & (base + _HALF <= n - 1)
+    out = np.full(n, np.nan)
+    k, frac = base[ok], frac[ok]
+    acc = np.zeros(k.size)
+    for j, off in enumerate(_NODES):
+        w = np.ones(k.size)
+        for q, offq in enumerate(_NODES):
+            if q != j:
+                w *= (frac - offq) / (off - offq)
+        acc += w * x[k + off]
+    out[ok] = acc
+    return out
+
+
+def ttl_terms(phi: dict, eta: dict, coeffs: TTLCoefficients, dt: float, delays: dict) -> tuple[dict, dict]:
+    """The local and (delayed) distant TTL terms of the six links (m), dicts keyed by link.
+
+    phi, eta: MOSA angles (rad), dicts keyed by MOSA, arrays of shape (n,) sampled at t0 + k dt;
+    dt: sampling step (s); delays: light travel time tau_ij (s) per link, a float or an (n,) array
+    at the reception times.  The first ~tau/dt + 4 samples of a distant term are NaN."""
+    if not isinstance(coeffs, TTLCoefficients):
+        raise ValueError(f"coeffs = {coeffs!r}: expected a TTLCoefficients")
+    _check_keys("phi", phi, MOSAS)
+    _check_keys("eta", eta, MOSAS)
+    _check_keys("delays", delays, MOSAS)
+    step = _finite_float("dt", dt, "s")
+    if step <= 0:
+        raise ValueError(f"dt = {dt!r}: must be > 0 (s)")
+    ph = {m: np.asarray(phi[m], dtype=np.float64) for m in MOSAS}
+    et = {m: np.asarray(eta[m], dtype=np.float64) for m in MOSAS}
+    n = ph[MOSAS[0]].size
+    for name, d in (("phi", ph), ("eta", et)):
+        for m in MOSAS:
+            if d[m].shape != (n,):
+                raise ValueError(f"{name}[{m!r}]: shape {d[m].shape}, expected ({n},) like phi['12']")
+    if n < POINTS + MARGIN:
+        raise ValueError(f"phi['12']: {n} samples, need at least {POINTS + MARGIN}")
+    tau = {}
+    for m in MOSAS:
+        t = np.asarray(delays[m], dtype=np.float64)
+        if t.shape not in ((), (n,)) or not np.all(np.isfinite(t)) or np.any(t < 0):
+            raise ValueError(f"delays[{m!r}] = {delays[m]!r}: must be a finite number >= 0 or ({n},) array (s)")
+        tau[m] = t
+    local = {m: coeffs.polynomial("local", m, ph[m], et[m]) for m in MOSAS}
+    emitted = {m: coeffs.polynomial("distant", m, ph[m], et[m]) for m in MOSAS}
+    distant = {m: _delay(emitted[distant_mosa(m)], step, tau[m]) for m in MOSAS}
+    return local, distant
+
+
+def link_ttl(phi: dict, eta: dict, coeffs: TTLCoefficients, dt: float, delays: dict) -> dict:
+    """s_ij = local + delayed distant TTL term (m) of each link; arguments as :func:`ttl_terms`."""
+    local, distant = ttl_terms(phi, eta, coeffs, dt, delays)
+    return {m: local[m] + distant[m] for m in MOSAS}
