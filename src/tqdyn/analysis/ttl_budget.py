@@ -20,9 +20,10 @@ __all__ = ["READOUT", "SINGLE_LINK_REQUIREMENT", "single_link_budget", "worst_ca
 
 #: Single-link displacement requirement [m/Hz^1/2] per mission:
 #: TianQin 1 pm/Hz^1/2, flat (Luo et al. 2016, CQG 33 035010; S_x = 1e-24 m^2/Hz in Hu et al. 2018,
-#: CQG 35 095008); LISA 15 pm/Hz^1/2 sqrt(1 + (2 mHz/f)^4), the single-link optical metrology allocation
-#: of the LISA Science Requirements Document (ESA-L3-EST-SCI-RS-001, 2018); Taiji 8 pm/Hz^1/2 with the same
-#: shape (Luo et al. 2020, Results in Physics 16 102918).
+#: CQG 35 095008); LISA 15 pm/Hz^1/2 sqrt(1 + (2 mHz/f)^4), the single-link optical metrology noise of
+#: the LISA science requirements' sensitivity model, P_OMS = (1.5e-11 m)^2 (1 + (2 mHz/f)^4) / Hz as quoted
+#: by Robson, Cornish & Liu 2019, CQG 36 105011, eq. 10; Taiji 8 pm/Hz^1/2 (Luo et al. 2020, Results in
+#: Physics 16 102918) with LISA's low-frequency shape (an assumption).
 SINGLE_LINK_REQUIREMENT = {
     "tianqin": AsdModel(1e-12, (), "m", "requirement"),
     "lisa": AsdModel(15e-12, ((2e-3, -2.0),), "m", "requirement"),
