@@ -11,23 +11,12 @@ in ``TYPED_ALLOWED`` (each with its reason).
 
 from __future__ import annotations
 
-import importlib.util
 import re
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+from docs_support import ROOT, rd
 
-
-def _renderer():
-    spec = importlib.util.spec_from_file_location("render_docs", ROOT / "tools" / "render_docs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-rd = _renderer()
 PAGES = [p.relative_to(ROOT).as_posix() for p in rd.pages(ROOT)]
 
 

@@ -5,7 +5,6 @@ Python's own formatting; each run here is short (a 1 h Kepler benchmark, one fas
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import subprocess
@@ -15,19 +14,8 @@ from pathlib import Path
 import pytest
 
 from cli_support import run_cli
+from docs_support import ROOT, rd
 from tqdyn.workflows import numbers
-
-ROOT = Path(__file__).resolve().parent.parent
-
-
-def _renderer():
-    spec = importlib.util.spec_from_file_location("render_docs", ROOT / "tools" / "render_docs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-rd = _renderer()
 
 
 def test_bench_json_merges_one_entry_per_model(tmp_path, capsys):

@@ -29,7 +29,7 @@ from . import layout as _lay
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
-__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "chunk_plan", "input_pipeline", "propagate_fixed", "warm_up"]
+__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_plan", "deliver_rows", "input_pipeline", "propagate_fixed", "warm_up"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -155,6 +155,35 @@ def chunk_plan(n: int, n_total: int, chunk: int, checkpoint_every: int) -> list[
     return plan
 
 
+class CheckpointClock:
+    """When a fixed-step run writes a checkpoint: after step ``n`` when ``n`` is a multiple of
+    ``every`` (0 = never), or at the first chunk boundary ``interval_s`` seconds of wall time
+    after the last one (0 = never), and never after the last step (``n_total``)."""
+
+    def __init__(self, every: int, interval_s: float, n_total: int):
+        self.every, self.interval_s, self.n_total = every, interval_s, n_total
+        self.last = self.now = _time.perf_counter()
+
+    def due(self, n: int) -> bool:
+        self.now = _time.perf_counter()
+        return ((bool(self.every) and n % self.every == 0)
+                or (self.interval_s > 0 and self.now - self.last >= self.interval_s)) and n < self.n_total
+
+    def written(self) -> None:
+        """A checkpoint was written for the step of the last :meth:`due`."""
+        self.last = self.now
+
+
+def deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t, y, a, aux) -> None:
+    """Hand the rows of the steps n0, n0 + 1, ... (dd times ``t``, states ``y``, accelerations ``a``,
+    diagnostics ``aux``) to ``sink`` (every ``every``-th step: :func:`select_rows`) and fold the
+    diagnostics into ``extremes`` (when the run forms them, ``n_aux``)."""
+    if sink is not None:
+        sink(select_rows(t, y, a, precision, every, n0, aux, system))
+    if n_aux:
+        update_extremes(extremes, aux, system)
+
+
 def input_pipeline(plan, inputs, block: int):
     """The chunks of ``plan`` with their time-only inputs computed one block
     ahead in a second thread (the inputs of the next block overlap the
@@ -204,7 +233,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
     gw, fw, aux = _lay.workspace(y)
     n_aux = _lay.AUX_LEN if system.coupled else 0
     t_start = _time.perf_counter()
-    t_ckpt = t_start
+    clock = CheckpointClock(checkpoint_every, checkpoint_interval_s, n_total)
     extremes: dict = {}
     # the time-only inputs of the next chunk are computed in a second thread
     # while the compiled loop (nogil) runs.
@@ -259,20 +288,14 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
                          out_a[o:e], out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat
-        if sink is not None:
-            sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
-        if n_aux:
-            update_extremes(extremes, out_aux, system)
+        deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t_out, out_y, out_a, out_aux)
         del out_y, out_a, out_aux
         n = n0 + m
         if progress is not None:
             progress(m)
-        now = _time.perf_counter()
-        due = ((checkpoint_every and n % checkpoint_every == 0)
-               or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
-        if checkpoint is not None and due and n < n_total:
+        if checkpoint is not None and clock.due(n):
             checkpoint(Checkpoint(n, y.copy(), comp.copy()))
-            t_ckpt = now
+            clock.written()
     # the final state and its acceleration
     t_end = np.empty((1, 2))
     t_nodes = np.empty((1 if model.time_dependent else 0, 13, 2))

@@ -37,7 +37,8 @@ from numba import njit
 from ..numerics import dp87
 from ..numerics import multistep as _ms
 from . import layout as _lay
-from .fixed import _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, input_pipeline
+from .fixed import (CheckpointClock, _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, deliver_rows,
+                    input_pipeline)
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
 
@@ -272,7 +273,7 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
 
     ypred = np.zeros_like(st.y)
     kbuf = np.zeros_like(st.y)
-    t_ckpt = _time.perf_counter()
+    clock = CheckpointClock(checkpoint_every, checkpoint_interval_s, n_total)
     for n0, m, parts in input_pipeline(plan, inputs, INPUT_BLOCK):
         t_out = np.empty((m, 2))
         _grid_times(n0, m, h, c_dummy, t_out, np.empty((0, 1, 2)))
@@ -286,29 +287,20 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
                              out_y[o:e], out_a[o:e], out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat
-        if sink is not None:
-            sink(select_rows(t_out, out_y, out_a, precision, every, n0, out_aux, system))
-        if n_aux:
-            update_extremes(extremes, out_aux, system)
+        deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t_out, out_y, out_a, out_aux)
         del out_y, out_a, out_aux
         n = n0 + m
         n_rhs += m * (n_corr + (1 if evaluated else 0))
         if progress is not None:
             progress(m)
-        now = _time.perf_counter()
-        due = ((checkpoint_every and n % checkpoint_every == 0)
-               or (checkpoint_interval_s > 0 and now - t_ckpt >= checkpoint_interval_s))
-        if checkpoint is not None and due and n < n_total:
+        if checkpoint is not None and clock.due(n):
             checkpoint(Checkpoint(n, st.y.copy(), np.zeros_like(st.y), st.table()))
-            t_ckpt = now
+            clock.written()
     # the final state: its acceleration and diagnostics are the last evaluation's
     t_end = np.empty((1, 2))
     _grid_times(n_total, 1, h, c_dummy, t_end, np.empty((0, 1, 2)))
     a_end = st.F[int(st.head[0])]
-    if sink is not None:
-        sink(select_rows(t_end, st.y[None], a_end[None], precision, every, n_total, st.aux[None], system))
-    if n_aux:
-        update_extremes(extremes, st.aux[None], system)
+    deliver_rows(sink, extremes, n_aux, system, precision, every, n_total, t_end, st.y[None], a_end[None], st.aux[None])
     wall = _time.perf_counter() - t_start
     extra = format_extremes(extremes)
     if n_corr:

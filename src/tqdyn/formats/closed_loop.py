@@ -34,6 +34,7 @@ from .._version import __version__ as _TQDYN_VERSION
 from ..closedloop.simulate import Block, Sink
 from .trajectory import OutputError, OutputIOError, check_writable
 from .trajectory._h5safe import _cleanup, _close_h5, _io_reason
+from .trajectory.reader import DAMAGED, damaged_message, open_for_reading
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError", "ClosedLoopWriter",
            "ROOT_ATTRS", "read_closed_loop"]
@@ -347,14 +348,7 @@ def read_closed_loop(path) -> ClosedLoopFile:
     (:meth:`ClosedLoopFile.timeseries`).  FileNotFoundError for a missing file; a one-line
     :class:`ClosedLoopFormatError` for anything that is not a ``tqdyn-closed-loop`` file of version
     <= :data:`FORMAT_VERSION` (a trajectory file, another HDF5 file, a damaged file)."""
-    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
-    fname = str(p)
-    if not p.is_file():
-        raise FileNotFoundError(f"closed-loop file {fname!r} does not exist or is not a file")
-    try:
-        h5 = h5py.File(p, "r")
-    except OSError as exc:
-        raise ClosedLoopFormatError(f"{fname}: not a readable HDF5 file ({' '.join(str(exc).split())[:160]})") from None
+    p, fname, h5 = open_for_reading(path, "closed-loop file", ClosedLoopFormatError)
     try:
         with h5:
             attrs = {k: _native(v) for k, v in h5.attrs.items()}
@@ -374,7 +368,6 @@ def read_closed_loop(path) -> ClosedLoopFile:
                 raise ClosedLoopFormatError(f"{fname}: the group '/budget' or '/timeseries' is missing; re-create "
                                             "it (tqdyn closed-loop)")
             budget = _read_budget(h5, fname)
-    except (OSError, RuntimeError, KeyError) as exc:
-        raise ClosedLoopFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
-                                    "re-create it (tqdyn closed-loop)") from None
+    except DAMAGED as exc:
+        raise ClosedLoopFormatError(damaged_message(fname, exc, "tqdyn closed-loop")) from None
     return ClosedLoopFile(p, attrs, budget)

@@ -16,8 +16,8 @@ from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, Ref
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["SpacecraftRecord", "Trajectory", "is_trajectory_file", "read_attributes", "read_trajectory",
-           "run_is_complete"]
+__all__ = ["DAMAGED", "SpacecraftRecord", "Trajectory", "damaged_message", "is_trajectory_file", "open_for_reading",
+           "read_attributes", "read_trajectory", "run_is_complete"]
 
 
 @dataclass(frozen=True)
@@ -367,6 +367,34 @@ def _read_array(obj, path: str, fname: str) -> np.ndarray:
     return arr
 
 
+#: What h5py raises on a damaged file (object headers, B-trees, checksums).
+DAMAGED = (OSError, RuntimeError, KeyError)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())[:160]
+
+
+def open_for_reading(path, noun: str, error: type) -> tuple[pathlib.Path, str, "h5py.File"]:
+    """(absolute path, its name, the open HDF5 file) of ``path`` for reading; FileNotFoundError
+    ("``noun`` '...' does not exist or is not a file") for a missing file, ``error`` (one line
+    naming the file) for one that HDF5 cannot open."""
+    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
+    fname = str(p)
+    if not p.is_file():
+        raise FileNotFoundError(f"{noun} {fname!r} does not exist or is not a file")
+    try:
+        return p, fname, h5py.File(p, "r")
+    except OSError as exc:
+        raise error(f"{fname}: not a readable HDF5 file ({_one_line(exc)})") from None
+
+
+def damaged_message(fname: str, exc: BaseException, remedy: str) -> str:
+    """The one-line message of a file whose HDF5 structures fail to read (``exc``, one of
+    :data:`DAMAGED`); ``remedy`` names the command that re-creates it."""
+    return f"{fname}: the file is damaged ({_one_line(exc)}); re-create it ({remedy})"
+
+
 def read_trajectory(path) -> Trajectory:
     """Read a tqdyn trajectory file completely into memory and close it.
 
@@ -377,19 +405,11 @@ def read_trajectory(path) -> Trajectory:
     one n_sat throughout).  HDF5 objects that are not fields of the format are
     ignored.  Returns a :class:`Trajectory` (float64 arrays, SI units, the file's time scale).
     """
-    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
-    fname = str(p)
-    if not p.is_file():
-        raise FileNotFoundError(f"trajectory file {fname!r} does not exist or is not a file")
-    try:
-        h5 = h5py.File(p, "r")
-    except OSError as exc:
-        raise TrajectoryFormatError(f"{fname}: not a readable HDF5 file ({exc})") from None
+    p, fname, h5 = open_for_reading(path, "trajectory file", TrajectoryFormatError)
     try:
         return _read_open(h5, p, fname)
-    except (OSError, RuntimeError, KeyError) as exc:  # damaged object headers / B-trees
-        raise TrajectoryFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
-                                    f"re-create it (run again)") from None
+    except DAMAGED as exc:  # damaged object headers / B-trees
+        raise TrajectoryFormatError(damaged_message(fname, exc, "run again")) from None
 
 
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -410,20 +430,12 @@ def read_attributes(path) -> dict:
     without reading its datasets; the same format and version checks as
     :func:`read_trajectory` (FileNotFoundError, or a one-line
     :class:`TrajectoryFormatError` naming the file)."""
-    p = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(path))))
-    fname = str(p)
-    if not p.is_file():
-        raise FileNotFoundError(f"trajectory file {fname!r} does not exist or is not a file")
-    try:
-        h5 = h5py.File(p, "r")
-    except OSError as exc:
-        raise TrajectoryFormatError(f"{fname}: not a readable HDF5 file ({exc})") from None
+    _, fname, h5 = open_for_reading(path, "trajectory file", TrajectoryFormatError)
     try:
         with h5:
             return _checked_attrs(h5, fname)
-    except (OSError, RuntimeError, KeyError) as exc:
-        raise TrajectoryFormatError(f"{fname}: the file is damaged ({' '.join(str(exc).split())[:160]}); "
-                                    f"re-create it (run again)") from None
+    except DAMAGED as exc:
+        raise TrajectoryFormatError(damaged_message(fname, exc, "run again")) from None
 
 
 def _checked_attrs(h5, fname) -> dict:
