@@ -175,7 +175,8 @@ def test_consider_sensitivity_analytic():
     """Noise-free fixes made with a_t = 2e-9 m/s^2, fitted with a_t considered at 0: the state error
     equals -S_xc da (linear model, module docstring) to 1e-9 of the state sigmas (measured 2.2e-13),
     and S_xc equals -P_xx H_x^T R^-1 H_c from the mpmath normal matrix (< 1e-9 relative; measured
-    3.8e-14)."""
+    3.8e-14); the covariance analysis' consider covariance P_xx + S_xc P_cc S_xc^T (sigma_a = 1e-9
+    m/s^2) equals mpmath's, < 1e-9 relative to sqrt(P_ii P_jj)."""
     times = _times(40)
     jac = _cw_jacobian(times)
     problem = _cw_problem(times, jac @ TRUE, consider=1e-9)
@@ -190,9 +191,12 @@ def test_consider_sensitivity_analytic():
             hx, hc = h[:, 1:5], h[:, 0]
             m_xx += hx.T * hx
             m_xc += hx.T * hc
-        sxc = -(mpmath.inverse(m_xx) * m_xc)
+        p_xx = mpmath.inverse(m_xx)
+        sxc = -(p_xx * m_xc)
         ref = np.array([float(v) for v in sxc])
+        p_c = p_xx + sxc * mpmath.mpf("1e-18") * sxc.T
     assert np.max(np.abs(fit.sensitivity[:, 0] - ref) / np.abs(ref)) < 1e-9
+    assert _relative_error(od.covariance_analysis(problem).consider_covariance, p_c) < 1e-9
 
 
 def test_consider_covariance_matches_monte_carlo():
@@ -224,8 +228,10 @@ def test_consider_covariance_matches_monte_carlo():
 
 def test_outliers_are_edited_and_the_rest_kept():
     """100 fixes (200 measurements) with 20-sigma errors added to 5 of them; 5-sigma editing removes
-    exactly those 5 and the estimate equals a fit to the other 195 (to 1e-10 sigma); a kept fraction
-    required above 195/200 is refused in one line."""
+    exactly those 5 and the estimate equals a fit to the other 195 (to 1e-10 sigma); the normalised
+    residuals equal those of the hat matrix formed with the normal equations (to 2e-12; measured
+    2.1e-13); a kept
+    fraction required above 195/200 is refused in one line."""
     times = _times(100)
     jac = _cw_jacobian(times)
     y = jac @ TRUE + SIGMA_M * np.random.default_rng(5).standard_normal(jac.shape[0])
@@ -240,6 +246,13 @@ def test_outliers_are_edited_and_the_rest_kept():
                      sigma=np.full(keep.size, SIGMA_M))
     ref = od.estimate(sub)
     assert np.max(np.abs(fit.values - ref.values) / ref.sigma) < 1e-10
+    # normalised residuals from the hat matrix of the kept rows, by the normal equations:
+    # kept r_i / (sigma sqrt(1 - h_i P h_i^T / sigma^2)), edited r_i / sqrt(sigma^2 + h_i P h_i^T)
+    p = np.linalg.inv(jac[keep].T @ jac[keep]) * SIGMA_M ** 2
+    r = y - jac @ ref.values
+    hph = np.einsum("ij,jk,ik->i", jac, p, jac)
+    z = np.where(fit.edited, r / np.sqrt(SIGMA_M ** 2 + hph), r / np.sqrt(SIGMA_M ** 2 - hph))
+    assert np.max(np.abs(fit.normalised_residuals - z)) < 2e-12
     with pytest.raises(ValueError, match="min_kept_fraction") as err:
         od.estimate(_cw_problem(times, y), edit_sigma=5.0, min_kept_fraction=0.99)
     assert "\n" not in str(err.value)
