@@ -230,8 +230,7 @@ def test_outliers_are_edited_and_the_rest_kept():
     """100 fixes (200 measurements) with 20-sigma errors added to 5 of them; 5-sigma editing removes
     exactly those 5 and the estimate equals a fit to the other 195 (to 1e-10 sigma); the normalised
     residuals equal those of the hat matrix formed with the normal equations (to 2e-12; measured
-    2.1e-13); a kept
-    fraction required above 195/200 is refused in one line."""
+    2.1e-13); a kept fraction required above 195/200 is refused in one line."""
     times = _times(100)
     jac = _cw_jacobian(times)
     y = jac @ TRUE + SIGMA_M * np.random.default_rng(5).standard_normal(jac.shape[0])
