@@ -353,7 +353,7 @@ def _evaluate(problem: Problem, q: np.ndarray, n_total: int):
         raise ValueError(f"model: returned h {h.shape} and H {jac.shape}, expected ({m},) and ({m}, {n_total})")
     if not (np.all(np.isfinite(h)) and np.all(np.isfinite(jac))):
         i = int(np.flatnonzero(~(np.isfinite(h) & np.all(np.isfinite(jac), axis=1)))[0])
-        raise ValueError(f"model: non-finite h or H at measurement {i} for parameters {q.tolist()}")
+        raise ValueError(f"model: non-finite h or H at measurement {i} (h = {h[i]}) at the current parameters")
     return h, jac
 
 
