@@ -1,0 +1,1 @@
+"""Orbit determination: estimation of initial states and acceleration parameters from tracking data."""
