@@ -190,7 +190,11 @@ def _leg(r, v, states, s: int, delay):
         R, V, A = states(shift)
         D = r[:, None, :] - R
         L = np.linalg.norm(D, axis=-1)
-        extra = 0.0 if delay is None else delay(R, r)
+        if delay is None:
+            extra = 0.0
+        else:   # the delay diverges on rays through the body's centre (hidden rays): 0 there
+            with np.errstate(divide="ignore", invalid="ignore"):
+                extra = np.nan_to_num(delay(R, r), nan=0.0, posinf=0.0)
         tau = L / C_LIGHT + extra
     u = D / L[..., None]
     uV = np.einsum("nsi,nsi->ns", u, V)

@@ -189,7 +189,10 @@ def pseudorange(t, r, v, constellation: WalkerConstellation = GPS, *, mode: str 
             g[:, k], vg[:, k] = gk[np.arange(t.size), k], vk[np.arange(t.size), k]
         D = r[:, None, :] - g
         L = np.linalg.norm(D, axis=-1)
-        extra = shapiro_delay(g, r[:, None, :]) if shapiro else 0.0
+        extra = 0.0
+        if shapiro:     # diverges on rays through the Earth's centre (occulted): 0 there
+            with np.errstate(divide="ignore", invalid="ignore"):
+                extra = np.nan_to_num(shapiro_delay(g, r[:, None, :]), nan=0.0, posinf=0.0)
         tau = L / C_LIGHT + extra
     u = D / L[..., None]
     d_r = C_LIGHT * u / (C_LIGHT - np.einsum("nki,nki->nk", u, vg))[..., None]
