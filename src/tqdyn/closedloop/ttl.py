@@ -200,7 +200,8 @@ def _spline_at(field: str, t_s: np.ndarray, y: np.ndarray, order: int, t: np.nda
     from scipy.interpolate import InterpolatedUnivariateSpline
 
     if t.size and (t.min() < t_s[0] or t.max() > t_s[-1]):
-        raise ValueError(f"{field}: covers t = {t_s[0]!r} .. {t_s[-1]!r} s; needed {t.min()!r} .. {t.max()!r} s")
+        raise ValueError(f"{field}: covers t = {float(t_s[0])!r} .. {float(t_s[-1])!r} s; needed "
+                         f"{float(t.min())!r} .. {float(t.max())!r} s")
     return InterpolatedUnivariateSpline(t_s, y, k=order, ext="raise")(t)
 
 

@@ -136,6 +136,10 @@ def export_ttl(cl_file, out_file, *, coefficients: str = "worst-case", seed: int
     if t_cl.size < 2:
         raise ValueError(f"{src}: its time series has {t_cl.size} sample(s); need at least 2")
     t = _grid(t_cl, step)
+    if t.size <= order:
+        raise ValueError(f"--step = {step!r}: gives {t.size} samples over {t_cl[0]:g} .. {t_cl[-1]:g} s; the spline of "
+                         f"degree {order} needs more than {order}" if step is not None else
+                         f"{src}: {t.size} samples; the spline of degree {order} needs more than {order}")
     if drift is not None and float(drift) != 0.0:
         r = float(drift)
         if not math.isfinite(r):
