@@ -1,7 +1,9 @@
-"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5`` and ``--format oem OUT.oem``.
+"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5``, ``--format oem OUT.oem`` and
+``tqdyn export CL.h5 --format ttl OUT.h5`` (the positional file is then a closed-loop file).
 
 A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
-It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`).  As
+It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`,
+:func:`tqdyn.workflows.export_oem.export_oem`, :func:`tqdyn.workflows.export_ttl.export_ttl`).  As
 everywhere in the CLI, bad input exits with status 2 and one line
 ``tqdyn: error: ...`` on stderr, and no output file is left behind.
 
@@ -20,9 +22,24 @@ from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
 
 __all__ = ["FORMATS", "export"]
 
+_LISA_OPTIONS = ("shapiro", "frame", "axes", "time_origin")
+_TTL_OPTIONS = ("coefficients", "seed", "drift", "step")
+#: LISA Pathfinder's measured drift of its TTL coefficients, 1 um/rad in 100 days, in m/rad per day
+#: (:data:`tqdyn.closedloop.ttl.LPF_DRIFT_M_PER_RAD_PER_S`).
+_LPF_DRIFT_PER_DAY = 1e-8
+
+
+def _refuse(opts, names, fmt, allowed) -> None:
+    """ValueError for the first option of ``names`` given (not None) with ``--format fmt``."""
+    given = [f"--{k.replace('_', '-')}" for k in names if opts.get(k) is not None]
+    if given:
+        raise ValueError(f"{given[0]}: does not apply to --format {fmt}; allowed with --format {fmt}: "
+                         + (", ".join(allowed) if allowed else "no options"))
+
 
 def _export_lisa(run_file, out_file, opts) -> list[str]:
     """``--format lisa``: :func:`tqdyn.workflows.export.export_lisa`; returns the report lines."""
+    _refuse(opts, _TTL_OPTIONS, "lisa", ["--shapiro/--no-shapiro", "--frame", "--axes", "--time-origin"])
     from ..workflows.export import export_lisa
 
     summary = export_lisa(run_file, out_file, shapiro=opts["shapiro"], frame=opts["frame"],
@@ -45,24 +62,56 @@ def _export_lisa(run_file, out_file, opts) -> list[str]:
 
 def _export_oem(run_file, out_file, opts) -> list[str]:
     """``--format oem``: :func:`tqdyn.workflows.export_oem.export_oem`; returns the report lines."""
-    given = [f"--{k.replace('_', '-')}" for k, v in opts.items() if v is not None]
-    if given:
-        raise ValueError(f"{given[0]}: applies to --format lisa only; allowed with --format oem: no options")
+    _refuse(opts, _LISA_OPTIONS + _TTL_OPTIONS, "oem", [])
     from ..workflows.export_oem import export_oem
 
     paths = export_oem(run_file, out_file)
     return [f"CCSDS OEM 2.0: {len(paths)} file(s), one per satellite: " + ", ".join(str(p) for p in paths)]
 
 
-_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem}
+def _drift_per_second(text) -> float | None:
+    """``--drift`` (m/rad per day, or ``lpf``) as m/rad/s; None when not given."""
+    if text is None:
+        return None
+    if str(text).strip().lower() == "lpf":
+        per_day = _LPF_DRIFT_PER_DAY
+    else:
+        try:
+            per_day = float(text)
+        except ValueError:
+            per_day = float("nan")
+        if per_day != per_day or per_day in (float("inf"), float("-inf")):
+            raise ValueError(f"--drift = {text!r}: must be a finite number (m/rad per day) or lpf")
+    return per_day / 86400.0
+
+
+def _export_ttl(cl_file, out_file, opts) -> list[str]:
+    """``--format ttl``: :func:`tqdyn.workflows.export_ttl.export_ttl`; returns the report lines."""
+    _refuse(opts, _LISA_OPTIONS, "ttl", ["--coefficients", "--seed", "--drift", "--step"])
+    from ..workflows.export_ttl import export_ttl
+
+    summary = export_ttl(cl_file, out_file, coefficients=opts["coefficients"] or "worst-case", seed=opts["seed"],
+                         drift=_drift_per_second(opts["drift"]), step=opts["step"])
+    m = summary.model
+    how = m["kind"] + (f" (seed {m['seed']})" if "seed" in m else "") + (f" ({m['file']})" if "file" in m else "")
+    drift = (f", drifting {m['drift_m_per_rad_per_s'] * 86400:g} m/rad per day from t = {m['t_ref_s']:g} s"
+             if "drift_m_per_rad_per_s" in m else ", constant")
+    grid = "the closed-loop file's grid" if summary.step is None else f"every {summary.step:g} s"
+    return [f"LISA Instrument TTL coefficient file {summary.path}: {summary.size} samples from t = "
+            f"{summary.t_start:g} s to {summary.t_stop:g} s ({grid}; the run's time axis since its epoch)",
+            f"coefficients: {how}{drift}"]
+
+
+_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem, "ttl": _export_ttl}
 FORMATS = tuple(_EXPORTERS)
-"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files."""
+"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files;
+``ttl`` = LISA Instrument's TTL coefficient file (from a closed-loop file)."""
 
 
 @click.command("export")
 @click.argument("run_file", metavar="RUN.h5")
 @click.argument("out_file", metavar="OUT")
-@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem.")
+@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem, ttl.")
 @click.option("--shapiro/--no-shapiro", default=None,
               help="lisa: include the Shapiro delay in the light travel times (GCRS: the Earth's; BCRS: the Sun's, "
                    "and the Earth's for a geocentric run).  Default: on for heliocentric runs, off for geocentric.")
@@ -75,8 +124,22 @@ FORMATS = tuple(_EXPORTERS)
 @click.option("--time-origin", "time_origin", type=click.Choice(["epoch", "j2000", "unix"]), default=None,
               help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
                    "Unix time of the first sample (as lisaorbits' OEM orbits).")
-def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
+@click.option("--coefficients", default=None, metavar="worst-case|random|FILE",
+              help="ttl: the TTL coefficients: worst-case (default; every MOSA at the half-widths of LISA "
+                   "Instrument's random draw, 2.2 mm/rad local, 2.4 mm/rad distant), random (uniform in those "
+                   "ranges, with --seed) or a .toml/.json file with tables local_phi, local_eta, distant_phi, "
+                   "distant_eta keyed by MOSA (12, 23, 31, 13, 32, 21) in m/rad.")
+@click.option("--seed", type=int, default=None, help="ttl, --coefficients random only: the seed of the draw.")
+@click.option("--drift", default=None, metavar="RATE",
+              help="ttl: every linear coefficient drifts by RATE m/rad per day from the first sample on; lpf = "
+                   "LISA Pathfinder's measured 1 um/rad per 100 days.  Default: constant.")
+@click.option("--step", type=float, default=None, metavar="SECONDS",
+              help="ttl: sample step (s) over the closed-loop file's span.  Default: its own time grid.")
+def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficients, seed, drift, step):
     """Export the trajectory RUN.h5 to OUT in another tool's format.
+
+    With --format ttl the positional file is a closed-loop file CL.h5
+    (tqdyn closed-loop RUN.h5 -o CL.h5).
 
     --format lisa writes a LISA orbit file OUT.h5 (lisaorbits layout 2.x,
     read by lisainstrument and pytdi): satellite states, light travel times
@@ -88,6 +151,11 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
     --format oem writes CCSDS OEM 2.0 files for mission-analysis tools
     (GMAT, Orekit, STK), one per satellite (OUT-<name>.oem beside OUT.oem),
     in the run's own system (SUN/ICRF/TDB or EARTH/GCRF/TT).
+
+    --format ttl writes LISA Instrument's TTL coefficient file OUT.h5 (read
+    by Instrument(ttl_coeffs=("file", "OUT.h5"))): per-MOSA linear
+    coefficients sampled on the closed-loop file's time grid t (the run's
+    time axis since its epoch, the t of the GCRS LISA orbit file).
     """
     if fmt is None:
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")
@@ -95,7 +163,8 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
         _fail(f"--format: {fmt!r} is not allowed; allowed: {', '.join(FORMATS)}")
     from ..formats import trajectory as io
 
-    opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin}
+    opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin,
+            "coefficients": coefficients, "seed": seed, "drift": drift, "step": step}
     try:
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
     except (FileNotFoundError, ValueError, io.OutputError) as exc:
