@@ -14,9 +14,10 @@ Stations (:data:`DEEP_SPACE_STATIONS`), ITRF positions [m]:
   (DSA 1): geodetic longitude and latitude of ESA's SPICE frame kernel
   ``estrack_v04.tf`` (ESAC, 2021, "in accordance with the public
   information provided by ESTRACK"), heights 794 m (Cebreros), 1550 m
-  (Malargue), 252 m (New Norcia) from ESA's station pages, on the WGS84
-  ellipsoid (``erfa.gd2gc``).  Accuracy: ~10 m (published values rounded
-  to 1e-7 deg and to 1 m); fine for simulations, not for real data.
+  (Malargue), 252 m (New Norcia) on the WGS84 ellipsoid (``erfa.gd2gc``):
+  an assumption, approximate values not checked against a primary
+  source (the kernel gives no heights).  Accuracy: ~10 m; fine for
+  simulations and covariance studies, not for real data.
 
 Model (:func:`dsn_tracking`): the two-way light time of
 :func:`tqdyn.od.measurements.two_way`, satellite state at the bounce time.
