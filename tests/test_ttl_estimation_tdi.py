@@ -155,8 +155,8 @@ def test_dws_noise_attenuates_ols_in_links_and_tdi():
 def test_tdi_cannot_separate_a_spacecraft_rotation_from_laser_noise():
     """Angles from spacecraft yaw, pitch and roll only (10 nrad/Hz^1/2, ttl.mosa_angles; no MOSA
     jitter): both MOSAs of spacecraft i share phi_i, and the TTL pattern c^l_ij = c^l_ik = -c^d_ij =
-    -c^d_ik = c on the phi coefficients puts -c phi_i in links ij, ik and D_ji (c phi_i), D_ki (c phi_i)
-    in links ji, ki: the signature y = D_ij p_j - p_i of laser noise p_i = c phi_i, which TDI cancels.
+    -c^d_ik = c on the phi coefficients puts c phi_i in links ij, ik and -D_ji (c phi_i), -D_ki (c phi_i)
+    in links ji, ki: the signature y = D_ij p_j - p_i of laser noise p_i = -c phi_i, which TDI cancels.
     The TDI fit must report exactly these three combinations (one per spacecraft) as its null space
     (measured: scaled eigenvalues 1e-16, next 0.33; the null space's projection onto the three
     predicted vectors 1 - 1e-16), the links' fit none (smallest eigenvalue 0.87; bound 0.5); with the
@@ -273,7 +273,8 @@ def test_tianqin_residual_after_subtraction(record_number):
     (lambda: tt.simulate_six_link_fit(COEFFS, dt=DT, n=1024, seed=0, band=BAND, jitter_asd=1e-9, readout_asd=0,
                                       dws_asd=0, delays=TAU, manoeuvres={"phi1": (1e-8, 0.02)}), "manoeuvres"),
     (lambda: tt.simulate_six_link_fit(COEFFS, dt=DT, n=1024, seed=0, band=BAND, jitter_asd=1e-9, readout_asd=0,
-                                      dws_asd=0, delays=TAU, manoeuvres={"phi12": (1e-8, 0.02), "eta12": (1e-8, 0.0201)}),
+                                      dws_asd=0, delays=TAU,
+                                      manoeuvres={"phi12": (1e-8, 0.02), "eta12": (1e-8, 0.0201)}),
      "manoeuvres"),
     (lambda: tt.simulate_six_link_fit("b", dt=DT, n=1024, seed=0, band=BAND, jitter_asd=1e-9, readout_asd=0,
                                       dws_asd=0, delays=TAU), "coeffs"),

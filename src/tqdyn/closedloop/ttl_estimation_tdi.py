@@ -44,14 +44,18 @@ the true angles and their DWS noises; with independent angles and jitter and DWS
 in the links and in TDI alike (:func:`predicted_attenuation`, the one-link lambda of
 :mod:`.ttl_estimation`).
 
-Degeneracies in TDI (constant delays): the angle of MOSA ij enters the Michelson centred on j as
-(c^l + c^d) D_ji phi (the far end of the round trip y_ji + D_ji y_ij: local and distant terms carry
-the same delayed series) and the one centred on i as (c^l + c^d D_ij D_ji) phi (the near end).  The
-difference c^l - c^d is seen only through (1 - D_ij D_ji), |.| = 2 sin(pi f tau_rt): without noise
-weighting the 2 x 2 normal matrix of the pair at frequency f is proportional to
-[[2, 1 + cos t], [1 + cos t, 2]], t = 2 pi f tau_rt, eigenvalues 3 + cos t and 1 - cos t along
-(1, 1) and (1, -1): the twelve local-minus-distant combinations are determined ~ 1 / (2 sin(t/2))
-times worse than the sums (:func:`normal_modes` reports the measured spectrum).
+Degeneracies in TDI: the whitened TDI information is the six links' projected onto the complement
+of the laser-noise signatures y_ij = D_ij p_j - p_i (three dimensions per frequency), so a TTL
+pattern of that form is invisible.  When the two MOSAs of spacecraft i share its yaw phi_i
+(spacecraft jitter, ``spacecraft_jitter_asd``), the phi coefficients c^l_ij = c^l_ik = -c^d_ij =
+-c^d_ik = c put c phi_i in links ij, ik and -D_ji (c phi_i), -D_ki (c phi_i) in links ji, ki: laser
+noise p_i = -c phi_i.  These three combinations (one per spacecraft) are undetermined at every frequency and
+are returned in :attr:`JointFit.null_space`; the MOSAs' own jitter or manoeuvres of the individual
+MOSAs lift them.  Pitch is spared while roll jitter is present (eta_ij = cos a_ij eta_i -
+sin a_ij theta_i + eta^MOSA_ij with a_ij = +-30 deg differs between the two MOSAs).  With
+independent MOSA angles nothing is degenerate: the round trips carry a MOSA's local and distant
+coefficients as c^l + c^d (far end) and c^l + c^d D_ij D_ji (near end), but the readout noise of the
+same links enters both alike and the whitened fit keeps their difference (:func:`normal_modes`).
 
 Units SI (rad, m, s, m/rad, Hz; ASDs one-sided); series (n,) on one uniform grid of step dt.
 """
