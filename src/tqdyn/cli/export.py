@@ -54,15 +54,35 @@ def _export_oem(run_file, out_file, opts) -> list[str]:
     return [f"CCSDS OEM 2.0: {len(paths)} file(s), one per satellite: " + ", ".join(str(p) for p in paths)]
 
 
-_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem}
+def _export_lisa_injection(cl_file, out_file, opts) -> list[str]:
+    """``--format lisa-injection``: :func:`tqdyn.workflows.export_injection.export_lisa_injection` of the
+    closed-loop file ``cl_file`` (the command's first argument) and its run ``--run``."""
+    given = [f"--{k.replace('_', '-')}" for k, v in opts.items() if v is not None and k not in _INJECTION_OPTIONS]
+    if given:
+        raise ValueError(f"{given[0]}: applies to --format lisa only; allowed with --format lisa-injection: "
+                         "--run, --ttl-coefficients")
+    if opts.get("run") is None:
+        raise ValueError("--run RUN.h5 is required with --format lisa-injection (the run the closed-loop file "
+                         "was made from: its light travel times)")
+    from ..workflows.export_injection import export_lisa_injection
+
+    r = export_lisa_injection(cl_file, opts["run"], out_file, opts.get("ttl_coefficients") or "worst-case")
+    return [f"LISA Instrument injection file {r.path}: {r.size} samples from t0 = {r.t0:g} s every {r.dt:g} s; "
+            f"TTL coefficients {r.coefficients}; readout_isi_carrier/usb of the six links, RMS up to "
+            f"{r.rms_hz:.3g} Hz ({r.rms_m:.3g} m of path length)"]
+
+
+_INJECTION_OPTIONS = ("run", "ttl_coefficients")
+_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem, "lisa-injection": _export_lisa_injection}
 FORMATS = tuple(_EXPORTERS)
-"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files."""
+"""Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files;
+``lisa-injection`` = LISA Instrument glitch file of a closed-loop file's tilt-to-length."""
 
 
 @click.command("export")
 @click.argument("run_file", metavar="RUN.h5")
 @click.argument("out_file", metavar="OUT")
-@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem.")
+@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem, lisa-injection.")
 @click.option("--shapiro/--no-shapiro", default=None,
               help="lisa: include the Shapiro delay in the light travel times (GCRS: the Earth's; BCRS: the Sun's, "
                    "and the Earth's for a geocentric run).  Default: on for heliocentric runs, off for geocentric.")
@@ -75,7 +95,13 @@ FORMATS = tuple(_EXPORTERS)
 @click.option("--time-origin", "time_origin", type=click.Choice(["epoch", "j2000", "unix"]), default=None,
               help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
                    "Unix time of the first sample (as lisaorbits' OEM orbits).")
-def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
+@click.option("--run", "run", metavar="RUN.h5", default=None,
+              help="lisa-injection: the run the closed-loop file was made from (its light travel times; checked "
+                   "by SHA-256).")
+@click.option("--ttl-coefficients", "ttl_coefficients", metavar="SPEC", default=None,
+              help="lisa-injection: worst-case (default: LISA Instrument's random-draw bounds), random:SEED, "
+                   "constant:LP,LE,DP,DE (m/rad) or a JSON file of TTL coefficients.")
+def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, run, ttl_coefficients):
     """Export the trajectory RUN.h5 to OUT in another tool's format.
 
     --format lisa writes a LISA orbit file OUT.h5 (lisaorbits layout 2.x,
@@ -88,6 +114,12 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
     --format oem writes CCSDS OEM 2.0 files for mission-analysis tools
     (GMAT, Orekit, STK), one per satellite (OUT-<name>.oem beside OUT.oem),
     in the run's own system (SUN/ICRF/TDB or EARTH/GCRF/TT).
+
+    --format lisa-injection takes a closed-loop file CL.h5 (tqdyn
+    closed-loop) in place of RUN.h5 and its run as --run RUN.h5, and writes
+    a LISA Instrument glitch file OUT.h5: the closed loop's tilt-to-length
+    of the six links injected at the science readouts
+    (docs/lisa-ttl.md).
     """
     if fmt is None:
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")
@@ -96,6 +128,10 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin):
     from ..formats import trajectory as io
 
     opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin}
+    if fmt == "lisa-injection":
+        opts.update(run=run, ttl_coefficients=ttl_coefficients)
+    elif run is not None or ttl_coefficients is not None:
+        _fail(f"{'--run' if run is not None else '--ttl-coefficients'}: applies to --format lisa-injection only")
     try:
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
     except (FileNotFoundError, ValueError, io.OutputError) as exc:

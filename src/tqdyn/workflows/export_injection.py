@@ -1,0 +1,211 @@
+"""The closed loop's tilt-to-length as a LISA Instrument injection file: the job behind
+``tqdyn export CL.h5 --format lisa-injection OUT.h5 --run RUN.h5`` (docs/lisa-ttl.md).
+
+:func:`export_lisa_injection` reads the closed-loop file (:mod:`tqdyn.formats.closed_loop`) and the run
+it was made from (checked by SHA-256), forms the MOSA angles of the closed loop's attitude and MOSA
+outputs, each link's TTL s_ij (:func:`tqdyn.closedloop.ttl.link_ttl`, the distant term delayed by the
+run's light travel times of :func:`tqdyn.lightpath.light_travel_times_of`, as ``--format lisa``) and
+its science-readout injection g_ij = -(nu0/c) ds_ij/dt
+(:mod:`tqdyn.closedloop.ttl_injection`), and writes them as a LISA Instrument glitch file
+(:func:`tqdyn.formats.lisa_injection.write_lisa_injection`) at ``readout_isi_carrier_ij`` and
+``readout_isi_usb_ij``.  It prints nothing; the CLI reports.
+
+Time axis: the file's t is the closed loop's (the run's time axis since its epoch: TT for geocentric
+runs, which is the time of ``--format lisa``'s GCRS file; TDB for heliocentric ones, whose BCRS file
+counts TCB since the epoch: the two differ by L_B t = 1.55e-8 t, 1.3 ms a day, a phase of the jitter
+only).  It starts where the delayed distant term and the derivative are defined (tau/dt + 8 samples
+after the closed loop's first sample) and ends 4 samples before its last.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import pathlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..closedloop.ttl import MOSAS, TTLCoefficients
+from ..closedloop.ttl_budget import ANGLE_OUTPUTS
+from ..closedloop.ttl_injection import CENTRAL_FREQ_HZ, readout_injections
+from ..formats import trajectory as _io
+from ..formats.closed_loop import read_closed_loop
+from ..formats.lisa_injection import write_lisa_injection
+from ..lightpath import light_travel_times_of
+from ..lightpath.proper_time import scenario_gm_earth
+
+__all__ = ["LisaInjection", "export_lisa_injection", "ttl_coefficients_from_spec"]
+
+
+@dataclass(frozen=True)
+class LisaInjection:
+    """Summary of one export: ``path``; ``size`` samples from ``t0`` every ``dt`` [s]; ``coefficients``
+    (the spec); ``rms_hz`` the largest RMS of the six injections [Hz]; ``rms_m`` the largest RMS of the
+    six TTL path lengths s_ij [m]."""
+
+    path: pathlib.Path
+    size: int
+    t0: float
+    dt: float
+    coefficients: str
+    rms_hz: float
+    rms_m: float
+
+
+def ttl_coefficients_from_spec(spec: str) -> TTLCoefficients:
+    """TTL coefficients from a command-line spec: ``worst-case`` (LISA Instrument 2.3's random-draw bounds,
+    :func:`tqdyn.analysis.ttl_budget.worst_case_coefficients`), ``random:SEED``
+    (:meth:`TTLCoefficients.random`), ``constant:LP,LE,DP,DE`` (m/rad: local phi, local eta, distant phi,
+    distant eta on every MOSA) or the path of a JSON file {field: {MOSA: value}} with the fields of
+    :class:`TTLCoefficients`.  ValueError (one line) otherwise."""
+    from ..analysis.ttl_budget import worst_case_coefficients
+
+    allowed = "allowed: worst-case, random:SEED, constant:LP,LE,DP,DE (m/rad) or a JSON file"
+    s = str(spec).strip()
+    if s == "worst-case":
+        return worst_case_coefficients()
+    if s.startswith("random:"):
+        try:
+            seed = int(s[7:])
+        except ValueError:
+            raise ValueError(f"--ttl-coefficients = {spec!r}: the seed must be an integer; {allowed}") from None
+        if seed < 0:
+            raise ValueError(f"--ttl-coefficients = {spec!r}: the seed must be >= 0; {allowed}")
+        return TTLCoefficients.random(seed)
+    if s.startswith("constant:"):
+        parts = s[9:].split(",")
+        if len(parts) != 4:
+            raise ValueError(f"--ttl-coefficients = {spec!r}: constant needs 4 numbers; {allowed}")
+        vals = []
+        for p in parts:
+            try:
+                v = float(p)
+            except ValueError:
+                v = math.nan
+            if not math.isfinite(v):
+                raise ValueError(f"--ttl-coefficients = {spec!r}: {p.strip()!r} is not a finite number (m/rad)")
+            vals.append(v)
+        return TTLCoefficients.constant(*vals)
+    if os.path.isfile(s):
+        try:
+            d = json.loads(pathlib.Path(s).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"--ttl-coefficients = {spec!r}: not a readable JSON file ({exc})") from None
+        if not isinstance(d, dict):
+            raise ValueError(f"--ttl-coefficients = {spec!r}: expected a JSON object of coefficient fields")
+        try:
+            return TTLCoefficients(**d)
+        except TypeError as exc:
+            raise ValueError(f"--ttl-coefficients = {spec!r}: {exc}") from None
+    raise ValueError(f"--ttl-coefficients = {spec!r}: not a known spec or an existing file; {allowed}")
+
+
+def _sha256(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _delays_at(lp, t: np.ndarray) -> dict:
+    """Light travel time (s) of each link at the times t (s): linear in the run's rows (ltt moves by
+    ~1e-9 s/s), extrapolated linearly from the first / last two defined rows."""
+    tr = np.asarray(lp.t[0], dtype=np.float64) + np.asarray(lp.t[1], dtype=np.float64)
+    tau = np.asarray(lp.tau[0], dtype=np.float64) + np.asarray(lp.tau[1], dtype=np.float64)
+    out = {}
+    for k, m in enumerate(MOSAS):
+        ok = np.isfinite(tau[:, k])
+        x, y = tr[ok], tau[ok, k]
+        if x.size < 2:
+            raise ValueError(f"link {m}: fewer than 2 rows with a light travel time")
+        v = np.interp(t, x, y)
+        lo, hi = t < x[0], t > x[-1]
+        v[lo] = y[0] + (t[lo] - x[0]) * (y[1] - y[0]) / (x[1] - x[0])
+        v[hi] = y[-1] + (t[hi] - x[-1]) * (y[-1] - y[-2]) / (x[-1] - x[-2])
+        out[m] = v
+    return out
+
+
+def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: str | TTLCoefficients = "worst-case",
+                          central_freq: float = CENTRAL_FREQ_HZ) -> LisaInjection:
+    """Write the LISA Instrument injection file of the closed loop ``closed_loop_file`` of the run
+    ``run_file`` (module docstring).  ``coefficients``: a :func:`ttl_coefficients_from_spec` spec or a
+    :class:`TTLCoefficients`; ``central_freq`` [Hz]: LISA Instrument's ``central_freq`` (its default).
+
+    Raises FileNotFoundError, ValueError (one line: a closed-loop file of another run -- its
+    ``source_sha256`` differs from the run file's SHA-256 --, not a closed-loop file, bad coefficients)
+    or :class:`tqdyn.formats.trajectory.OutputError`; nothing is written then."""
+    coeffs = coefficients if isinstance(coefficients, TTLCoefficients) else ttl_coefficients_from_spec(coefficients)
+    spec = "given" if isinstance(coefficients, TTLCoefficients) else str(coefficients)
+    nu0 = float(central_freq)
+    if not (math.isfinite(nu0) and nu0 > 0):
+        raise ValueError(f"central_freq = {central_freq!r}: must be a finite frequency > 0 (Hz)")
+    out = _io.check_writable(out_path)
+    for src in (closed_loop_file, run_file):
+        if out.exists() and os.path.exists(src) and os.path.samefile(src, out):
+            raise ValueError(f"output {str(out)!r} is an input file; choose another output path")
+    cl = read_closed_loop(closed_loop_file)
+    if not os.path.isfile(run_file):
+        raise FileNotFoundError(f"run file {str(run_file)!r} not found")
+    digest = _sha256(run_file)
+    if cl.attrs.get("source_sha256") != digest:
+        raise ValueError(f"{cl.path} is the closed loop of another run ({cl.attrs.get('source_file')!r}, SHA-256 "
+                         f"{str(cl.attrs.get('source_sha256'))[:12]}...) than {str(run_file)!r} (SHA-256 "
+                         f"{digest[:12]}...); give the run it was made from")
+    traj = _io.read_trajectory(run_file)
+    if traj.n_sat != 3:
+        raise ValueError(f"{run_file}: n_sat = {traj.n_sat}; the six links need 3 satellites")
+    ts = cl.timeseries(list(ANGLE_OUTPUTS))
+    t = np.asarray(ts["time"].values, dtype=np.float64)
+    dt = 1.0 / float(cl.attrs["fs"])
+    vals = ts["values"].values                                             # (n, 3, 5)
+    outputs = {name: vals[:, :, k] for k, name in enumerate(ts["output"].values)}
+    # opening angle theta = mosa/angle_1 - mosa/angle_2 (as the closed loop's working points) mid-series
+    tr = np.asarray(traj["t"], dtype=np.float64)
+    mid = int(np.argmin(np.abs(tr - 0.5 * (t[0] + t[-1]))))
+    ang = np.asarray(traj["mosa/angle"][mid], dtype=np.float64)            # (3, 2)
+    theta = ang[:, 0] - ang[:, 1]
+    if traj.reference.origin == "sun":
+        lp = light_travel_times_of(traj)
+    else:
+        lp = light_travel_times_of(traj, shapiro=False, gm=scenario_gm_earth(traj))
+    delays = _delays_at(lp, t)
+    s, g = readout_injections(outputs, theta, coeffs, dt, delays, nu0)
+    ok = np.all([np.isfinite(g[m]) for m in MOSAS], axis=0)
+    idx = np.flatnonzero(ok)
+    if idx.size < 16 or not ok[idx[0]:idx[-1] + 1].all():
+        raise ValueError(f"{cl.path}: {t.size} samples leave {idx.size} with a defined TTL injection "
+                         f"(the delay takes {max(float(np.max(v)) for v in delays.values()) / dt:.0f} samples); "
+                         "make a longer closed-loop series")
+    sl = slice(idx[0], idx[-1] + 1)
+    series, desc = {}, {}
+    for m in MOSAS:
+        for point in ("readout_isi_carrier", "readout_isi_usb"):
+            series[f"{point}_{m}"] = g[m][sl]
+            desc[f"{point}_{m}"] = (f"-(nu0/c) ds_{m}/dt: the closed loop's tilt-to-length of link {m} as a "
+                                    "science-beatnote frequency fluctuation (Hz)")
+    attrs = {
+        "generator": "tqdyn export --format lisa-injection",
+        "central_freq": nu0,
+        "ttl_coefficients": spec,
+        "ttl_coefficients_json": json.dumps({k: getattr(coeffs, k) for k in ("local_phi", "local_eta",
+                                                                              "distant_phi", "distant_eta")}),
+        "opening_angles_rad": json.dumps([float(x) for x in theta]),
+        "source_closed_loop": str(cl.path),
+        "source_closed_loop_seed": int(cl.attrs.get("seed", 0)),
+        "source_run": str(pathlib.Path(run_file).resolve()),
+        "source_run_sha256": digest,
+        "time_scale": str(cl.attrs.get("source_time_scale", "")) + " seconds since the run's epoch (the closed "
+                      "loop's time axis)",
+        "ltt_note": lp.note,
+        "convention": "readout_isi_{carrier,usb}_ij = -(nu0/c) d s_ij/dt, s_ij = local TTL of MOSA ij + distant "
+                      "TTL of MOSA ji delayed by the light travel time (tqdyn.closedloop.ttl.link_ttl)",
+    }
+    path = write_lisa_injection(out, t[idx[0]], dt, series, attrs, desc)
+    return LisaInjection(path=path, size=int(idx.size), t0=float(t[idx[0]]), dt=dt, coefficients=spec,
+                         rms_hz=max(float(np.sqrt(np.mean(g[m][sl] ** 2))) for m in MOSAS),
+                         rms_m=max(float(np.sqrt(np.nanmean(s[m][sl] ** 2))) for m in MOSAS))
