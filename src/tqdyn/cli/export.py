@@ -60,19 +60,20 @@ def _export_lisa_injection(cl_file, out_file, opts) -> list[str]:
     given = [f"--{k.replace('_', '-')}" for k, v in opts.items() if v is not None and k not in _INJECTION_OPTIONS]
     if given:
         raise ValueError(f"{given[0]}: applies to --format lisa only; allowed with --format lisa-injection: "
-                         "--run, --ttl-coefficients")
+                         "--run, --ttl-coefficients, --tm-acceleration")
     if opts.get("run") is None:
         raise ValueError("--run RUN.h5 is required with --format lisa-injection (the run the closed-loop file "
                          "was made from: its light travel times)")
     from ..workflows.export_injection import export_lisa_injection
 
-    r = export_lisa_injection(cl_file, opts["run"], out_file, opts.get("ttl_coefficients") or "worst-case")
+    r = export_lisa_injection(cl_file, opts["run"], out_file, opts.get("ttl_coefficients") or "worst-case",
+                              tm=bool(opts.get("tm_acceleration")))
     return [f"LISA Instrument injection file {r.path}: {r.size} samples from t0 = {r.t0:g} s every {r.dt:g} s; "
             f"TTL coefficients {r.coefficients}; readout_isi_carrier/usb of the six links, RMS up to "
             f"{r.rms_hz:.3g} Hz ({r.rms_m:.3g} m of path length)"]
 
 
-_INJECTION_OPTIONS = ("run", "ttl_coefficients")
+_INJECTION_OPTIONS = ("run", "ttl_coefficients", "tm_acceleration")
 _EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem, "lisa-injection": _export_lisa_injection}
 FORMATS = tuple(_EXPORTERS)
 """Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files;
@@ -101,7 +102,10 @@ FORMATS = tuple(_EXPORTERS)
 @click.option("--ttl-coefficients", "ttl_coefficients", metavar="SPEC", default=None,
               help="lisa-injection: worst-case (default: LISA Instrument's random-draw bounds), random:SEED, "
                    "constant:LP,LE,DP,DE (m/rad) or a JSON file of TTL coefficients.")
-def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, run, ttl_coefficients):
+@click.option("--tm-acceleration", "tm_acceleration", is_flag=True, default=None,
+              help="lisa-injection: also inject the TMs' residual velocity (the integral of the closed loop's "
+                   "TM acceleration) at LISA Instrument's test-mass point.")
+def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, run, ttl_coefficients, tm_acceleration):
     """Export the trajectory RUN.h5 to OUT in another tool's format.
 
     --format lisa writes a LISA orbit file OUT.h5 (lisaorbits layout 2.x,
@@ -129,9 +133,11 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, run, ttl_
 
     opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin}
     if fmt == "lisa-injection":
-        opts.update(run=run, ttl_coefficients=ttl_coefficients)
-    elif run is not None or ttl_coefficients is not None:
-        _fail(f"{'--run' if run is not None else '--ttl-coefficients'}: applies to --format lisa-injection only")
+        opts.update(run=run, ttl_coefficients=ttl_coefficients, tm_acceleration=tm_acceleration)
+    else:
+        for name, v in (("--run", run), ("--ttl-coefficients", ttl_coefficients), ("--tm-acceleration", tm_acceleration)):
+            if v is not None:
+                _fail(f"{name}: applies to --format lisa-injection only")
     try:
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
     except (FileNotFoundError, ValueError, io.OutputError) as exc:

@@ -8,7 +8,8 @@ run's light travel times of :func:`tqdyn.lightpath.light_travel_times_of`, as ``
 its science-readout injection g_ij = -(nu0/c) ds_ij/dt
 (:mod:`tqdyn.closedloop.ttl_injection`), and writes them as a LISA Instrument glitch file
 (:func:`tqdyn.formats.lisa_injection.write_lisa_injection`) at ``readout_isi_carrier_ij`` and
-``readout_isi_usb_ij``.  It prints nothing; the CLI reports.
+``readout_isi_usb_ij``; with ``tm=True`` also the TMs' residual velocity (the integral of the closed loop's
+``tm{l}_acceleration``) at ``tm_ij``.  It prints nothing; the CLI reports.
 
 Time axis: the file's t is the closed loop's (the run's time axis since its epoch: TT for geocentric
 runs, which is the time of ``--format lisa``'s GCRS file; TDB for heliocentric ones, whose BCRS file
@@ -30,7 +31,7 @@ import numpy as np
 
 from ..closedloop.ttl import MOSAS, TTLCoefficients
 from ..closedloop.ttl_budget import ANGLE_OUTPUTS
-from ..closedloop.ttl_injection import CENTRAL_FREQ_HZ, readout_injections
+from ..closedloop.ttl_injection import CENTRAL_FREQ_HZ, readout_injections, tm_velocity_injections
 from ..formats import trajectory as _io
 from ..formats.closed_loop import read_closed_loop
 from ..formats.lisa_injection import write_lisa_injection
@@ -130,11 +131,26 @@ def _delays_at(lp, t: np.ndarray) -> dict:
     return out
 
 
+def _axis_signs(traj, run_file) -> tuple:
+    """e_l . X_OA_l (+-1) of the run's two sensitive axes; ValueError unless each is +-X_OA_l."""
+    axes = np.asarray(traj.spacecraft.sensitive_axes, dtype=np.float64)
+    out = []
+    for l in range(2):
+        e = axes[l] / np.linalg.norm(axes[l])
+        if abs(abs(e[0]) - 1.0) > 1e-12:
+            raise ValueError(f"{run_file}: spacecraft.sensitive_axes[{l}] = {axes[l].tolist()}; the TM injection "
+                             "needs sensitive axes along +-X_OA (allowed: [1, 0, 0] or [-1, 0, 0])")
+        out.append(float(np.sign(e[0])))
+    return tuple(out)
+
+
 def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: str | TTLCoefficients = "worst-case",
-                          central_freq: float = CENTRAL_FREQ_HZ) -> LisaInjection:
+                          central_freq: float = CENTRAL_FREQ_HZ, tm: bool = False) -> LisaInjection:
     """Write the LISA Instrument injection file of the closed loop ``closed_loop_file`` of the run
     ``run_file`` (module docstring).  ``coefficients``: a :func:`ttl_coefficients_from_spec` spec or a
-    :class:`TTLCoefficients`; ``central_freq`` [Hz]: LISA Instrument's ``central_freq`` (its default).
+    :class:`TTLCoefficients`; ``central_freq`` [Hz]: LISA Instrument's ``central_freq`` (its default);
+    ``tm``: also inject the TMs' residual velocity at ``tm_ij`` (m/s; the run's sensitive axes must be
+    +-X_OA_l).
 
     Raises FileNotFoundError, ValueError (one line: a closed-loop file of another run -- its
     ``source_sha256`` differs from the run file's SHA-256 --, not a closed-loop file, bad coefficients)
@@ -159,7 +175,8 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
     traj = _io.read_trajectory(run_file)
     if traj.n_sat != 3:
         raise ValueError(f"{run_file}: n_sat = {traj.n_sat}; the six links need 3 satellites")
-    ts = cl.timeseries(list(ANGLE_OUTPUTS))
+    signs = _axis_signs(traj, run_file) if tm else None
+    ts = cl.timeseries(list(ANGLE_OUTPUTS) + (["tm1_acceleration", "tm2_acceleration"] if tm else []))
     t = np.asarray(ts["time"].values, dtype=np.float64)
     dt = 1.0 / float(cl.attrs["fs"])
     vals = ts["values"].values                                             # (n, 3, 5)
@@ -175,6 +192,7 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
         lp = light_travel_times_of(traj, shapiro=False, gm=scenario_gm_earth(traj))
     delays = _delays_at(lp, t)
     s, g = readout_injections(outputs, theta, coeffs, dt, delays, nu0)
+    v = tm_velocity_injections(outputs["tm1_acceleration"], outputs["tm2_acceleration"], dt, signs) if tm else {}
     ok = np.all([np.isfinite(g[m]) for m in MOSAS], axis=0)
     idx = np.flatnonzero(ok)
     if idx.size < 16 or not ok[idx[0]:idx[-1] + 1].all():
@@ -188,6 +206,10 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
             series[f"{point}_{m}"] = g[m][sl]
             desc[f"{point}_{m}"] = (f"-(nu0/c) ds_{m}/dt: the closed loop's tilt-to-length of link {m} as a "
                                     "science-beatnote frequency fluctuation (Hz)")
+        if tm:
+            series[f"tm_{m}"] = v[m][sl] - v[m][sl].mean()
+            desc[f"tm_{m}"] = (f"residual velocity (m/s) of the TM of MOSA {m} towards the distant spacecraft: the "
+                               "time integral of the closed loop's tm acceleration, mean removed")
     attrs = {
         "generator": "tqdyn export --format lisa-injection",
         "central_freq": nu0,
@@ -202,6 +224,7 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
         "time_scale": str(cl.attrs.get("source_time_scale", "")) + " seconds since the run's epoch (the closed "
                       "loop's time axis)",
         "ltt_note": lp.note,
+        "test_masses": "tm_ij: TM residual velocity (m/s)" if tm else "not injected",
         "convention": "readout_isi_{carrier,usb}_ij = -(nu0/c) d s_ij/dt, s_ij = local TTL of MOSA ij + distant "
                       "TTL of MOSA ji delayed by the light travel time (tqdyn.closedloop.ttl.link_ttl)",
     }
