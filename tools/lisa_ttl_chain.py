@@ -45,8 +45,6 @@ def simulate(orbits, injection=None, size: int = 3000, laser: bool = False, seed
     Returns (t, sci, x2, group_delay): measurement times [s], {link: sci carrier fluctuations [Hz]},
     X2 [Hz] and the anti-aliasing filter's group delay [s]."""
     from lisainstrument import Instrument
-    from pytdi import Data
-    from pytdi.michelson import X2
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
