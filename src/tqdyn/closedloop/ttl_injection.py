@@ -21,7 +21,7 @@ plus sign; so the injection
     g_ij(t) = -(nu0 / c) ds_ij/dt    [Hz]
 
 enters the science carrier exactly as LISA Instrument's TTL does, up to the omitted factors: the
-carrier offset O_ji (|O| < 30 MHz in its static frequency plan: < 1.1e-7 relative), the Doppler factor
+carrier offset O_ji (tens of MHz: ~1e-7 relative; <= 16 MHz with lock = "six"), the Doppler factor
 1 - d_ppr (|d_ppr| ~ 1e-8) and the delay (tqdyn's light travel time instead of the proper
 pseudorange: their difference, the clocks' desynchronisation, is microseconds, a phase 2 pi f dtau).
 The upper sideband carries the same TTL with nu0 + O + f_mod (f_mod = 2.4 GHz: 1e-5 relative): the
