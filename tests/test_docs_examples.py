@@ -13,7 +13,7 @@ import re
 import pytest
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs"
-PAGES = ("../README.md", "python.md", "lisa-toolchain.md")
+PAGES = ("../README.md", "python.md", "lisa-toolchain.md", "lisa-ttl.md")
 
 
 def _blocks(page):
@@ -39,6 +39,9 @@ def test_python_blocks_run(page, tmp_path, monkeypatch, capsys):
     if page == "lisa-toolchain.md":
         for name in ("TianQin", "LISA"):
             assert float(re.search(name + r": X2 suppresses laser noise by ([0-9.e+-]+)", out).group(1)) > 1e7
+    if page == "lisa-ttl.md":
+        m = re.search(r"X2 RMS: ([0-9.e+-]+) Hz without TTL, ([0-9.e+-]+) Hz with it", out)
+        assert m and float(m.group(2)) > 0 == float(m.group(1))   # only the TTL in X2
     if os.environ.get("TQDYN_WRITE_DOC_FIGURES") and page == "python.md":
         (DOCS / "figures").mkdir(exist_ok=True)
         (DOCS / "figures" / "quickstart.png").write_bytes((tmp_path / "quickstart.png").read_bytes())

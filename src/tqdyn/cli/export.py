@@ -1,9 +1,11 @@
-"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5``, ``--format oem OUT.oem`` and
-``tqdyn export CL.h5 --format ttl OUT.h5`` (the positional file is then a closed-loop file).
+"""Command line: ``tqdyn export RUN.h5 --format lisa OUT.h5``, ``--format oem OUT.oem``,
+``tqdyn export CL.h5 --format ttl OUT.h5`` and ``tqdyn export CL.h5 --format lisa-injection OUT.h5
+--run RUN.h5`` (the positional file is then a closed-loop file).
 
 A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
 It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`,
-:func:`tqdyn.workflows.export_oem.export_oem`, :func:`tqdyn.workflows.export_ttl.export_ttl`).  As
+:func:`tqdyn.workflows.export_oem.export_oem`, :func:`tqdyn.workflows.export_ttl.export_ttl`,
+:func:`tqdyn.workflows.export_injection.export_lisa_injection`).  As
 everywhere in the CLI, bad input exits with status 2 and one line
 ``tqdyn: error: ...`` on stderr, and no output file is left behind.
 
@@ -24,6 +26,7 @@ __all__ = ["FORMATS", "export"]
 
 _LISA_OPTIONS = ("shapiro", "frame", "axes", "time_origin")
 _TTL_OPTIONS = ("coefficients", "seed", "drift", "step")
+_INJECTION_OPTIONS = ("run", "tm_acceleration")
 #: LISA Pathfinder's measured drift of its TTL coefficients, 1 um/rad in 100 days, in m/rad per day
 #: (:data:`tqdyn.closedloop.ttl.LPF_DRIFT_M_PER_RAD_PER_S`).
 _LPF_DRIFT_PER_DAY = 1e-8
@@ -39,7 +42,7 @@ def _refuse(opts, names, fmt, allowed) -> None:
 
 def _export_lisa(run_file, out_file, opts) -> list[str]:
     """``--format lisa``: :func:`tqdyn.workflows.export.export_lisa`; returns the report lines."""
-    _refuse(opts, _TTL_OPTIONS, "lisa", ["--shapiro/--no-shapiro", "--frame", "--axes", "--time-origin"])
+    _refuse(opts, _TTL_OPTIONS + _INJECTION_OPTIONS, "lisa", ["--shapiro/--no-shapiro", "--frame", "--axes", "--time-origin"])
     from ..workflows.export import export_lisa
 
     summary = export_lisa(run_file, out_file, shapiro=opts["shapiro"], frame=opts["frame"],
@@ -62,7 +65,7 @@ def _export_lisa(run_file, out_file, opts) -> list[str]:
 
 def _export_oem(run_file, out_file, opts) -> list[str]:
     """``--format oem``: :func:`tqdyn.workflows.export_oem.export_oem`; returns the report lines."""
-    _refuse(opts, _LISA_OPTIONS + _TTL_OPTIONS, "oem", [])
+    _refuse(opts, _LISA_OPTIONS + _TTL_OPTIONS + _INJECTION_OPTIONS, "oem", [])
     from ..workflows.export_oem import export_oem
 
     paths = export_oem(run_file, out_file)
@@ -87,7 +90,7 @@ def _drift_per_second(text) -> float | None:
 
 def _export_ttl(cl_file, out_file, opts) -> list[str]:
     """``--format ttl``: :func:`tqdyn.workflows.export_ttl.export_ttl`; returns the report lines."""
-    _refuse(opts, _LISA_OPTIONS, "ttl", ["--coefficients", "--seed", "--drift", "--step"])
+    _refuse(opts, _LISA_OPTIONS + _INJECTION_OPTIONS, "ttl", ["--coefficients", "--seed", "--drift", "--step"])
     from ..workflows.export_ttl import export_ttl
 
     summary = export_ttl(cl_file, out_file, coefficients=opts["coefficients"] or "worst-case", seed=opts["seed"],
@@ -102,16 +105,34 @@ def _export_ttl(cl_file, out_file, opts) -> list[str]:
             f"coefficients: {how}{drift}"]
 
 
-_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem, "ttl": _export_ttl}
+def _export_lisa_injection(cl_file, out_file, opts) -> list[str]:
+    """``--format lisa-injection``: :func:`tqdyn.workflows.export_injection.export_lisa_injection` of the
+    closed-loop file ``cl_file`` (the command's first argument) and its run ``--run``."""
+    _refuse(opts, _LISA_OPTIONS + ("step",), "lisa-injection",
+            ["--run", "--coefficients", "--seed", "--drift", "--tm-acceleration"])
+    if opts.get("run") is None:
+        raise ValueError("--run RUN.h5 is required with --format lisa-injection (the run the closed-loop file "
+                         "was made from: its light travel times)")
+    from ..workflows.export_injection import export_lisa_injection
+
+    r = export_lisa_injection(cl_file, opts["run"], out_file, opts["coefficients"] or "worst-case", seed=opts["seed"],
+                              drift=_drift_per_second(opts["drift"]), tm=bool(opts.get("tm_acceleration")))
+    return [f"LISA Instrument injection file {r.path}: {r.size} samples from t0 = {r.t0:g} s every {r.dt:g} s; "
+            f"TTL coefficients {r.coefficients}; readout_isi_carrier/usb of the six links, RMS up to "
+            f"{r.rms_hz:.3g} Hz ({r.rms_m:.3g} m of path length)"]
+
+
+_EXPORTERS = {"lisa": _export_lisa, "oem": _export_oem, "ttl": _export_ttl, "lisa-injection": _export_lisa_injection}
 FORMATS = tuple(_EXPORTERS)
 """Export formats: ``lisa`` = LISA orbit file (lisaorbits layout 2.x); ``oem`` = CCSDS OEM 2.0 files;
-``ttl`` = LISA Instrument's TTL coefficient file (from a closed-loop file)."""
+``ttl`` = LISA Instrument's TTL coefficient file and ``lisa-injection`` = LISA Instrument glitch file of the
+closed loop's tilt-to-length (both from a closed-loop file)."""
 
 
 @click.command("export")
 @click.argument("run_file", metavar="RUN.h5")
 @click.argument("out_file", metavar="OUT")
-@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem, ttl.")
+@click.option("--format", "fmt", metavar="FORMAT", help="Output format (required); allowed: lisa, oem, ttl, lisa-injection.")
 @click.option("--shapiro/--no-shapiro", default=None,
               help="lisa: include the Shapiro delay in the light travel times (GCRS: the Earth's; BCRS: the Sun's, "
                    "and the Earth's for a geocentric run).  Default: on for heliocentric runs, off for geocentric.")
@@ -125,17 +146,24 @@ FORMATS = tuple(_EXPORTERS)
               help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
                    "Unix time of the first sample (as lisaorbits' OEM orbits).")
 @click.option("--coefficients", default=None, metavar="worst-case|random|FILE",
-              help="ttl: the TTL coefficients: worst-case (default; every MOSA at the half-widths of LISA "
+              help="ttl, lisa-injection: the TTL coefficients: worst-case (default; every MOSA at the half-widths of LISA "
                    "Instrument's random draw, 2.2 mm/rad local, 2.4 mm/rad distant), random (uniform in those "
                    "ranges, with --seed) or a .toml/.json file with tables local_phi, local_eta, distant_phi, "
                    "distant_eta keyed by MOSA (12, 23, 31, 13, 32, 21) in m/rad.")
-@click.option("--seed", type=int, default=None, help="ttl, --coefficients random only: the seed of the draw.")
+@click.option("--seed", type=int, default=None, help="ttl, lisa-injection, --coefficients random only: the seed of the draw.")
 @click.option("--drift", default=None, metavar="RATE",
-              help="ttl: every linear coefficient drifts by RATE m/rad per day from the first sample on; lpf = "
+              help="ttl, lisa-injection: every linear coefficient drifts by RATE m/rad per day from the first sample on; lpf = "
                    "LISA Pathfinder's measured 1 um/rad per 100 days.  Default: constant.")
 @click.option("--step", type=float, default=None, metavar="SECONDS",
               help="ttl: sample step (s) over the closed-loop file's span.  Default: its own time grid.")
-def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficients, seed, drift, step):
+@click.option("--run", "run", metavar="RUN.h5", default=None,
+              help="lisa-injection: the run the closed-loop file was made from (its light travel times; checked "
+                   "by SHA-256).")
+@click.option("--tm-acceleration", "tm_acceleration", is_flag=True, default=None,
+              help="lisa-injection: also inject the TMs' residual velocity (the integral of the closed loop's "
+                   "TM acceleration) at LISA Instrument's test-mass point.")
+def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficients, seed, drift, step, run,
+           tm_acceleration):
     """Export the trajectory RUN.h5 to OUT in another tool's format.
 
     With --format ttl the positional file is a closed-loop file CL.h5
@@ -156,6 +184,12 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficie
     by Instrument(ttl_coeffs=("file", "OUT.h5"))): per-MOSA linear
     coefficients sampled on the closed-loop file's time grid t (the run's
     time axis since its epoch, the t of the GCRS LISA orbit file).
+
+    --format lisa-injection takes a closed-loop file CL.h5 (tqdyn
+    closed-loop) in place of RUN.h5 and its run as --run RUN.h5, and writes
+    a LISA Instrument glitch file OUT.h5: the closed loop's tilt-to-length
+    of the six links injected at the science readouts
+    (docs/lisa-ttl.md).
     """
     if fmt is None:
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")
@@ -164,7 +198,8 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficie
     from ..formats import trajectory as io
 
     opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin,
-            "coefficients": coefficients, "seed": seed, "drift": drift, "step": step}
+            "coefficients": coefficients, "seed": seed, "drift": drift, "step": step, "run": run,
+            "tm_acceleration": tm_acceleration}
     try:
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
     except (FileNotFoundError, ValueError, io.OutputError) as exc:

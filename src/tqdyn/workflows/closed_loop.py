@@ -75,7 +75,7 @@ def resolved_configuration(config, architecture: str, settings: dict) -> dict:
                       for k, a in noise.items()}}
 
 
-def _sha256(path) -> str:
+def file_sha256(path) -> str:
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 22), b""):
@@ -121,7 +121,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings)
     ta = traj.attrs
     attrs = {"mission": model.mission, "source_file": os.path.basename(src), "source_path": src,
-             "source_sha256": _sha256(src),
+             "source_sha256": file_sha256(src),
              "source_scenario_sha256": hashlib.sha256(traj.scenario_toml.encode("utf-8")).hexdigest(),
              "source_format_version": int(ta.get("format_version", 0)),
              "source_tqdyn_version": str(ta.get("tqdyn_version", "")),

@@ -14,7 +14,6 @@ Time axis: the file's ``t`` is the closed-loop file's ``t`` -- seconds on the ru
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import pathlib
@@ -27,8 +26,9 @@ from ..analysis.ttl_budget import worst_case_coefficients
 from ..closedloop.ttl import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
 from ..formats.closed_loop import read_closed_loop
 from ..formats.ttl import write_ttl_file
+from .closed_loop import file_sha256
 
-__all__ = ["COEFFICIENT_KINDS", "TTLExport", "export_ttl", "read_coefficient_file"]
+__all__ = ["COEFFICIENT_KINDS", "TTLExport", "coefficient_set", "export_ttl", "read_coefficient_file"]
 
 #: Built-in coefficient sets (anything else is a TOML or JSON file of per-MOSA coefficients).
 COEFFICIENT_KINDS = ("worst-case", "random")
@@ -46,14 +46,6 @@ class TTLExport:
     t_stop: float
     step: float | None
     model: dict
-
-
-def _sha256(path: pathlib.Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def read_coefficient_file(path) -> TTLCoefficients:
@@ -82,7 +74,11 @@ def read_coefficient_file(path) -> TTLCoefficients:
         raise ValueError(f"{p}: {exc}") from None
 
 
-def _base(coefficients, seed) -> tuple[TTLCoefficients, dict]:
+def coefficient_set(coefficients, seed=None) -> tuple[TTLCoefficients, dict]:
+    """The linear TTL coefficients of the command's ``--coefficients`` and ``--seed`` (m/rad) and their
+    description {"kind": ...}: "worst-case" (:func:`tqdyn.analysis.ttl_budget.worst_case_coefficients`),
+    "random" (:meth:`TTLCoefficients.random` with ``seed``) or a TOML/JSON file
+    (:func:`read_coefficient_file`).  One-line ValueError (or FileNotFoundError) otherwise."""
     if coefficients == "random":
         if seed is None:
             raise ValueError("--seed: required with --coefficients random (an integer >= 0)")
@@ -124,7 +120,7 @@ def export_ttl(cl_file, out_file, *, coefficients: str = "worst-case", seed: int
     order: the file's spline degree (3 or 5).  Bad input: a one-line ValueError (or FileNotFoundError,
     :class:`tqdyn.formats.closed_loop.ClosedLoopFormatError` for a file that is not a closed-loop file)
     before anything is written."""
-    base, model = _base(coefficients, seed)
+    base, model = coefficient_set(coefficients, seed)
     model["base_m_per_rad"] = {f: getattr(base, f) for f in LINEAR_FIELDS}
     src = pathlib.Path(cl_file)
     cl = read_closed_loop(src)
@@ -154,7 +150,7 @@ def export_ttl(cl_file, out_file, *, coefficients: str = "worst-case", seed: int
     attrs = {"time_axis": f"s on the run's time axis ({scale or 'its time_scale'}) since its epoch: the "
                           "closed-loop file's t, the t of the GCRS LISA orbit file of the same run",
              "coefficient_model": json.dumps(model, sort_keys=True),
-             "source_file": src.name, "source_sha256": _sha256(src),
+             "source_file": src.name, "source_sha256": file_sha256(src),
              "source_epoch_utc": cl.attrs.get("source_epoch_utc", ""), "source_time_scale": scale}
     path = write_ttl_file(out_file, t, values, order=order, attrs=attrs)
     return TTLExport(path, int(t.size), float(t[0]), float(t[-1]), None if step is None else float(step), model)
