@@ -169,8 +169,8 @@ def ttl_budget_values(model, frequencies=SUMMARY_FREQUENCIES_HZ, band=SUMMARY_BA
     the model's frequency grid; ``values``: :func:`link_budget_summary` of it at ``frequencies`` [Hz] and in
     ``band`` [Hz] (against :data:`TTL_ALLOCATION` of the mission), with ``coefficients`` (their description,
     ``local_m_per_rad``, ``distant_m_per_rad``) and, unless ``seed`` is None, ``random``: the same summary
-    (``seed``, per link ``ttl`` at ``frequencies``, ``ttl_max``, ``ttl_over_requirement_max``,
-    ``dominant_source``) for the coefficients ``TTLCoefficients.random(seed)`` (LISA Instrument's uniform
+    (``seed``, ``worst_link``, ``ttl_over_requirement_range`` [smallest, largest] over the links, per link
+    ``ttl`` at ``frequencies``, ``ttl_max``, ``ttl_max_f_hz``, ``ttl_over_requirement_max``, ``dominant_source``) for the coefficients ``TTLCoefficients.random(seed)`` (LISA Instrument's uniform
     draw within those half-widths).  Units: m/Hz^1/2, Hz, m/rad."""
     fq = np.asarray(frequencies, dtype=np.float64)
     w = RANDOM_HALF_WIDTH_M_PER_RAD
@@ -187,6 +187,8 @@ def ttl_budget_values(model, frequencies=SUMMARY_FREQUENCIES_HZ, band=SUMMARY_BA
         rs = link_budget_summary(rd, single_link_budget(model, c, f=fq, segment=segment, dt=dt), band,
                                  allocation=allocation)
         keep = ("ttl", "ttl_max", "ttl_max_f_hz", "ttl_over_requirement_max", "dominant_source")
+        ratios = [v["ttl_over_requirement_max"] for v in rs["links"].values()]
         values["random"] = {"seed": int(seed), "worst_link": rs["worst_link"],
+                            "ttl_over_requirement_range": [min(ratios), max(ratios)],
                             "links": {k: {q: v[q] for q in keep} for k, v in rs["links"].items()}}
     return values, ds
