@@ -204,10 +204,11 @@ def _ttl_figures(mission: str, t: dict, ds, fig_dir, where: str) -> list:
     f = ds["frequency"].values
     links = [str(x) for x in ds["link"].values]
     req, ro = ds["requirement"].values, ds["readout"].values[0]
-    coeffs = f"TTL coefficients {t['local_m_per_rad'] * 1e3:g} / {t['distant_m_per_rad'] * 1e3:g} mm/rad on every MOSA"
+    coeffs = (f"TTL coefficients {t['local_m_per_rad'] * 1e3:g} (local) / {t['distant_m_per_rad'] * 1e3:g} (distant) "
+              "mm/rad on every MOSA")
     paths = plot_link_budget(f, links, ds["ttl_total"].values, ro, ds["tm_acceleration_total"].values,
                              ds["total"].values, req, fig_dir, f"{mission}-ttl-budget",
-                             f"{mission}: single-link budget of the six links ({coeffs}, local / distant)\n"
+                             f"{mission}: single-link budget of the six links ({coeffs})\n"
                              f"{where}; the loops of the three spacecraft", LINK_REQUIREMENT_TEXT[mission],
                              allocation=t["allocation"], band=MISSION_BAND_HZ)
     w = t["worst_link"]
