@@ -233,3 +233,20 @@ def test_link_budget_summary_against_an_analytic_budget():
     assert v["dominant_source"] == "a" and v["dominant_source_share"] == pytest.approx(100 / 101, rel=1e-12)
     assert v["ttl"] == [pytest.approx(1e-13 * math.sqrt(1.01), rel=1e-12)]
     assert s["frequencies_hz"] == [1e-3] and s["requirement"] == [2e-12]
+
+
+def test_summary_refuses_a_band_outside_the_grid_and_bad_frequencies_in_one_line():
+    from tqdyn.analysis.closed_loop import ClosedLoopModel
+    from tqdyn.analysis.ttl_budget import link_budget_summary, single_link_budget, ttl_budget_values
+
+    cl = _lisa_loop()
+    model = ClosedLoopModel(loops=[[(0.0, cl)]] * 3, noise=default_noise("lisa"), mission="lisa",
+                            settings={"f_min": 1e-4, "f_max": 1.0, "n_freq": 11}, satellite_names=("1", "2", "3"),
+                            t_span=(0.0, 1.0), parts=[[(None, w)] for w in [_WP] * 3])
+    ds = single_link_budget(model)
+    for call, match in ((lambda: link_budget_summary(ds, ds, band=(2.0, 3.0)), "band = "),
+                        (lambda: link_budget_summary(ds, ds, allocation=-1.0), "allocation = "),
+                        (lambda: ttl_budget_values(model, frequencies=(1e-3, 0.0)), "frequencies = ")):
+        with pytest.raises(ValueError, match=match) as e:
+            call()
+        assert "\n" not in str(e.value)

@@ -123,6 +123,11 @@ def link_budget_summary(ds, points, band=SUMMARY_BAND_HZ, bands=SUMMARY_BANDS_HZ
     * ``worst_link``: the link with the largest ``ttl_over_requirement_max``."""
     f = ds["frequency"].values
     m = (f >= band[0]) & (f <= band[1])
+    if not np.any(m):
+        raise ValueError(f"band = {tuple(band)!r}: holds no frequency of the budget's grid "
+                         f"({f[0]:.3g} .. {f[-1]:.3g} Hz); allowed: a band (f_lo, f_hi) [Hz] that overlaps it")
+    if allocation is not None and not (math.isfinite(allocation) and allocation > 0):
+        raise ValueError(f"allocation = {allocation!r}: must be a finite ASD > 0 (m/Hz^1/2) or None")
     sources = [str(x) for x in ds["source"].values]
     band_names = [f"{lo:g}-{hi:g} Hz" for lo, hi in bands]
     req = ds["requirement"].values
@@ -170,9 +175,12 @@ def ttl_budget_values(model, frequencies=SUMMARY_FREQUENCIES_HZ, band=SUMMARY_BA
     ``band`` [Hz] (against :data:`TTL_ALLOCATION` of the mission), with ``coefficients`` (their description,
     ``local_m_per_rad``, ``distant_m_per_rad``) and, unless ``seed`` is None, ``random``: the same summary
     (``seed``, ``worst_link``, ``ttl_over_requirement_range`` [smallest, largest] over the links, per link
-    ``ttl`` at ``frequencies``, ``ttl_max``, ``ttl_max_f_hz``, ``ttl_over_requirement_max``, ``dominant_source``) for the coefficients ``TTLCoefficients.random(seed)`` (LISA Instrument's uniform
+    ``ttl`` at ``frequencies``, ``ttl_max``, ``ttl_max_f_hz``, ``ttl_over_requirement_max``,
+    ``dominant_source``) for the coefficients ``TTLCoefficients.random(seed)`` (LISA Instrument's uniform
     draw within those half-widths).  Units: m/Hz^1/2, Hz, m/rad."""
-    fq = np.asarray(frequencies, dtype=np.float64)
+    fq = np.atleast_1d(np.asarray(frequencies, dtype=np.float64))
+    if fq.ndim != 1 or not np.all(np.isfinite(fq) & (fq > 0)):
+        raise ValueError(f"frequencies = {frequencies!r}: must be finite frequencies > 0 (Hz)")
     w = RANDOM_HALF_WIDTH_M_PER_RAD
     ds = single_link_budget(model, segment=segment, dt=dt)
     allocation = TTL_ALLOCATION.get(model.mission)
