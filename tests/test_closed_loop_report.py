@@ -140,3 +140,60 @@ def test_cli_closed_loop_bad_input(args, match, tmp_path, capsys):
     code, _out, err = _cli(["report", *args, "--out", str(tmp_path / "x")], capsys)
     assert code == 2 and match in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "x").exists()
+
+
+def test_ttl_record_is_the_single_link_budget(lisa):
+    """The record's TTL part (worst-case coefficients, six links): at each named frequency the total is
+    the power sum of TTL, TM acceleration and readout and the margin is requirement / total (round-off);
+    the smallest margin in the band is at most the margins at the named frequencies; the coefficients are
+    LISA Instrument 2.3's half-widths, 2.2 / 2.4 mm/rad; the worst link has the largest TTL / requirement;
+    the seeded random draw is recorded for the same six links."""
+    _, record = lisa
+    t = record["values"]["missions"]["lisa"]["ttl"]
+    assert (t["local_m_per_rad"], t["distant_m_per_rad"]) == (2.2e-3, 2.4e-3)
+    assert sorted(t["links"]) == sorted(["12", "23", "31", "13", "32", "21"])
+    req, ro = np.array(t["requirement"]), np.array(t["readout"])
+    for link, v in t["links"].items():
+        ttl, tm, tot = np.array(v["ttl"]), np.array(v["tm_acceleration"]), np.array(v["total"])
+        np.testing.assert_allclose(tot, np.sqrt(ttl ** 2 + tm ** 2 + ro ** 2), rtol=1e-12)
+        np.testing.assert_allclose(v["margin"], req / tot, rtol=1e-12)
+        assert v["worst_margin"] <= min(v["margin"]) * (1 + 1e-12)
+        assert t["band_hz"][0] <= v["worst_margin_f_hz"] <= t["band_hz"][1]
+        assert len(t["random"]["links"][link]["ttl"]) == len(ttl)
+    worst = max(t["links"].values(), key=lambda v: v["ttl_over_requirement_max"])
+    assert t["links"][t["worst_link"]] is worst
+
+
+def test_record_holds_every_ttl_value_the_docs_quote(lisa):
+    """Every closedloop marker of docs/tilt-to-length.md resolves in the fresh record (other missions read
+    as lisa, other links as the worst link's name of the record: the layout is the same)."""
+    _, record = lisa
+    spec = importlib.util.spec_from_file_location("render_docs", ROOT / "tools" / "render_docs.py")
+    rd = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rd)
+    page = (ROOT / "docs" / "tilt-to-length.md").read_text(encoding="utf-8")
+    paths = [m.group("path") for m in rd.INLINE.finditer(page) if m.group("src") == "closedloop"]
+    assert len(paths) > 10
+    for path in paths:
+        p = re.sub(r"missions/(tianqin|taiji)/", "missions/lisa/", path)
+        p = re.sub(r"/links/\d\d/", "/links/12/", p)
+        value = rd.lookup({"closedloop": record}, "closedloop", p)
+        assert value is not None or "allocation" in p, path
+
+
+def test_report_writes_the_ttl_figures_and_row(tmp_path, monkeypatch):
+    """The closed-loop report of LISA with figures: the single-link budget and the worst link's TTL by
+    source, PNG and PDF, non-empty; the summary table carries the TTL row (the report's other figures,
+    tested above, are skipped here to keep the test short)."""
+    import tqdyn.workflows.report.closed_loop as mod
+
+    for name in ("plot_budget_stack", "plot_loop_gains", "plot_residual_acceleration"):
+        monkeypatch.setattr(mod, name, lambda *a, **k: [])
+    rep = report_closed_loop(tmp_path, missions=("lisa",))
+    names = sorted(p.name for p in rep.figures)
+    assert names == sorted(f"lisa-ttl-{s}.{e}" for s in ("budget", "sources") for e in ("png", "pdf"))
+    for p in rep.figures:
+        assert p.parent == tmp_path / "closed-loop" and p.stat().st_size > 10_000, p
+    summary = rep.summary_path.read_text(encoding="utf-8")
+    w = rep.values["missions"]["lisa"]["ttl"]["worst_link"]
+    assert f"lisa: TTL of link {w} (worst-case coefficients)" in summary

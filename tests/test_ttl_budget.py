@@ -158,3 +158,95 @@ def test_single_link_budget_dataset_and_its_tm_term():
     assert ds["requirement"].values[k] == pytest.approx(15e-12 * math.sqrt(1 + (2e-3 / f[k]) ** 4), rel=1e-12)
     tot = np.sqrt(ds["ttl_total"] ** 2 + ds["tm_acceleration_total"] ** 2 + ds["readout"] ** 2)
     np.testing.assert_allclose(ds["total"].values, tot.values, rtol=1e-12)
+
+
+def test_link_ttl_asd_of_a_dynamic_loop_is_the_coefficients_times_python_controls_transfer():
+    """LISA's closed loop (dynamic, all loops closed), DWS alone (4 inputs), random coefficients (seed 2):
+    links 12 and 13 against the transfers evaluated by python-control's own ``frequency_response`` and
+    the MOSA angles written out by hand (module docstring: phi = -(phi_z + dth_l), eta = sin(s_l theta/2)
+    phi_x - cos(s_l theta/2) phi_y, s_1 = +1, s_2 = -1; link 12 = MOSA 2 of spacecraft 1 + MOSA 1 of
+    spacecraft 2, link 13 = MOSA 1 of spacecraft 1 + MOSA 2 of spacecraft 3), |H_local|^2 + |H_distant|^2
+    summed over the inputs, times the DWS ASD.  Relative agreement 1e-9 (measured: 0, python-control's LU
+    solve per frequency is the one budget.frequency_response batches; the angle map and sums are independent)."""
+    cl = _lisa_loop()
+    noise = {"dws": default_noise("lisa")["dws"]}
+    f = np.array([1e-4, 1e-3, 3e-3, 1e-2, 1e-1])
+    theta = math.pi / 3
+    coeffs = TTLCoefficients.random(2)
+    a, sources = link_ttl_asd([cl] * 3, noise, f, coeffs, theta)
+    assert sources == ["dws"]
+    sys = cl.system
+    oi = [sys.output_labels.index(o) for o in ANGLE_OUTPUTS]
+    ii = [sys.input_labels.index(q) for q in source_inputs("dws")]
+    sub = control.ss(sys.A, sys.B[:, ii], sys.C[oi, :], sys.D[np.ix_(oi, ii)])
+    G = np.asarray(control.frequency_response(sub, 2 * math.pi * f).complex).reshape(5, 4, len(f))
+    gx, gy, gz = G[0], G[1], G[2]
+
+    def angles(l):                                        # (phi, eta) of MOSA l of any spacecraft: (4, n_f)
+        s = 1.0 if l == 1 else -1.0
+        return -(gz + G[2 + l]), math.sin(s * theta / 2) * gx - math.cos(s * theta / 2) * gy
+
+    for link, (l_local, distant, l_distant) in {"12": (2, "21", 1), "13": (1, "31", 2)}.items():
+        pl, el = angles(l_local)
+        pd, ed = angles(l_distant)
+        h_loc = coeffs.local_phi[link] * pl + coeffs.local_eta[link] * el
+        h_dis = coeffs.distant_phi[distant] * pd + coeffs.distant_eta[distant] * ed
+        ref = np.sqrt(np.sum(np.abs(h_loc) ** 2 + np.abs(h_dis) ** 2, axis=0)) * noise["dws"].asd(f)
+        np.testing.assert_allclose(a[MOSAS.index(link), 0], ref, rtol=1e-9)
+
+
+def test_link_budget_summary_against_an_analytic_budget():
+    """A budget built by hand: link TTL 1e-13 (1 mHz / f) m/Hz^1/2 from one source (a second source at a
+    tenth of it), readout flat 1e-12, no TM term, requirement flat 2e-12.  Analytic: the TTL exceeds the
+    readout below 1e-4 sqrt(1.01) Hz (from the band's edge, 0.01 mHz, to the last grid point below it), the
+    worst margin is at the band's lowest frequency, TTL / requirement there (1e-13 sqrt(1.01) x 100 / 2e-12
+    = 5.02 at 0.01 mHz), the dominant source holds 100/101 of the TTL power, the allocation ratio is the
+    largest TTL over 0.3 pm (bounds: exact grid points, 1e-12 relative)."""
+    import xarray as xr
+
+    from tqdyn.analysis.ttl_budget import link_budget_summary
+
+    def budget(f):
+        t = 1e-13 * (1e-3 / f)
+        ttl = np.stack([t, 0.1 * t])[None].repeat(6, axis=0)
+        tt = np.sqrt(np.sum(ttl ** 2, axis=1))
+        ro = np.full((6, f.size), 1e-12)
+        tot = np.sqrt(tt ** 2 + ro ** 2)
+        S, F = ("link", "source", "frequency"), ("link", "frequency")
+        return xr.Dataset({"ttl": (S, ttl), "ttl_total": (F, tt), "tm_acceleration_total": (F, np.zeros_like(tt)),
+                           "readout": (F, ro), "total": (F, tot),
+                           "requirement": (("frequency",), np.full(f.size, 2e-12)),
+                           "margin": (F, 2e-12 / tot)},
+                          coords={"link": list(MOSAS), "source": ["a", "b"], "frequency": f})
+
+    f = np.logspace(-6, 0, 121)
+    s = link_budget_summary(budget(f), budget(np.array([1e-3])), band=(0.99e-5, 1.0), allocation=0.3e-12)
+    v = s["links"]["23"]
+    f_cross = 1e-4 * math.sqrt(1.01)                       # 1e-13 sqrt(1.01) (1 mHz / f) = 1e-12
+    lo, hi = f[f >= 0.99e-5][0], f[f < f_cross][-1]
+    assert v["ttl_exceeds_readout_hz"] == [lo, hi] and lo == pytest.approx(1e-5) and hi == pytest.approx(1e-4)
+    assert v["ttl_exceeds_readout_throughout"]
+    assert v["worst_margin_f_hz"] == lo and v["worst_margin_limited_by"] == "ttl"
+    t_max = 1e-13 * (1e-3 / lo) * math.sqrt(1.01)
+    assert v["ttl_over_requirement_max"] == pytest.approx(t_max / 2e-12, rel=1e-12)
+    assert v["ttl_over_allocation_max"] == pytest.approx(t_max / 0.3e-12, rel=1e-12)
+    assert v["dominant_source"] == "a" and v["dominant_source_share"] == pytest.approx(100 / 101, rel=1e-12)
+    assert v["ttl"] == [pytest.approx(1e-13 * math.sqrt(1.01), rel=1e-12)]
+    assert s["frequencies_hz"] == [1e-3] and s["requirement"] == [2e-12]
+
+
+def test_summary_refuses_a_band_outside_the_grid_and_bad_frequencies_in_one_line():
+    from tqdyn.analysis.closed_loop import ClosedLoopModel
+    from tqdyn.analysis.ttl_budget import link_budget_summary, single_link_budget, ttl_budget_values
+
+    cl = _lisa_loop()
+    model = ClosedLoopModel(loops=[[(0.0, cl)]] * 3, noise=default_noise("lisa"), mission="lisa",
+                            settings={"f_min": 1e-4, "f_max": 1.0, "n_freq": 11}, satellite_names=("1", "2", "3"),
+                            t_span=(0.0, 1.0), parts=[[(None, w)] for w in [_WP] * 3])
+    ds = single_link_budget(model)
+    for call, match in ((lambda: link_budget_summary(ds, ds, band=(2.0, 3.0)), "band = "),
+                        (lambda: link_budget_summary(ds, ds, allocation=-1.0), "allocation = "),
+                        (lambda: ttl_budget_values(model, frequencies=(1e-3, 0.0)), "frequencies = ")):
+        with pytest.raises(ValueError, match=match) as e:
+            call()
+        assert "\n" not in str(e.value)

@@ -1,5 +1,6 @@
 """Figures of the closed loop (``tqdyn report --closed-loop``): budget stacks, loop gains with margins,
-the residual TM acceleration against the mission's requirement.
+the residual TM acceleration against the mission's requirement, the single-link displacement budget
+(TTL per link, readout, TM acceleration, total) and one link's TTL by source.
 
 matplotlib is imported lazily (:func:`tqdyn.analysis.figures._pyplot`); every figure is written as PNG
 and PDF (:data:`tqdyn.analysis.figures.FIGURE_FORMATS`) into ``out_dir`` as ``<stem>.png`` /
@@ -17,7 +18,8 @@ import numpy as np
 
 from .figures import _pyplot, _save
 
-__all__ = ["plot_budget_stack", "plot_loop_gains", "plot_residual_acceleration"]
+__all__ = ["plot_budget_stack", "plot_link_budget", "plot_loop_gains", "plot_residual_acceleration",
+           "plot_ttl_sources"]
 
 _SOURCE_STYLES = ("-", "--", ":", "-.")
 
@@ -137,4 +139,84 @@ def plot_residual_acceleration(f, curves: Sequence[tuple], requirement, out_dir:
         a.tick_params(labelsize=8)
     ax.legend(fontsize=7.5)
     ax.set_title(title, fontsize=9.5)
+    return _save(fig, out_dir, stem)
+
+
+def _shade_outside(axes, f, band) -> None:
+    if band is None:
+        return
+    for a in axes:
+        if band[0] > f[0]:
+            a.axvspan(f[0], band[0], color="0.85", alpha=0.5, lw=0)
+        if band[1] < f[-1]:
+            a.axvspan(band[1], f[-1], color="0.85", alpha=0.5, lw=0)
+
+
+def plot_link_budget(f, links: Sequence[str], ttl, readout, tm_acceleration, total, requirement, out_dir: Path,
+                     stem: str, title: str, requirement_label: str, allocation=None, band=None) -> list[Path]:
+    """The single-link displacement budget of every link: upper panel the TTL ASD per link (colours), the
+    total per link (thin, dashed, same colours), the readout noise, the TM acceleration as displacement
+    (the largest over the links), the requirement and (optional) a flat TTL ``allocation`` [m/Hz^1/2];
+    lower panel total / requirement per link.
+
+    f (n_f,) [Hz]; ttl, tm_acceleration, total (n_link, n_f) and readout (n_f,) [m/Hz^1/2]; requirement
+    (n_f,) [m/Hz^1/2] and its legend label; band: (f_lo, f_hi) [Hz] (shaded outside)."""
+    plt = _pyplot()
+    fig, (ax, ar) = plt.subplots(2, 1, figsize=(8, 6.8), sharex=True, gridspec_kw={"height_ratios": (2.4, 1)})
+    for n, link in enumerate(links):
+        c = f"C{n % 10}"
+        ax.loglog(f, ttl[n], color=c, lw=1.2, label=f"TTL, link {link}")
+        ax.loglog(f, total[n], color=c, lw=0.8, ls="--")
+        ar.loglog(f, total[n] / requirement, color=c, lw=1.0, label=f"link {link}")
+    ax.loglog(f, readout, color="0.45", lw=1.4, label="readout (science interferometer)")
+    ax.loglog(f, np.max(tm_acceleration, axis=0), color="0.45", ls=":", lw=1.4,
+              label="TM acceleration / $(2\\pi f)^2$ (two TMs)")
+    ax.loglog(f, requirement, color="k", ls="--", lw=1.5, label=requirement_label)
+    if allocation is not None:
+        ax.axhline(allocation, color="k", ls="-.", lw=1.0,
+                   label=f"TTL allocation after subtraction {allocation * 1e12:g} pm/Hz$^{{1/2}}$")
+    ax.plot([], [], color="0.3", lw=0.8, ls="--", label="total per link (dashed)")
+    ar.axhline(1.0, color="k", ls="--", lw=1.0)
+    _shade_outside((ax, ar), f, band)
+    ax.set_ylabel("single-link ASD [m/Hz$^{1/2}$]", fontsize=9)
+    ar.set_ylabel("total / requirement", fontsize=9)
+    ar.set_xlabel("frequency [Hz]", fontsize=9)
+    for a in (ax, ar):
+        a.grid(True, which="both", alpha=0.3)
+        a.tick_params(labelsize=8)
+    ax.legend(fontsize=6.5, ncol=2)
+    ax.set_title(title, fontsize=9)
+    return _save(fig, out_dir, stem)
+
+
+def plot_ttl_sources(f, ttl, sources: Sequence[str], readout, requirement, out_dir: Path, stem: str, title: str,
+                     requirement_label: str, allocation=None, band=None, floor: float = 1e-3) -> list[Path]:
+    """One link's TTL ASD by noise source and its total (power sum), with the readout noise, the
+    requirement and (optional) a flat TTL ``allocation``; a source below ``floor`` x the TTL total
+    everywhere is left out.
+
+    f (n_f,) [Hz]; ttl (n_source, n_f), readout (n_f,), requirement (n_f,) [m/Hz^1/2]; band: (f_lo, f_hi) [Hz]
+    (shaded outside)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 5.2))
+    total = np.sqrt(np.sum(np.asarray(ttl) ** 2, axis=0))
+    shown = [j for j in range(len(sources)) if np.any(ttl[j] > floor * total)]
+    for k, j in enumerate(shown):
+        y = ttl[j]
+        ax.loglog(f, np.where(y > 0, y, np.nan), color=f"C{k % 10}", lw=1.1, ls=_SOURCE_STYLES[(k // 10) % 4],
+                  label=sources[j])
+    ax.loglog(f, total, color="k", lw=1.8, label="TTL total")
+    ax.loglog(f, readout, color="0.45", lw=1.4, label="readout")
+    ax.loglog(f, requirement, color="k", ls="--", lw=1.4, label=requirement_label)
+    if allocation is not None:
+        ax.axhline(allocation, color="k", ls="-.", lw=1.0,
+                   label=f"TTL allocation after subtraction {allocation * 1e12:g} pm/Hz$^{{1/2}}$")
+    _shade_outside((ax,), f, band)
+    ax.set_ylim(max(total.max() * 1e-5, np.nanmin(np.minimum(total, readout)) * 1e-1), total.max() * 5)
+    ax.set_ylabel("TTL ASD [m/Hz$^{1/2}$]", fontsize=9)
+    ax.set_xlabel("frequency [Hz]", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.tick_params(labelsize=8)
+    ax.legend(fontsize=6.5, ncol=2)
+    ax.set_title(title, fontsize=9)
     return _save(fig, out_dir, stem)

@@ -16,7 +16,8 @@ composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
 * ``tqdyn report --closed-loop [--out DIR]``: the default closed-loop designs of TianQin, LISA and
   Taiji at the working points of short coupled runs (:mod:`tqdyn.workflows.report.closed_loop`):
   ``DIR/closed-loop/*.png|pdf`` (budget stacks, loop gains with margins, residual TM acceleration
-  against the requirement), ``DIR/summary.md`` and ``DIR/summary.json``.
+  against the requirement, the single-link TTL budget of the six links and the worst link's TTL by
+  source), ``DIR/summary.md`` and ``DIR/summary.json``.
 
 Bad input (a missing file, a file that is not a tqdyn trajectory, an unknown
 study, bad overrides, conflicting options) exits with status 2 and one line
@@ -47,7 +48,8 @@ __all__ = ["report"]
               help="Run (or reuse) the study runs of the paper's section V and regenerate its figures and table.")
 @click.option("--closed-loop", "closed_loop", is_flag=True,
               help="The default closed-loop designs of the three missions at the working points of short coupled "
-                   "runs: budget stacks, loop gains with margins, residual TM acceleration (docs/closed-loop.md).")
+                   "runs: budget stacks, loop gains with margins, residual TM acceleration (docs/closed-loop.md), "
+                   "single-link TTL budgets (docs/tilt-to-length.md).")
 @click.option("--mission", type=click.Choice(["tianqin", "lisa"]), default=None,
               help="With --studies: the study set, tianqin (the paper's section V, default) or lisa (the same "
                    "studies on LISA and Taiji, one-year runs).")

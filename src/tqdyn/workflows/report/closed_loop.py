@@ -10,7 +10,11 @@ satellite 1 in the first frozen-coefficient segment (the working point at its mi
 into ``DIR/closed-loop/`` (PNG and PDF): ``<mission>-budget`` (budget stacks of :data:`BUDGET_OUTPUTS`),
 ``<mission>-loops`` (the loop gain L of the first channel of every loop, with its margins),
 ``<mission>-tm-acceleration`` (the residual acceleration of both TMs along their sensitive axes
-against the requirement); ``DIR/summary.md`` and ``DIR/summary.json`` (``values``: :func:`_mission_values`).
+against the requirement), ``<mission>-ttl-budget`` (the single-link displacement budget of the six
+links: TTL, readout, TM acceleration as displacement, total, requirement) and ``<mission>-ttl-sources``
+(the TTL of the worst link by source); ``DIR/summary.md`` and ``DIR/summary.json`` (``values``:
+:func:`_mission_values`, and per mission ``ttl``: :func:`tqdyn.analysis.ttl_budget.ttl_budget_values`,
+worst-case coefficients, the three spacecraft's loops of the same segment).
 
 Units: SI; frequencies Hz; ASDs one-sided [unit/Hz^1/2]; margins: phase in deg, gain as a factor (a
 *lower* gain margin: the loops are conditionally stable, docs/closed-loop.md).
@@ -25,7 +29,9 @@ from collections.abc import Callable
 import numpy as np
 
 from ...analysis.closed_loop import BANDS, closed_loop_model
-from ...analysis.figures_closed_loop import plot_budget_stack, plot_loop_gains, plot_residual_acceleration
+from ...analysis.figures_closed_loop import (plot_budget_stack, plot_link_budget, plot_loop_gains,
+                                             plot_residual_acceleration, plot_ttl_sources)
+from ...analysis.ttl_budget import ttl_budget_values
 from ...closedloop.budget import dominant_sources, loop_gains, loop_margins, noise_budget
 from ...closedloop.controllers import LOOPS
 from ...closedloop.loop import OUTPUTS, output_names
@@ -33,8 +39,8 @@ from ...closedloop.missions import MISSIONS, requirement
 from ...closedloop.study import DC_SUSPENSION_LIMIT, dc_paths
 from .summary import Report, SummaryRow, _e, _finish, check_out_dir
 
-__all__ = ["BUDGET_OUTPUTS", "FREQUENCIES_HZ", "LINK_FREQUENCIES_HZ", "MISSION_BAND_HZ", "REQUIREMENT_TEXT", "RUNS",
-           "report_closed_loop"]
+__all__ = ["BUDGET_OUTPUTS", "FREQUENCIES_HZ", "LINK_FREQUENCIES_HZ", "LINK_REQUIREMENT_TEXT", "MISSION_BAND_HZ",
+           "REQUIREMENT_TEXT", "RUNS", "report_closed_loop"]
 
 #: Per mission: (built-in scenario, overrides, description) of the coupled run whose working point is used.
 RUNS = {
@@ -59,6 +65,13 @@ REQUIREMENT_TEXT = {
     "lisa": ("LISA requirement 3 fm s$^{-2}$/Hz$^{1/2}$ "
              "$(1+(0.4\\,\\mathrm{mHz}/f)^2)^{1/2}(1+(f/8\\,\\mathrm{mHz})^4)^{1/2}$"),
     "taiji": "Taiji requirement 3 fm s$^{-2}$/Hz$^{1/2}$ (LISA's knees)",
+}
+#: Legend text of each mission's single-link displacement requirement
+#: (:data:`tqdyn.analysis.ttl_budget.SINGLE_LINK_REQUIREMENT`).
+LINK_REQUIREMENT_TEXT = {
+    "tianqin": "TianQin single-link requirement 1 pm/Hz$^{1/2}$",
+    "lisa": "LISA single-link requirement 15 pm/Hz$^{1/2}$ $(1+(2\\,\\mathrm{mHz}/f)^4)^{1/2}$",
+    "taiji": "Taiji single-link requirement 8 pm/Hz$^{1/2}$ (LISA's shape)",
 }
 _F_GRID = (1e-5, 1.0, 401)
 _F_LOOPS = (1e-5, 1.0, 801)
@@ -145,7 +158,8 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
     """Figures (unless ``figures`` is False), summary rows and values of the closed loop of ``missions``
     (module docstring).
     Returns :class:`~tqdyn.workflows.report.summary.Report` (``values``: ``missions`` -> the values of
-    :func:`_mission_values`, and the frequencies, bands and limit they refer to)."""
+    :func:`_mission_values` and ``ttl`` (:func:`tqdyn.analysis.ttl_budget.ttl_budget_values`), and the
+    frequencies, bands and limit they refer to)."""
     say = progress or (lambda msg: None)
     for m in missions:
         if m not in MISSIONS:
@@ -162,6 +176,8 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
         model = closed_loop_model(traj)
         say(f"{mission}: loops, margins and budgets")
         v, a = _mission_values(mission, model, text)
+        say(f"{mission}: single-link TTL budget")
+        v["ttl"], ttl_ds = ttl_budget_values(model, band=MISSION_BAND_HZ)
         rep.values["missions"][mission] = v
         _rows(rep, mission, v)
         if not figures:
@@ -179,8 +195,29 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
             a["requirement"], fig_dir, f"{mission}-tm-acceleration",
             f"{mission}: residual TM acceleration, default noises and controllers ({where})",
             REQUIREMENT_TEXT[mission], tm_force=a["tm_force"], band=MISSION_BAND_HZ)
+        rep.figures += _ttl_figures(mission, v["ttl"], ttl_ds, fig_dir, where)
     _finish(rep, "tqdyn report --closed-loop", [f"{m}: {RUNS[m][2]}" for m in missions])
     return rep
+
+
+def _ttl_figures(mission: str, t: dict, ds, fig_dir, where: str) -> list:
+    f = ds["frequency"].values
+    links = [str(x) for x in ds["link"].values]
+    req, ro = ds["requirement"].values, ds["readout"].values[0]
+    coeffs = (f"TTL coefficients {t['local_m_per_rad'] * 1e3:g} (local) / {t['distant_m_per_rad'] * 1e3:g} (distant) "
+              "mm/rad on every MOSA")
+    paths = plot_link_budget(f, links, ds["ttl_total"].values, ro, ds["tm_acceleration_total"].values,
+                             ds["total"].values, req, fig_dir, f"{mission}-ttl-budget",
+                             f"{mission}: single-link budget of the six links ({coeffs})\n"
+                             f"{where}; the loops of the three spacecraft", LINK_REQUIREMENT_TEXT[mission],
+                             allocation=t["allocation"], band=MISSION_BAND_HZ)
+    w = t["worst_link"]
+    n = links.index(w)
+    paths += plot_ttl_sources(f, ds["ttl"].values[n], [str(x) for x in ds["source"].values], ro, req, fig_dir,
+                              f"{mission}-ttl-sources",
+                              f"{mission}: TTL of link {w} by noise source ({coeffs})\n{where}",
+                              LINK_REQUIREMENT_TEXT[mission], allocation=t["allocation"], band=MISSION_BAND_HZ)
+    return paths
 
 
 def _rows(rep: Report, mission: str, v: dict) -> None:
@@ -206,3 +243,14 @@ def _rows(rep: Report, mission: str, v: dict) -> None:
         f"{lk['frequencies_hz'][0]:g} Hz", f"limit {lk['limit']:g} m/s^2",
         f"{_e(lk['actuation_force'][0])} (at the limit {_e(lk['actuation_force_at_limit'][0])}) m/s^2/Hz^1/2",
         f"every DC-force path {_e(lk['dc_forces'][0])}; stiffness x jitter {_e(lk['stiffness_times_jitter'][0])}"))
+    t = v.get("ttl")
+    if t is not None:
+        w = t["links"][t["worst_link"]]
+        rep.rows.append(SummaryRow(
+            f"{mission}: TTL of link {t['worst_link']} (worst-case coefficients) at "
+            + " / ".join(f"{x:g}" for x in t["frequencies_hz"]) + " Hz",
+            "requirement " + " / ".join(_e(x) for x in t["requirement"]),
+            " / ".join(_e(x) for x in w["ttl"]) + " m/Hz^1/2",
+            f"TTL / requirement up to {w['ttl_over_requirement_max']:.3g} at {w['ttl_over_requirement_f_hz']:.3g} Hz; "
+            f"dominant source {w['dominant_source']}; smallest margin {w['worst_margin']:.3g} at "
+            f"{w['worst_margin_f_hz']:.3g} Hz ({w['worst_margin_limited_by']})"))
