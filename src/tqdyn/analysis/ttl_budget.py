@@ -44,7 +44,9 @@ SUMMARY_BAND_HZ = (1e-4, 1.0)
 #: The decades [Hz] of the summary's dominant TTL source per band.
 SUMMARY_BANDS_HZ = ((1e-4, 1e-3), (1e-3, 1e-2), (1e-2, 1e-1), (1e-1, 1.0))
 #: The TTL left after subtraction [m/Hz^1/2, flat] to which the summary compares the TTL (missions with one):
-#: TianQin 0.3 pm/Hz^1/2 (docs/tilt-to-length.md, "Estimating the coefficients of a link").
+#: TianQin 0.3 pm/Hz^1/2, the reference curve for the TTL residual after subtraction of Wang et al. 2024,
+#: "Postprocessing of tilt-to-length noise with coefficient drifts in TianQin using a null time-delay
+#: interferometry channel", arXiv:2410.20121 (also Fang et al. 2025, arXiv:2510.17499).
 TTL_ALLOCATION = {"tianqin": 0.3e-12}
 #: The random draw of :func:`ttl_budget_values` (``TTLCoefficients.random(seed)``).
 RANDOM_SEED = 1
