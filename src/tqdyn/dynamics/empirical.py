@@ -35,7 +35,7 @@ from numba import njit
 
 from ..numerics.dd import add, ld, st, sub, to_f64
 
-__all__ = ["N_PAR", "PARAMETER_NAMES", "add_empirical", "empirical_basis"]
+__all__ = ["N_PAR", "PARAMETER_NAMES", "add_empirical", "empirical_basis", "s_frame_rows"]
 
 #: Names of the per-satellite parameters, in the order of the basis columns.
 PARAMETER_NAMES = ("s_x", "s_y", "s_z", "rtn_r", "rtn_t", "rtn_n",

@@ -45,6 +45,7 @@ float64 round-off (~1e-13 relative), which changes A by as little.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,8 +134,6 @@ def propagate_dd(scenario, parameters: Parameters | None = None, t_out=None):
 
 
 def _with_every_step(scen):
-    import dataclasses
-
     return dataclasses.replace(scen, run=dataclasses.replace(scen.run, output_every=1))
 
 
@@ -178,8 +177,8 @@ def _integrate(scen, model, system, y0, h: float, n_steps: int):
     coef = dp87.step_coefficients(dp87.load_tableau(scen.integrator.tableau), repr(h), "float64")
     cpar = system.cpar
     emp = _lay.empirical_of(cpar, N_PAR)
-    with_s = n == 3 and emp.shape[0] == 3 and bool(np.any(emp[:, :3] != 0.0))
-    coupled = with_s or system.centre_ramp is not None
+    coupled = bool(np.any(emp[:, :3] != 0.0)) or system.centre_ramp is not None  # satellites interact
+    with_s = n == 3  # the S-frame columns of B
     y = np.ascontiguousarray(y0, np.float64)
     phi = np.eye(6 * n)
     psi = np.zeros((6 * n, N_PAR * n))
