@@ -17,7 +17,8 @@ matrix and the sensitivities, at the requested times:
   ``parameter_names`` (:data:`~tqdyn.dynamics.empirical.PARAMETER_NAMES`) [s^2, s];
 * ``stm_full`` (n, 6 n_sat, 6 n_sat) and ``sensitivities_full`` (n, 6 n_sat, 12 n_sat):
   the same for the whole system (the S frame and the self-gravity toward the centre couple
-  the satellites; their blocks off the diagonal are of the order of p / L t^2);
+  the satellites; their blocks off the diagonal are at most ~ (p / L) t^2, p the coupling
+  acceleration and L the arm length);
   rows and columns ordered satellite by satellite (:func:`~tqdyn.od.parameters.state_names`,
   :func:`~tqdyn.od.parameters.parameter_names`).
 
@@ -52,8 +53,8 @@ import numpy as np
 from numba import njit
 
 from .. import dynamics
-from ..dynamics.empirical import N_PAR, PARAMETER_NAMES, empirical_basis
-from ..dynamics.rhs import point_mass_system
+from ..dynamics.empirical import N_PAR, PARAMETER_NAMES, add_empirical, empirical_basis
+from ..dynamics.rhs import point_mass_system, toward_centre
 from ..dynamics.results import Rows
 from ..dynamics.system import build_system
 from ..dynamics import layout as _lay
@@ -196,6 +197,20 @@ def _integrate(scen, model, system, y0, h: float, n_steps: int):
 
 
 @njit(cache=True)
+def _coupling_terms(y, tdat, cpar, k):
+    """k <- the accelerations through which the satellites act on each other (float64): the
+    self-gravity toward the centre and the parameter accelerations (their S frame); gravity
+    is left out, so that a difference of k has no round-off of the ~1e-2 m/s^2 gravity."""
+    for b in range(k.shape[0]):
+        for q in range(6):
+            k[b, q] = 0.0
+    if cpar[_lay.CP_SGC] >= 0.0:
+        toward_centre(y, tdat[int(cpar[_lay.CP_SGC])], k)
+    if cpar.shape[0] > _lay.CP_LEN:
+        add_empirical(y, cpar[_lay.CP_LEN:].reshape(((cpar.shape[0] - _lay.CP_LEN) // N_PAR, N_PAR)), k)
+
+
+@njit(cache=True)
 def _derivs(y, phi, psi, tdat, params, layout, cpar, coupled, with_s, dy, dphi, dpsi):
     """dy, dphi, dpsi of the augmented system at one instant (float64)."""
     n = y.shape[0]
@@ -225,10 +240,16 @@ def _derivs(y, phi, psi, tdat, params, layout, cpar, coupled, with_s, dy, dphi, 
             for c in range(n):
                 if coupled and c != b:
                     continue
-                rows = range(n) if coupled else range(c, c + 1)
-                for r in rows:
-                    for s in range(3):
-                        A[3 * r + s, 6 * c + q] = (kp[r, 3 + s] - km[r, 3 + s]) / (2.0 * hs[c])
+                for s in range(3):
+                    A[3 * c + s, 6 * c + q] = (kp[c, 3 + s] - km[c, 3 + s]) / (2.0 * hs[c])
+            if coupled:  # the other satellites' rows: differences of the coupling terms alone
+                _coupling_terms(yp, tdat, cpar, km)
+                yp[b, q] = y[b, q] + hs[b]
+                _coupling_terms(yp, tdat, cpar, kp)
+                for r in range(n):
+                    if r != b:
+                        for s in range(3):
+                            A[3 * r + s, 6 * b + q] = (kp[r, 3 + s] - km[r, 3 + s]) / (2.0 * hs[b])
     B = np.empty((3, N_PAR))
     for r in range(n):
         for s in range(3):
