@@ -27,7 +27,7 @@ from ..numerics import dp87
 from ..numerics.dd import add, ld, mul, st
 from . import layout as _lay
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
+from .rhs import evaluate_rhs, point_mass_system, system_rhs
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_plan", "deliver_rows", "input_pipeline", "propagate_fixed", "warm_up"]
 
@@ -58,15 +58,10 @@ def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step
     masses call their right-hand side directly: passing the coupled system's
     work arrays 13 times per step costs time (their reference counts)."""
     if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
-        centre = int(cpar[_lay.CP_SGC])
-        point_masses(y, tdat_step[0], params, layout, K[0])
-        if centre >= 0:
-            toward_centre(y, tdat_step[0][centre], K[0])
+        point_mass_system(y, tdat_step[0], params, layout, cpar, K[0])
         for i in range(1, 13):
             dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
-            point_masses(ystage, tdat_step[i], params, layout, K[i])
-            if centre >= 0:
-                toward_centre(ystage, tdat_step[i][centre], K[i])
+            point_mass_system(ystage, tdat_step[i], params, layout, cpar, K[i])
     else:
         system_rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
         for i in range(1, 13):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
-           "SCHEME_CODES", "TM_GRAVITY_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "make_cpar", "workspace",
+           "SCHEME_CODES", "TM_GRAVITY_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "empirical_of", "make_cpar", "workspace",
            "aux_views"]
 
 #: Arithmetic of a propagation: double-double states (trailing axis 2) or plain float64.
@@ -50,6 +50,9 @@ JERK_BODIES_MAX = 10
 CP_GMREL = CP_JGM + JERK_BODIES_MAX   # GM [m^3/s^2] of the central body's Schwarzschild jerk, 0 = off
 CP_TMG = CP_GMREL + 1  # TM differential gravity: TMG_DIFFERENTIAL or TMG_DIRECT (:data:`TM_GRAVITY_CODES`)
 CP_LEN = CP_TMG + 1
+#: cpar[CP_LEN:] (absent when all are zero, so that cpar and its hash stay those of a run without
+#: them): the acceleration parameters of point-mass satellites, N_PAR per satellite
+#: (:mod:`tqdyn.dynamics.empirical`), satellite by satellite
 #: codes of cpar[CP_TMG] (names: ``constellation.tm_gravity``): the test masses'
 #: differential gravity from :mod:`tqdyn.forces.differential` or from a second
 #: full evaluation of the force model at each EH centre
@@ -79,7 +82,8 @@ _FW_SHAPES = (("r_hi", (3, 3)), ("r_lo", (3, 3)), ("v", (3, 3)), ("a", (3, 3)), 
 
 def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta_nom=np.pi / 3,
               r0_nom=None, pivots=None, sensitive_axes=None, sg_oa=None, sg_s=None, jerk_gms=(), j2k=0.0,
-              tdat_offset=-1, centre_column=-1, gm_relativity=0.0, tm_gravity="differential") -> np.ndarray:
+              tdat_offset=-1, centre_column=-1, gm_relativity=0.0, tm_gravity="differential",
+              empirical=None) -> np.ndarray:
     """Pack the constellation parameters for :func:`system_rhs`.
 
     mode : MODE_*; law : pointing-law code (``_kinematics_jit.LAW_CODES``);
@@ -103,7 +107,9 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta
     centre_column : column in tdat of the magnitude [m/s^2] of the
     self-gravity toward the constellation centre (positive toward it), -1 if off;
     tm_gravity : "differential" | "direct", how the TMs' differential gravity is formed
-    (:data:`TM_GRAVITY_CODES`).
+    (:data:`TM_GRAVITY_CODES`); empirical : (n_sat, N_PAR) acceleration parameters [m/s^2]
+    of the point-mass satellites (:mod:`tqdyn.dynamics.empirical`), appended after CP_LEN
+    unless None or all zero.
     """
     p = np.zeros(CP_LEN)
     p[CP_MODE], p[CP_LAW], p[CP_CONTROL] = mode, law, 1.0 if control else 0.0
@@ -125,7 +131,17 @@ def make_cpar(mode, law=0, control=False, gm=0.0, c=299792458.0, scheme=0, theta
     p[CP_J2K], p[CP_TD], p[CP_GMREL] = j2k, tdat_offset, gm_relativity
     p[CP_SGC] = centre_column
     p[CP_TMG] = TM_GRAVITY_CODES[tm_gravity]
+    if empirical is not None and np.any(np.asarray(empirical, np.float64) != 0.0):
+        if mode != MODE_POINT_MASS:
+            raise ValueError("accelerations: the acceleration parameters need point-mass satellites; "
+                             "allowed: constellation.pointing = \"none\"")
+        p = np.concatenate([p, np.asarray(empirical, np.float64).ravel()])
     return p
+
+
+def empirical_of(cpar: np.ndarray, n_par: int) -> np.ndarray:
+    """The (n_sat, n_par) acceleration parameters carried by cpar ((0, n_par) if none)."""
+    return np.ascontiguousarray(cpar[CP_LEN:]).reshape(-1, n_par)
 
 
 def workspace(y: np.ndarray):

@@ -40,7 +40,7 @@ from . import layout as _lay
 from .fixed import (CheckpointClock, _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, deliver_rows,
                     input_pipeline)
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import evaluate_rhs, point_masses, system_rhs, toward_centre
+from .rhs import evaluate_rhs, point_mass_system, system_rhs
 
 __all__ = ["INPUT_BLOCK", "propagate_multistep", "warm_up_multistep", "corrector_stages"]
 
@@ -68,10 +68,7 @@ def _evaluate(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
     """k = f(t, y) (independent point masses call their right-hand side
     directly, as :func:`.fixed._one_step` does)."""
     if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
-        point_masses(y, tdat_row, params, layout, k)
-        centre = int(cpar[_lay.CP_SGC])
-        if centre >= 0:
-            toward_centre(y, tdat_row[centre], k)
+        point_mass_system(y, tdat_row, params, layout, cpar, k)
     else:
         system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)
 

@@ -74,12 +74,13 @@ from ..forces.model import ForceModel, gravity, gravity_split
 from ..forces.relativity import schwarzschild_jerk
 from ..forces.third_body import third_body_jerk
 from ..numerics.dd import add, ld, lo_part, st, sub, to_f64
+from .empirical import N_PAR, add_empirical
 from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX_TMLEN, AX_W, AX_WD, CP_CONTROL,
                      CP_C, CP_GM, CP_GMREL, CP_J2K, CP_JGM, CP_LAW, CP_MODE, CP_NJB, CP_PIV, CP_R0, CP_SCHEME, CP_SENS,
-                     CP_SG_OA, CP_SG_S, CP_SGC, CP_TD, CP_THNOM, CP_TMG, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
+                     CP_SG_OA, CP_SG_S, CP_SGC, CP_LEN, CP_TD, CP_THNOM, CP_TMG, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
                      TM_SUSP, TM_VHI, TM_VLO, TMG_DIRECT, make_cpar, workspace)
 
-__all__ = ["system_rhs", "point_masses", "evaluate_rhs", "toward_centre"]
+__all__ = ["system_rhs", "point_masses", "point_mass_system", "evaluate_rhs", "toward_centre"]
 
 
 @njit(cache=True)
@@ -94,6 +95,20 @@ def point_masses(y, tdat, params, layout, k):
         st(k, ax, b, 3)
         st(k, ay, b, 4)
         st(k, az, b, 5)
+
+
+@njit(cache=True)
+def point_mass_system(y, tdat, params, layout, cpar, k):
+    """dy/dt of the point-mass system (MODE_POINT_MASS): :func:`point_masses`, then, when
+    cpar says so, the self-gravity toward the constellation centre (:func:`toward_centre`)
+    and the satellites' acceleration parameters (:func:`tqdyn.dynamics.empirical.add_empirical`,
+    from cpar[CP_LEN:]); arguments as :func:`system_rhs`."""
+    point_masses(y, tdat, params, layout, k)
+    if cpar[CP_SGC] >= 0.0:
+        toward_centre(y, tdat[int(cpar[CP_SGC])], k)
+    if cpar.shape[0] > CP_LEN:
+        n = (cpar.shape[0] - CP_LEN) // N_PAR
+        add_empirical(y, cpar[CP_LEN:].reshape((n, N_PAR)), k)
 
 
 @njit(cache=True)
@@ -369,9 +384,7 @@ def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
     (:func:`workspace`).
     """
     if cpar[CP_MODE] == MODE_POINT_MASS:
-        point_masses(y, tdat, params, layout, k)
-        if cpar[CP_SGC] >= 0.0:
-            toward_centre(y, tdat[int(cpar[CP_SGC])], k)
+        point_mass_system(y, tdat, params, layout, cpar, k)
     else:
         _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw)
 

@@ -109,15 +109,18 @@ def self_gravity_oa(scenario) -> np.ndarray:
 
 def build_system(scenario, model: ForceModel | None = None) -> System:
     """The :class:`System` of a scenario (point masses unless
-    ``constellation.pointing`` names a law).  ``model``: the scenario's force
+    ``constellation.pointing`` names a law; point masses carry the acceleration
+    parameters of ``[accelerations]``, :mod:`.empirical`).  ``model``: the scenario's force
     model (built if None), whose time-only inputs the system's follow."""
     c = scenario.constellation
     if not c.coupled:
         ramp = scenario.self_gravity_centre_ramp()
+        acc = getattr(scenario, "accelerations", None)  # [accelerations]: the satellites' parameters
+        emp = acc.values(len(scenario.satellites)) if acc is not None and acc.nonzero else None
         if ramp is None:
-            return System(_lay.make_cpar(_lay.MODE_POINT_MASS), False, False)
+            return System(_lay.make_cpar(_lay.MODE_POINT_MASS, empirical=emp), False, False)
         model = build_force_model(scenario.forces, scenario.reference) if model is None else model
-        return System(_lay.make_cpar(_lay.MODE_POINT_MASS, centre_column=model.n_tdat), False, False,
+        return System(_lay.make_cpar(_lay.MODE_POINT_MASS, centre_column=model.n_tdat, empirical=emp), False, False,
                       centre_ramp=ramp)
     craft = scenario.spacecraft.craft(self_gravity_oa(scenario))
     _, common = scenario.spacecraft.self_gravity_values()

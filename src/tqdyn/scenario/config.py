@@ -31,23 +31,19 @@ __all__ = [
     "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig",
 ]
 
-_PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), \
-    ("corrected", "published")
+_PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), ("corrected", "published")
 _RTOL_MAX = 1e-3
 #: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive mode) a run
 #: may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at ``tqdyn bench``'s rates
 #: (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (full TianQin model) and write ~1e11 bytes per
 #: satellite (output_every = 1): a count above is a mistyped duration or step; raise run.max_steps to override.
 MAX_STEPS = 1_000_000_000
-from .initial import BODY_RADII_M, check_above_surface  # noqa: F401
 from .spacecraft import SELF_GRAVITY_MODELS, TM_AXES, SpacecraftConfig  # noqa: F401  (re-exported)
 from .closed_loop import ClosedLoopConfig  # noqa: F401  ([closed_loop]; re-exported)
-from .initial import AU_M, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
-from .values import (  # noqa: F401  (re-exported for the loader)
-    _EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require, _require_choice, _set, _to_decimal,
-    _toml_type)
-
-# --------------------------------------------------------------------------- dataclasses
+from .accelerations import AccelerationsConfig  # noqa: F401  ([accelerations]; re-exported)
+from .initial import AU_M, BODY_RADII_M, check_above_surface, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
+from .values import (_EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require,  # noqa: F401  (re-exported)
+                     _require_choice, _set, _to_decimal, _toml_type)
 
 
 @dataclass(frozen=True)
@@ -345,6 +341,7 @@ class Scenario:
     allow_below_surface: bool = False
     # ---- [closed_loop] (tqdyn.scenario.closed_loop): the closed-loop model's settings, sparse
     closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
+    accelerations: AccelerationsConfig = field(default_factory=AccelerationsConfig)  # [accelerations], sparse
 
     def __post_init__(self) -> None:
         _require_choice(self.central_body, "scenario.central_body", CENTRAL_BODIES)
@@ -388,6 +385,7 @@ class Scenario:
             seen[sat.name] = k
         _set(self, "satellites", sats)
         self._check_satellite_count()
+        self.accelerations.check(len(sats), self.constellation.coupled)
         if not self.allow_below_surface:
             check_above_surface(self.satellites, self.initial, self.central_body)
         if self.integrator.step_s > self.run.duration_s:
@@ -580,7 +578,7 @@ class Scenario:
         c = self.constellation
         out += ["[constellation]", f"pointing = {toml_str(c.pointing)}", f"control = {toml_str(c.control)}",
                 f"free_tms = {b(c.free_tms)}", f"tm_gravity = {toml_str(c.tm_gravity)}", ""]
-        out += self.closed_loop.to_toml_lines()  # [closed_loop]: only the keys given (none: nothing)
+        out += self.closed_loop.to_toml_lines() + self.accelerations.to_toml_lines()  # only keys given / non-zero
         for sat in self.satellites:
             out += ["[[satellites]]", f"name = {toml_str(sat.name)}"]
             if i.derived:  # the states follow from [initial]

@@ -23,6 +23,7 @@ from typing import Any, Mapping, Sequence
 from ..forces.body_gms import BODY_GM_KEYS
 from .config import (
     EOP_SOURCES_ALLOWED,
+    AccelerationsConfig,
     _EXACT,
     _NOVALUE,
     ClosedLoopConfig,
@@ -114,6 +115,7 @@ _SCHEMA: dict[str, dict[str, str]] = {
     "initial": {"axes": _STR, "design": _STR, "arm_length": _NUM, "displacement_deg": _NUM, "rotation": _STR,
                 "semi_major_axis": _NUM, "oem": _STRLIST, "oem_eme2000": _STR},
     "constellation": {"pointing": _STR, "control": _STR, "free_tms": _BOOL, "tm_gravity": _STR},
+    "accelerations": {"s_frame": _ANY, "rtn": _ANY, "rtn_cos": _ANY, "rtn_sin": _ANY},
 }
 _SAT_SCHEMA: dict[str, str] = {
     "name": _STR, "a_km": _NUM, "e": _NUM, "i_deg": _NUM, "raan_deg": _NUM, "argp_deg": _NUM, "nu_deg": _NUM,
@@ -280,9 +282,11 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     body = _typed(meta.get("central_body", "earth"), _STR, "scenario.central_body")
     below = _typed(meta.get("allow_below_surface", False), _BOOL, "scenario.allow_below_surface")
     closed = _closed_loop_from_raw(raw.get("closed_loop", {}))
+    acc = _build(AccelerationsConfig, "accelerations", raw.get("accelerations", {}), _SCHEMA["accelerations"])
     return Scenario(name=name, description=desc, epoch_utc=epoch, run=run, integrator=integ, forces=forces,
                     spacecraft=craft, constellation=const, satellites=sats, central_body=body,
-                    epoch_tdb=epoch_tdb, initial=initial, allow_below_surface=below, closed_loop=closed)
+                    epoch_tdb=epoch_tdb, initial=initial, allow_below_surface=below, closed_loop=closed,
+                    accelerations=acc)
 
 
 # --------------------------------------------------------------------------- [closed_loop] (nested tables)
