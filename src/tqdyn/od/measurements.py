@@ -64,8 +64,9 @@ import numpy as np
 
 from ..astro.constants import C_LIGHT
 from ..astro.earth_orientation import earth_orientation
+from ..lightpath.shapiro import shapiro_delay
 
-__all__ = ["EARTH_ROTATION_RATE", "Observable", "simulate", "sin_elevation", "station_states_gcrs",
+__all__ = ["EARTH_ROTATION_RATE", "Observable", "geocentric_two_way", "simulate", "sin_elevation", "station_states_gcrs",
            "two_way"]
 
 #: Earth rotation rate d(ERA)/d(UT1) [rad/s]: 2 pi x 1.00273781191135448 / 86400
@@ -242,3 +243,16 @@ def two_way(t, r, v, states, *, delay=None):
             "range_rate": half_c * (ru + rd), "range_rate_dr": half_c * (dru + drd),
             "range_rate_dv": half_c * (dvu + dvd),
             "R_transmit": Ru, "R_receive": Rd}
+
+
+def geocentric_two_way(epoch, t, r, v, itrs, *, eop=None, use_eop: bool = True, shapiro: bool = True):
+    """Two-way light time between ground stations and a satellite of a geocentric run.
+
+    t : (N,) bounce times [s TT since the epoch]; r, v : (N, 3) satellite GCRS position [m] and
+    velocity [m/s] at t; itrs : (S, 3) station ITRS positions [m]; ``shapiro``: add the Earth's
+    Shapiro delay on each leg.  Returns (the dict of :func:`two_way`, sin_elevation (N, S))."""
+    def states(dt):
+        return station_states_gcrs(epoch, t, itrs, dt=dt, eop=eop, use_eop=use_eop)
+
+    delay = (lambda R, rr: shapiro_delay(R, rr[:, None, :])) if shapiro else None
+    return two_way(t, r, v, states, delay=delay), sin_elevation(epoch, t, itrs, r, eop=eop, use_eop=use_eop)

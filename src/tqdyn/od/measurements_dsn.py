@@ -49,7 +49,7 @@ from ..astro.reference import HELIOCENTRIC
 from ..astro.timescales import tdb_minus_tt
 from ..lightpath.heliocentric import body_states, sun_barycentric_motion
 from ..lightpath.shapiro import shapiro_delay
-from .measurements import Observable, sin_elevation, station_states_gcrs, two_way
+from .measurements import Observable, geocentric_two_way, sin_elevation, station_states_gcrs, two_way
 
 __all__ = ["DEEP_SPACE_STATIONS", "DSN_DOPPLER_SIGMA_M_S", "DSN_RANGE_SIGMA_M", "dsn_tracking",
            "station_itrs"]
@@ -127,12 +127,7 @@ def dsn_tracking(epoch, t, r, v, stations=None, *, heliocentric: bool = True, ep
         pe0, _ = body_states(eph, epoch, t, ("earth",), HELIOCENTRIC, velocity=False)
         sel = sin_elevation(epoch, t_tt, itrs, r - pe0[:, 0], eop=eop, use_eop=use_eop)
     else:
-        def states(dt):
-            return station_states_gcrs(epoch, t, itrs, dt=dt, eop=eop, use_eop=use_eop)
-
-        delay = (lambda R, rr: shapiro_delay(R, rr[:, None, :])) if shapiro else None
-        res = two_way(t, r, v, states, delay=delay)
-        sel = sin_elevation(epoch, t, itrs, r, eop=eop, use_eop=use_eop)
+        res, sel = geocentric_two_way(epoch, t, r, v, itrs, eop=eop, use_eop=use_eop, shapiro=shapiro)
     visible = sel >= np.sin(np.radians(elevation_mask_deg))
     extra = {"stations": names, "tau_up": res["tau_up"], "tau_down": res["tau_down"],
              "t_transmit": t[:, None] - res["tau_up"], "t_receive": t[:, None] + res["tau_down"],

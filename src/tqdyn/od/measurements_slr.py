@@ -27,9 +27,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..astro.constants import J2000_JD
-from ..lightpath.shapiro import shapiro_delay
 from ..readers.sinex import shipped_slrf, station_position
-from .measurements import Observable, sin_elevation, station_states_gcrs, two_way
+from .measurements import Observable, geocentric_two_way
 
 __all__ = ["ILRS_STATIONS", "SLR_SIGMA_M", "slr_range", "slr_station_positions"]
 
@@ -94,13 +93,7 @@ def slr_range(epoch, t, r, v, stations=None, *, elevation_mask_deg: float = 20.0
     """
     t = np.asarray(t, np.float64)
     names, itrs = slr_station_positions(epoch, stations)
-
-    def states(dt):
-        return station_states_gcrs(epoch, t, itrs, dt=dt, eop=eop, use_eop=use_eop)
-
-    delay = (lambda R, rr: shapiro_delay(R, rr[:, None, :])) if shapiro else None
-    res = two_way(t, r, v, states, delay=delay)
-    sel = sin_elevation(epoch, t, itrs, r, eop=eop, use_eop=use_eop)
+    res, sel = geocentric_two_way(epoch, t, r, v, itrs, eop=eop, use_eop=use_eop, shapiro=shapiro)
     visible = sel >= np.sin(np.radians(elevation_mask_deg))
     return Observable(res["range"], res["range_dr"], np.zeros_like(res["range_dr"]), visible,
                       "two-way range", "m",
