@@ -169,3 +169,20 @@ def test_ctrl_c_exits_130_without_a_file(run_file, tmp_path, capsys, monkeypatch
     status, _, err = run_cli(argv, capsys)
     assert status == 130 and err.strip() == "tqdyn: error: interrupted; no output file written"
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_front_door_wrappers_match_the_command(run_file, tmp_path, capsys):
+    """tqdyn.od_simulate / od_fit / od_covariance / read_od_estimate give what the commands write."""
+    import tqdyn
+
+    a, b = tmp_path / "a.tdm", tmp_path / "b.tdm"
+    assert _simulate(run_file, a, capsys)[0] in (0, None)
+    s = tqdyn.od_simulate(run_file, ["gnss", "slr", "isr", "dsn"], 43200, output=b, seed=3)
+    assert s.counts["slr_range"] == 219
+    strip = [ln for ln in a.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
+    assert strip == [ln for ln in b.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
+    est = tqdyn.od_fit(str(run_file), b, output=tmp_path / "e.h5", edit_sigma=6.0)
+    f = tqdyn.read_od_estimate(tmp_path / "e.h5")
+    assert np.array_equal(f.parameters["values"], est.values) and f.attrs["edit_sigma"] == 6.0
+    cov = tqdyn.od_covariance("tianqin-kepler", "slr", "12h", estimate="s_frame")
+    assert cov.names == ("Sat1/s_x", "Sat2/s_x", "Sat3/s_x")

@@ -1,12 +1,12 @@
 """Orbit determination from files: the jobs behind ``tqdyn od simulate | fit | covariance``.
 
 * :func:`simulate_to_tdm`: the scenario of a run file (its ``[accelerations]`` and initial states are
-  the injected truth), a tracking plan, seeded measurements (:func:`tqdyn.od.problem.simulate`) written
+  the injected truth), a tracking plan, seeded measurements (``tqdyn.od``'s ``problem.simulate``) written
   as a CCSDS TDM (:mod:`tqdyn.formats.od_tdm`) whose header records the plan;
 * :func:`fit_to_file`: a scenario and a TDM, the batch least-squares fit
-  (:func:`tqdyn.od.problem.fit`) written as the estimate file (:mod:`tqdyn.formats.od_estimate`);
+  (``tqdyn.od``'s ``problem.fit``) written as the estimate file (:mod:`tqdyn.formats.od_estimate`);
 * :func:`covariance_of`: the predicted covariance of a tracking plan
-  (:func:`tqdyn.od.problem.covariance`), optionally written as JSON.
+  (``tqdyn.od``'s ``problem.covariance``), optionally written as JSON.
 
 Every input is checked before any work and nothing is written on bad input (a ``ValueError`` /
 ``FileNotFoundError`` / :class:`tqdyn.formats.trajectory.OutputError` with one line); files are
@@ -48,7 +48,7 @@ def _problem():
 
 def parse_tracking(text, option: str = "--tracking") -> tuple[str, ...]:
     """``"gnss,slr,isr"`` (or a sequence) -> the kinds, checked against
-    :data:`tqdyn.od.problem.TRACKING_KINDS`; ValueError (one line) otherwise."""
+    ``tqdyn.od``'s ``problem.TRACKING_KINDS``; ValueError (one line) otherwise."""
     allowed = _problem().TRACKING_KINDS
     kinds = tuple(k.strip() for k in (text.split(",") if isinstance(text, str) else text))
     if not kinds or any(not k for k in kinds):
