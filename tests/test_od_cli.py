@@ -122,6 +122,7 @@ def _bad_tdm(tmp_path):
     ("malformed", r"bad.tdm, line 6: FOO: not a TDM metadata keyword"),
     ("foreign", r"good.tdm: header: no 'COMMENT tqdyn epoch'"),
     ("estimate", r"tracking.estimate: 'bogus' is not a parameter group"),
+    ("header", r"good.tdm: header: tqdyn arc_s = 'long'; allowed: a number of seconds > 0"),
     ("arc-format", r"--arc: 'week' is not a duration"),
 ])
 def test_refusals_are_one_line_and_write_nothing(run_file, tmp_path, capsys, case, pattern):
@@ -134,11 +135,13 @@ def test_refusals_are_one_line_and_write_nothing(run_file, tmp_path, capsys, cas
     fit = ["od", "fit", str(run_file), str(good), "--output", str(out)]
     if case == "foreign":
         good.write_text(good.read_text().replace("COMMENT tqdyn epoch", "COMMENT epoch"))
+    if case == "header":
+        good.write_text(good.read_text().replace("tqdyn arc_s = 43200.0", "tqdyn arc_s = long"))
     argv = {"tracking": sim[:4] + ["gnss,radar"] + sim[5:], "arc": sim[:6] + ["30d"] + sim[7:],
             "horizon": sim + ["--tracking", "slr", "--stations", "Yarragadee,Nowhere"],
             "sim-output-is-input": sim[:-1] + [str(run_file)], "fit-output-is-input": fit[:-1] + [str(good)],
             "malformed": ["od", "fit", str(run_file), str(_bad_tdm(tmp_path)), "--output", str(out)],
-            "foreign": fit, "estimate": fit + ["--estimate", "state,bogus"],
+            "foreign": fit, "header": fit, "estimate": fit + ["--estimate", "state,bogus"],
             "arc-format": sim[:6] + ["week"] + sim[7:]}[case]
     before = sorted(p.name for p in tmp_path.iterdir())
     status, _, err = run_cli(argv, capsys)

@@ -197,6 +197,16 @@ def _measurements(fields):
     return _problem().Measurements(**{k: fields[k] for k in ("t", "type", "sat", "peer", "value", "sigma")})
 
 
+def _header_number(info: dict, key: str, tdm) -> float:
+    try:
+        v = float(info[key])
+    except ValueError:
+        v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{tdm}: header: tqdyn {key} = {info[key]!r}; allowed: a number of seconds > 0")
+    return v
+
+
 def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma=None, overrides=(),
                 progress: Callable[[str], None] | None = None, **options):
     """Fit the scenario's parameters (``estimate``, ``consider``: names of parameter groups, default
@@ -217,10 +227,10 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
     kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
         tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
     parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
-    arc_s = float(info["arc_s"]) if "arc_s" in info else float(np.max(fields["t"]))
+    arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
     _check_arc(scen, arc_s, label)
-    plan = _tracking(kinds, arc_s, float(info["interval_s"]) if "interval_s" in info else None, est_names,
-                     con_names, **_stations(info.get("stations")))
+    interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
+    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, **_stations(info.get("stations")))
     meas = _measurements(fields)
     say("fitting")
     if edit_sigma is not None:
