@@ -36,8 +36,8 @@ from .workflows.run import RunSummary, load_run_scenario, output_attrs, run_to_f
 
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
            "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
-           "light_travel_times", "load_scenario", "open_trajectory", "propagate", "range_asd", "read_closed_loop",
-           "requirement_asd", "run"]
+           "light_travel_times", "load_scenario", "od_covariance", "od_fit", "od_simulate", "open_trajectory",
+           "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd", "run"]
 
 
 def _overrides(overrides) -> list[str]:
@@ -213,3 +213,46 @@ def read_closed_loop(path):
     from .formats.closed_loop import read_closed_loop as g
 
     return g(path)
+
+
+def od_simulate(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None,
+                overrides: Mapping[str, object] | Sequence[str] = ()):
+    """Simulate tracking on a run, as ``tqdyn od simulate``: the run file's scenario (its
+    ``[accelerations]`` and initial states are the truth), ``tracking`` ``"gnss,slr,isr"`` or a sequence
+    of ``tqdyn.od``'s ``problem.TRACKING_KINDS``, ``arc`` seconds or ``"7d"``, seeded noise, written as a
+    CCSDS TDM to ``output``.  Returns :class:`tqdyn.workflows.od.SimulateSummary`
+    (:func:`tqdyn.workflows.od.simulate_to_tdm`)."""
+    from .workflows.od import simulate_to_tdm
+
+    return simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval, stations=stations,
+                           overrides=_overrides(overrides))
+
+
+def od_fit(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma: float | None = None,
+           overrides: Mapping[str, object] | Sequence[str] = (), **options):
+    """Fit a scenario (a name, a TOML path or a run file) to the measurements of the TDM ``tdm``, as
+    ``tqdyn od fit`` (``output``: the estimate file, None: none); returns the
+    :class:`tqdyn.od.estimator.Estimate` (:func:`tqdyn.workflows.od.fit_to_file`)."""
+    from .workflows.od import fit_to_file
+
+    return fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider, edit_sigma=edit_sigma,
+                       overrides=_overrides(overrides), **options)[0]
+
+
+def od_covariance(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, stations=None,
+                  overrides: Mapping[str, object] | Sequence[str] = (), json=None):
+    """The predicted covariance of a tracking plan on a scenario, as ``tqdyn od covariance``; returns the
+    :class:`tqdyn.od.estimator.Covariance` (``json``: also write it there;
+    :func:`tqdyn.workflows.od.covariance_of`)."""
+    from .workflows.od import covariance_of
+
+    return covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate, consider=consider,
+                         stations=stations, overrides=_overrides(overrides), json_out=json)[0]
+
+
+def read_od_estimate(path):
+    """Read an estimate file (``tqdyn od fit --output``): ``.attrs``, ``.parameters``, ``.measurements``
+    -- :func:`tqdyn.formats.od_estimate.read_estimate_file`."""
+    from .formats.od_estimate import read_estimate_file
+
+    return read_estimate_file(path)

@@ -1,8 +1,8 @@
-"""Command line: ``tqdyn run | info | forces | bench | export | sweep | report | closed-loop``.
+"""Command line: ``tqdyn run | info | forces | bench | export | sweep | report | closed-loop | od``.
 
 The click group and the entry point :func:`main`; every command lives in its
 own module (:mod:`.run`, :mod:`.forces`, :mod:`.info`, :mod:`.bench`,
-:mod:`.export`, :mod:`.sweep`, :mod:`.report`, :mod:`.closed_loop`) and only composes library
+:mod:`.export`, :mod:`.sweep`, :mod:`.report`, :mod:`.closed_loop`, :mod:`.od`) and only composes library
 calls.  Bad input exits with status 2 and one line on stderr (no traceback,
 no partial output file).
 """
@@ -19,6 +19,7 @@ from .closed_loop import closed_loop as _closed_loop_command
 from .export import export as _export_command
 from .forces import forces as _forces_command
 from .info import info as _info_command
+from .od import od as _od_command
 from .report import report as _report_command
 from .run import run as _run_command
 from .sweep import sweep as _sweep_command
@@ -41,6 +42,7 @@ cli.add_command(_export_command)
 cli.add_command(_sweep_command)
 cli.add_command(_report_command)
 cli.add_command(_closed_loop_command)
+cli.add_command(_od_command)
 
 
 def main(argv=None):

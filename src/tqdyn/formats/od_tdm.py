@@ -1,0 +1,268 @@
+"""Orbit-determination measurements as CCSDS Tracking Data Messages (KVN, 503.0-B-2): the measurement
+file of ``tqdyn od simulate`` and ``tqdyn od fit`` (I/O only; docs/orbit-determination.md, "Files").
+
+A measurement table has one row per scalar measurement: ``t`` (m,) [s since the scenario epoch, the
+run's time scale], ``type`` (m,) str (:data:`TYPES`), ``sat`` (m,) int (the satellite's index in the
+scenario), ``peer`` (m,) str (a station name, a GNSS transmitter "G07"/"C12" or the other satellite's
+index), ``value`` (m,) [m or m/s] and ``sigma`` (m,) [m or m/s] (any object with these attributes is
+written; the reader returns them as a dict of arrays).
+
+Layout.  One segment per participant set and sigma -- (type, sat, peer, sigma) -- in the order of the
+rows' first appearance, with the standard's keywords:
+
+* ``TIME_SYSTEM`` the run's time scale (TT geocentric, TDB heliocentric) and the epochs
+  ``scenario epoch + t`` in it, ``YYYY-MM-DDThh:mm:ss.fffffffff`` (1 ns digits);
+* ``PARTICIPANT_1`` the peer (the station, the GNSS transmitter, the other satellite: its name in the
+  scenario when known), ``PARTICIPANT_2`` the satellite (its name in the scenario, else ``SAT<k>``);
+* ``MODE = SEQUENTIAL`` and ``PATH = 1,2`` for the one-way types (GNSS pseudorange, inter-satellite
+  range: emitted by the peer, received at the satellite, ``TIMETAG_REF = RECEIVE``), ``PATH = 1,2,1``
+  for the two-way ones (SLR, deep-space range and range rate; their time tag is the instant at the
+  satellite, which TIMETAG_REF cannot express: a COMMENT says so);
+* ranges as ``RANGE`` with ``RANGE_UNITS = km``, range rates as ``DOPPLER_INSTANTANEOUS`` [km/s] (the
+  standard's unit): the value in m or m/s with its decimal point moved three places, the shortest
+  decimal that gives the float64 back (Python's ``repr``), so that ``value`` reads back bit for bit
+  (a pm-level difference of two ranges survives as far as float64 holds it).
+
+What the standard lacks goes into tqdyn's own COMMENT lines, ``COMMENT tqdyn <key> = <value>``: in
+the metadata block the measurement ``type``, ``sat``, ``peer`` and ``sigma`` (m or m/s, repr), and in
+the header the scenario ``epoch`` (t = 0) and ``time_scale`` plus the writer's keys (``info``).
+
+Round trip: ``value``, ``sigma``, ``type``, ``sat`` and ``peer`` are exact; ``t`` comes back rounded to
+1 ns (the epoch digits), exactly when t and the epoch in the run's time scale are whole nanoseconds
+(a geocentric run from a UTC epoch, t on a grid of nanoseconds); rows come back in time order, rows
+of equal t in the order of their segments -- the order written when the table is in that order.
+Errors: one-line ``ValueError`` naming the file, the segment and the field.
+"""
+
+from __future__ import annotations
+
+import datetime
+import pathlib
+from decimal import Decimal, InvalidOperation
+
+import erfa
+import numpy as np
+
+from ..astro.timescales import tdb_after, tt_jd
+from .tdm import Tdm, TdmSegment, read_tdm, write_tdm
+
+__all__ = ["TYPES", "TIME_SCALES", "measurements_to_tdm", "read_measurements_tdm", "tdm_to_measurements",
+           "write_measurements_tdm"]
+
+#: type -> (data keyword, PATH, TIMETAG_REF or None, unit, description)
+TYPES = {
+    "gnss_pseudorange": ("RANGE", "1,2", "RECEIVE", "m", "GNSS pseudorange c tau + receiver clock, transmitter "
+                                                           "PARTICIPANT_1 to spacecraft PARTICIPANT_2"),
+    "slr_range": ("RANGE", "1,2,1", None, "m", "SLR range, station PARTICIPANT_1 to spacecraft PARTICIPANT_2 "
+                                               "and back"),
+    "isr_range": ("RANGE", "1,2", "RECEIVE", "m", "inter-satellite one-way light-path range, emitted by "
+                                                  "PARTICIPANT_1, received by PARTICIPANT_2"),
+    "dsn_range": ("RANGE", "1,2,1", None, "m", "deep-space two-way range, station PARTICIPANT_1 to spacecraft "
+                                               "PARTICIPANT_2 and back"),
+    "dsn_range_rate": ("DOPPLER_INSTANTANEOUS", "1,2,1", None, "m/s", "deep-space two-way range rate, station "
+                                                                      "PARTICIPANT_1 to spacecraft PARTICIPANT_2"),
+}
+#: run time scale -> the function (epoch, t) -> two-part JD in it
+TIME_SCALES = {"TT": tt_jd, "TDB": tdb_after}
+_FIELDS = ("t", "type", "sat", "peer", "value", "sigma")
+_NS = 9
+
+
+def _km_text(v: float) -> str:
+    """The decimal of repr(v) [m] divided by 1000 exactly (km)."""
+    d = Decimal(repr(float(v))).scaleb(-3)
+    return str(d)
+
+
+def _si_value(text: str) -> float:
+    """A km (or km/s) value text -> m (m/s), the exact decimal times 1000 rounded once to float64."""
+    return float(Decimal(text.replace("d", "e").replace("D", "e")).scaleb(3))
+
+
+def _epoch_texts(epoch, time_scale: str, t: np.ndarray) -> list[str]:
+    jd1, jd2 = TIME_SCALES[time_scale](epoch, np.asarray(t, np.float64))
+    iy, im, iday, ihmsf = erfa.d2dtf(time_scale, _NS, np.atleast_1d(jd1), np.atleast_1d(jd2))
+    return [f"{y:04d}-{m:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}.{f:0{_NS}d}"
+            for y, m, d, (h, mi, s, f) in zip(iy.tolist(), im.tolist(), iday.tolist(), ihmsf.tolist())]
+
+
+def _t_of(texts: list[str], epoch, time_scale: str) -> np.ndarray:
+    """Seconds since the epoch (the time scale's) of calendar epoch texts, rounded to 1 ns."""
+    e1, e2 = TIME_SCALES[time_scale](epoch, 0.0)
+    out = np.empty(len(texts))
+    for i, s in enumerate(texts):
+        s = s.rstrip("Z")
+        date, clock = s.split("T")
+        if len(date) == 8:  # YYYY-DDD
+            d = datetime.date(int(date[:4]), 1, 1) + datetime.timedelta(days=int(date[5:]) - 1)
+            y, m, day = d.year, d.month, d.day
+        else:
+            y, m, day = int(date[:4]), int(date[5:7]), int(date[8:10])
+        hh, mm, ss = clock.split(":")
+        whole, _, frac = ss.partition(".")
+        d1, d2 = erfa.dtf2d(time_scale, y, m, day, int(hh), int(mm), float(whole))
+        sec = (float(d1) - float(e1)) * 86400.0 + (float(d2) - float(e2)) * 86400.0  # error ~1e-11 s
+        sec += float(Decimal("0." + frac)) if frac else 0.0
+        base = np.floor(sec)  # whole seconds, then the fraction rounded to the 1 ns of the digits
+        out[i] = base + np.round((sec - base) * 1e9) / 1e9
+    return out
+
+
+def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, info=None,
+                        originator: str = "tqdyn", creation_date: str | None = None) -> Tdm:
+    """The :class:`~tqdyn.formats.tdm.Tdm` of a measurement table (module docstring).
+
+    epoch: the scenario epoch (:class:`tqdyn.astro.timescales.Epoch`, t = 0); time_scale: "TT" or
+    "TDB" (the run's); satellite_names: names of the scenario's satellites (by index; None: SAT<k>);
+    info: {key: value} written as header comments ``tqdyn key = value`` (the writer's own keys).
+    Raises ValueError (one line) for an unknown type, a non-finite value, a sigma that is not > 0."""
+    if time_scale not in TIME_SCALES:
+        raise ValueError(f"time_scale: {time_scale!r}; allowed: {', '.join(TIME_SCALES)}")
+    cols = {f: np.asarray(getattr(meas, f)) for f in _FIELDS}
+    m = cols["t"].size
+    if any(c.shape != (m,) for c in cols.values()):
+        raise ValueError("measurements: t, type, sat, peer, value, sigma must be (m,) arrays of one length")
+    if m == 0:
+        raise ValueError("measurements: none to write (a TDM needs a data line)")
+    for f in ("t", "value"):
+        bad = np.flatnonzero(~np.isfinite(cols[f].astype(np.float64)))
+        if bad.size:
+            raise ValueError(f"measurements.{f}[{bad[0]}] = {cols[f][bad[0]]}: must be finite")
+    sig = cols["sigma"].astype(np.float64)
+    bad = np.flatnonzero(~(np.isfinite(sig) & (sig > 0)))
+    if bad.size:
+        raise ValueError(f"measurements.sigma[{bad[0]}] = {sig[bad[0]]}: must be finite and > 0")
+    names = list(satellite_names or [])
+
+    def sat_name(k: int) -> str:
+        return names[k] if 0 <= k < len(names) else f"SAT{k}"
+
+    groups: dict = {}
+    for i in range(m):
+        typ = str(cols["type"][i])
+        if typ not in TYPES:
+            raise ValueError(f"measurements.type[{i}] = {typ!r}; allowed: {', '.join(TYPES)}")
+        key = (typ, int(cols["sat"][i]), str(cols["peer"][i]), float(sig[i]))
+        groups.setdefault(key, []).append(i)
+    epochs = _epoch_texts(epoch, time_scale, cols["t"].astype(np.float64))
+    if creation_date is None:
+        creation_date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
+    tdm = Tdm(version="2.0", header={"CREATION_DATE": creation_date, "ORIGINATOR": originator})
+    tdm.comments = [f"tqdyn epoch = {epoch.iso}", f"tqdyn time_scale = {time_scale}"]
+    tdm.comments += [f"tqdyn {k} = {v}" for k, v in (info or {}).items()]
+    for (typ, sat, peer, sigma), rows in groups.items():
+        kw, path, tag, unit, what = TYPES[typ]
+        p1 = sat_name(int(peer)) if typ == "isr_range" and peer.lstrip("-").isdigit() else peer
+        meta = {"TIME_SYSTEM": time_scale, "PARTICIPANT_1": p1, "PARTICIPANT_2": sat_name(sat), "MODE": "SEQUENTIAL",
+                "PATH": path}
+        if tag:
+            meta["TIMETAG_REF"] = tag
+        if kw == "RANGE":
+            meta["RANGE_UNITS"] = "km"
+        meta["START_TIME"], meta["STOP_TIME"] = epochs[rows[0]], epochs[rows[-1]]
+        comments = [f"tqdyn type = {typ}", f"tqdyn sat = {sat}", f"tqdyn peer = {peer}",
+                    f"tqdyn sigma = {sigma!r} {unit}", what + (" (time tag: the instant at the spacecraft)"
+                                                               if tag is None else "")]
+        if peer != peer.strip() or "\n" in peer or not peer:
+            raise ValueError(f"measurements.peer[{rows[0]}] = {peer!r}: must be a non-empty name without "
+                             "leading or trailing blanks")
+        data = [(kw, epochs[i], _km_text(cols["value"][i])) for i in rows]
+        tdm.segments.append(TdmSegment(metadata=meta, meta_comments=comments, data=data))
+    return tdm
+
+
+def write_measurements_tdm(path, meas, **kw) -> pathlib.Path:
+    """Write :func:`measurements_to_tdm` ``(meas, **kw)`` to ``path`` atomically."""
+    return write_tdm(path, measurements_to_tdm(meas, **kw))
+
+
+def _tqdyn_comments(comments) -> dict:
+    out = {}
+    for c in comments:
+        if c.startswith("tqdyn ") and " = " in c:
+            k, _, v = c[len("tqdyn "):].partition(" = ")
+            out[k.strip()] = v.strip()
+    return out
+
+
+def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, name: str = "<tdm>"):
+    """(fields, info) of a TDM written by :func:`measurements_to_tdm`: fields = {t (m,) float64 [s],
+    type (m,) str, sat (m,) int64, peer (m,) str, value (m,) float64 [m, m/s], sigma (m,) float64}
+    in time order; info = the header's ``tqdyn`` comments (epoch, time_scale and the writer's keys).
+
+    epoch, time_scale: the scenario's (t = 0 and its scale); None: the file's own (``tqdyn epoch``),
+    given as an Epoch they must agree with it.  Raises ValueError (one line naming ``name``)."""
+    from ..astro.timescales import Epoch
+
+    info = _tqdyn_comments(tdm.comments)
+    file_epoch, file_scale = info.get("epoch"), info.get("time_scale")
+    if file_epoch is None or file_scale is None:
+        raise ValueError(f"{name}: header: no 'COMMENT tqdyn epoch' / 'COMMENT tqdyn time_scale'; allowed: a "
+                         "measurement file written by tqdyn od simulate")
+    if time_scale is not None and file_scale != time_scale:
+        raise ValueError(f"{name}: header: time scale {file_scale}, the scenario's is {time_scale}; allowed: "
+                         "measurements of this scenario")
+    if epoch is not None and file_epoch != epoch.iso:
+        raise ValueError(f"{name}: header: epoch {file_epoch}, the scenario's is {epoch.iso}; allowed: "
+                         "measurements of this scenario")
+    if epoch is None:
+        try:
+            iso, _, scale = file_epoch.rpartition(" ")
+            epoch = Epoch.from_tdb(iso) if scale == "TDB" else Epoch.from_utc(iso)
+        except ValueError as exc:
+            raise ValueError(f"{name}: header: tqdyn epoch = {file_epoch!r} ({exc})") from None
+    if file_scale not in TIME_SCALES:
+        raise ValueError(f"{name}: header: tqdyn time_scale = {file_scale!r}; allowed: {', '.join(TIME_SCALES)}")
+    parts = {f: [] for f in _FIELDS}
+    for k, seg in enumerate(tdm.segments, start=1):
+        where = f"{name}, segment {k}"
+        c = _tqdyn_comments(seg.meta_comments)
+        missing = [f for f in ("type", "sat", "peer", "sigma") if f not in c]
+        if missing:
+            raise ValueError(f"{where}: metadata: no 'COMMENT tqdyn {missing[0]}'; allowed: a measurement file "
+                             "written by tqdyn od simulate")
+        typ = c["type"]
+        if typ not in TYPES:
+            raise ValueError(f"{where}: tqdyn type = {typ!r}; allowed: {', '.join(TYPES)}")
+        kw, _, _, unit, _ = TYPES[typ]
+        if seg.metadata.get("TIME_SYSTEM") != file_scale:
+            raise ValueError(f"{where}: TIME_SYSTEM = {seg.metadata.get('TIME_SYSTEM')!r}; allowed: {file_scale} "
+                             "(the header's tqdyn time_scale)")
+        if kw == "RANGE" and seg.metadata.get("RANGE_UNITS", "km") != "km":
+            raise ValueError(f"{where}: RANGE_UNITS = {seg.metadata['RANGE_UNITS']!r}; allowed: km")
+        try:
+            sat = int(c["sat"])
+            sig_text, _, sig_unit = c["sigma"].partition(" ")
+            sigma = float(sig_text)
+        except ValueError:
+            raise ValueError(f"{where}: tqdyn sat = {c['sat']!r}, sigma = {c['sigma']!r}; allowed: an integer and "
+                             f"a number with its unit {unit}") from None
+        if sig_unit != unit or not (np.isfinite(sigma) and sigma > 0):
+            raise ValueError(f"{where}: tqdyn sigma = {c['sigma']!r}; allowed: a number > 0 followed by {unit}")
+        other = sorted({d[0] for d in seg.data} - {kw})
+        if other:
+            raise ValueError(f"{where}: data keyword {other[0]}; allowed: {kw} for {typ}")
+        epochs = [e for _, e, _ in seg.data]
+        try:
+            values = [_si_value(v) for _, _, v in seg.data]
+        except InvalidOperation:
+            raise ValueError(f"{where}: {kw}: a value is not a number") from None
+        parts["t"].append(_t_of(epochs, epoch, file_scale))
+        parts["value"].append(np.array(values, np.float64))
+        n = len(epochs)
+        parts["type"].append(np.full(n, typ, dtype=object))
+        parts["sat"].append(np.full(n, sat, dtype=np.int64))
+        parts["peer"].append(np.full(n, c["peer"], dtype=object))
+        parts["sigma"].append(np.full(n, sigma))
+    cat = {f: np.concatenate(v) for f, v in parts.items()}
+    order = np.argsort(cat["t"], kind="stable")
+    fields = {f: v[order] for f, v in cat.items()}
+    fields["type"] = fields["type"].astype(str)
+    fields["peer"] = fields["peer"].astype(str)
+    return fields, info
+
+
+def read_measurements_tdm(path, *, epoch=None, time_scale: str | None = None):
+    """(fields, info) of the measurement file ``path`` (:func:`tdm_to_measurements`); the TDM reader's
+    one-line errors for a malformed file."""
+    return tdm_to_measurements(read_tdm(path), epoch=epoch, time_scale=time_scale, name=str(path))

@@ -1,0 +1,286 @@
+"""Orbit determination from files: the jobs behind ``tqdyn od simulate | fit | covariance``.
+
+* :func:`simulate_to_tdm`: the scenario of a run file (its ``[accelerations]`` and initial states are
+  the injected truth), a tracking plan, seeded measurements (``tqdyn.od``'s ``problem.simulate``) written
+  as a CCSDS TDM (:mod:`tqdyn.formats.od_tdm`) whose header records the plan;
+* :func:`fit_to_file`: a scenario and a TDM, the batch least-squares fit
+  (``tqdyn.od``'s ``problem.fit``) written as the estimate file (:mod:`tqdyn.formats.od_estimate`);
+* :func:`covariance_of`: the predicted covariance of a tracking plan
+  (``tqdyn.od``'s ``problem.covariance``), optionally written as JSON.
+
+Every input is checked before any work and nothing is written on bad input (a ``ValueError`` /
+``FileNotFoundError`` / :class:`tqdyn.formats.trajectory.OutputError` with one line); files are
+written atomically.  ``progress`` callbacks receive the name of the stage that starts.  Nothing is
+printed here; the CLI reports.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import pathlib
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..formats import trajectory as io
+from ..formats.atomic import replacing
+from ..formats.od_estimate import write_estimate_file
+from ..formats.od_tdm import read_measurements_tdm, write_measurements_tdm
+from .closed_loop import file_sha256
+from .run import load_run_scenario
+
+__all__ = ["KIND_OF_TYPE", "SimulateSummary", "covariance_of", "fit_to_file", "parameter_unit", "parse_arc",
+           "parse_names", "parse_tracking", "simulate_to_tdm"]
+
+#: measurement type -> the tracking kind that produces it
+KIND_OF_TYPE = {"gnss_pseudorange": "gnss", "slr_range": "slr", "isr_range": "isr", "dsn_range": "dsn",
+                "dsn_range_rate": "dsn"}
+
+
+def _problem():
+    from ..od import problem
+
+    return problem
+
+
+def parse_tracking(text, option: str = "--tracking") -> tuple[str, ...]:
+    """``"gnss,slr,isr"`` (or a sequence) -> the kinds, checked against
+    ``tqdyn.od``'s ``problem.TRACKING_KINDS``; ValueError (one line) otherwise."""
+    allowed = _problem().TRACKING_KINDS
+    kinds = tuple(k.strip() for k in (text.split(",") if isinstance(text, str) else text))
+    if not kinds or any(not k for k in kinds):
+        raise ValueError(f"{option}: {text!r} is empty; allowed: a comma-separated list of {', '.join(allowed)}")
+    for k in kinds:
+        if k not in allowed:
+            raise ValueError(f"{option}: {k!r} is not a tracking type; allowed: {', '.join(allowed)}")
+    if len(set(kinds)) != len(kinds):
+        raise ValueError(f"{option}: {text!r} names a tracking type twice")
+    return kinds
+
+
+def parse_names(text, option: str) -> tuple[str, ...]:
+    """``"state,s_frame"`` (or a sequence; None or "" -> ()) -> a tuple of names."""
+    if text is None:
+        return ()
+    items = text.split(",") if isinstance(text, str) else list(text)
+    return tuple(s.strip() for s in items if s.strip())
+
+
+def parse_arc(value, option: str = "--arc") -> float:
+    """A duration (seconds, or ``7d``, ``12h``, ``30min`` as ``--duration`` takes it) -> seconds > 0."""
+    from ..scenario import ScenarioError
+    from ..scenario.loader import parse_duration
+
+    try:
+        v = float(parse_duration(value))
+    except (ScenarioError, ValueError, ArithmeticError):
+        v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{option}: {value!r} is not a duration > 0; allowed: seconds, or with a unit (7d, 12h, "
+                         "30min, 3600s)")
+    return v
+
+
+def parameter_unit(name: str) -> str:
+    """The unit of an estimated parameter from its name ``"<sat>/<component>"``: the initial state's
+    x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters [m/s^2]; "" otherwise."""
+    from ..od.parameters import PARAMETER_NAMES, STATE_NAMES
+
+    last = name.rsplit("/", 1)[-1]
+    if last in STATE_NAMES:
+        return "m" if last in STATE_NAMES[:3] else "m/s"
+    return "m/s^2" if last in PARAMETER_NAMES else ""
+
+
+def _same(a, b) -> bool:
+    pa, pb = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(a)))), \
+        pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(b))))
+    if pa.exists() and pb.exists():
+        return os.path.samefile(pa, pb)
+    return pa == pb
+
+
+def _check_output(output, option: str, inputs: dict) -> pathlib.Path:
+    out = io.check_writable(output)
+    for label, path in inputs.items():
+        if path is not None and os.path.exists(os.fspath(path)) and _same(out, path):
+            raise ValueError(f"{option}: {str(out)!r} is the input {label}; allowed: another file")
+    return out
+
+
+def _check_arc(scen, arc_s: float, source: str) -> None:
+    span = float(scen.run.duration_s)
+    if arc_s > span:
+        raise ValueError(f"--arc: {arc_s:g} s is outside the run {source} ({span:g} s from its epoch); allowed: "
+                         f"0 < arc <= {span:g} s (or --set run.duration=...)")
+
+
+def _scenario(scenario, overrides):
+    """(scenario, notes, label) of a name, TOML path or run file (as ``tqdyn run``)."""
+    scen, notes = load_run_scenario(scenario, list(overrides))
+    return scen, notes, (str(scenario) if scenario is not None else scen.name)
+
+
+@dataclass(frozen=True)
+class SimulateSummary:
+    """What :func:`simulate_to_tdm` wrote: path, measurement count per type, the tracking plan."""
+
+    path: pathlib.Path
+    counts: dict
+    tracking: object
+    notes: tuple
+
+
+def _tracking(kinds, arc_s, interval_s, estimate=None, consider=None, **kw):
+    p = _problem()
+    extra = {}
+    if interval_s is not None:
+        extra["interval_s"] = float(interval_s)
+    if estimate:
+        extra["estimate"] = tuple(estimate)
+    if consider:
+        extra["consider"] = tuple(consider)
+    return p.Tracking(kinds=tuple(kinds), arc_s=float(arc_s), **extra, **kw)
+
+
+def _stations(value) -> dict:
+    names = parse_names(value, "--stations")
+    return {"stations": names} if names else {}
+
+
+def _interval(value) -> float | None:
+    return None if value is None else parse_arc(value, "--interval")
+
+
+def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, overrides=(),
+                    progress: Callable[[str], None] | None = None) -> SimulateSummary:
+    """Simulate the measurements of ``tracking`` (kinds) over ``arc`` from the run file's scenario (its
+    ``[accelerations]`` are the truth) with noise seed ``seed``, and write them as a TDM to ``output``.
+    stations: ground-station names (None: the plan's defaults)."""
+    say = progress or (lambda stage: None)
+    kinds = parse_tracking(tracking)
+    arc_s = parse_arc(arc)
+    interval_s = _interval(interval)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"--seed: {seed!r} is not allowed; allowed: an integer >= 0")
+    if not io.is_trajectory_file(run_file):
+        raise (FileNotFoundError(f"RUN.h5: trajectory file {str(run_file)!r} does not exist or is not a file")
+               if not os.path.isfile(os.fspath(run_file)) else
+               ValueError(f"RUN.h5: {str(run_file)!r} is not a trajectory file; allowed: a file written by tqdyn run"))
+    out = _check_output(output, "--output", {"RUN.h5": run_file})
+    scen, notes, label = _scenario(run_file, overrides)
+    _check_arc(scen, arc_s, label)
+    p = _problem()
+    plan = _tracking(kinds, arc_s, interval_s, **_stations(stations))
+    say("scheduling")
+    p.schedule(scen, plan)  # visibility refusals (a station below the horizon) before the simulation
+    say("simulating")
+    meas = p.simulate(scen, plan, None, seed)
+    info = {"tracking": ",".join(kinds), "arc_s": repr(arc_s), "interval_s": repr(float(plan.interval_s)),
+            "seed": str(seed), "scenario": scen.name, "run_file": pathlib.Path(run_file).name,
+            "run_sha256": file_sha256(run_file)}
+    if plan.stations is not None:
+        info["stations"] = ",".join(plan.stations)
+    say("writing")
+    path = write_measurements_tdm(out, meas, epoch=scen.epoch, time_scale=scen.reference.time_scale,
+                                  satellite_names=[s.name for s in scen.satellites], info=info)
+    counts: dict = {}
+    for typ in np.asarray(meas.type).tolist():
+        counts[typ] = counts.get(typ, 0) + 1
+    return SimulateSummary(path, counts, plan, tuple(notes))
+
+
+def _measurements(fields):
+    return _problem().Measurements(**{k: fields[k] for k in ("t", "type", "sat", "peer", "value", "sigma")})
+
+
+def _header_number(info: dict, key: str, tdm) -> float:
+    try:
+        v = float(info[key])
+    except ValueError:
+        v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{tdm}: header: tqdyn {key} = {info[key]!r}; allowed: a number of seconds > 0")
+    return v
+
+
+def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma=None, overrides=(),
+                progress: Callable[[str], None] | None = None, **options):
+    """Fit the scenario's parameters (``estimate``, ``consider``: names of parameter groups, default
+    the plan's) to the measurements of the TDM ``tdm``; write the estimate file ``output`` (None: no
+    file).  Returns (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
+    :func:`tqdyn.od.estimator.estimate` with ``edit_sigma``."""
+    say = progress or (lambda stage: None)
+    est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
+    if edit_sigma is not None and not (isinstance(edit_sigma, (int, float)) and edit_sigma > 0):
+        raise ValueError(f"--edit-sigma: {edit_sigma!r} is not allowed; allowed: a number > 0")
+    if not os.path.isfile(os.fspath(tdm)):
+        raise FileNotFoundError(f"MEAS.tdm: measurement file {str(tdm)!r} does not exist or is not a file")
+    inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
+    out = _check_output(output, "--output", inputs) if output is not None else None
+    scen, notes, label = _scenario(scenario, overrides)
+    say("reading")
+    fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale)
+    kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
+        tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
+    parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
+    arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
+    _check_arc(scen, arc_s, label)
+    interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
+    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, **_stations(info.get("stations")))
+    meas = _measurements(fields)
+    say("fitting")
+    if edit_sigma is not None:
+        options["edit_sigma"] = float(edit_sigma)
+    fit = _problem().fit(scen, meas, plan, **options)
+    if out is not None:
+        say("writing")
+        attrs = {"scenario": scen.to_toml(), "scenario_name": scen.name, "epoch": scen.epoch.iso,
+                 "time_scale": scen.reference.time_scale, "tdm_file": pathlib.Path(tdm).name,
+                 "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
+                 "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
+                                         "estimate": list(plan.estimate), "consider": list(plan.consider)})}
+        write_estimate_file(out, fit, meas, attrs=attrs, units=[parameter_unit(n) for n in fit.names])
+    return fit, scen, tuple(notes)
+
+
+def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, stations=None,
+                  overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
+    """The predicted covariance (:class:`tqdyn.od.estimator.Covariance`) of the tracking plan on the
+    scenario, and (optionally) its JSON file ``json_out``.  Returns (covariance, scenario, notes)."""
+    say = progress or (lambda stage: None)
+    kinds = parse_tracking(tracking)
+    arc_s = parse_arc(arc)
+    interval_s = _interval(interval)
+    est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
+    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
+    out = _check_output(json_out, "--json", inputs) if json_out is not None else None
+    scen, notes, label = _scenario(scenario, overrides)
+    _check_arc(scen, arc_s, label)
+    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, **_stations(stations))
+    say("covariance")
+    cov = _problem().covariance(scen, plan)
+    if out is not None:
+        say("writing")
+        rec = covariance_record(cov, scen, plan)
+        with replacing(out, "the covariance JSON") as tmp:
+            tmp.write_text(json.dumps(rec, indent=1) + "\n", encoding="utf-8")
+    return cov, scen, tuple(notes)
+
+
+def covariance_record(cov, scen, plan) -> dict:
+    """The JSON record of a predicted covariance: scenario, tracking plan, parameter names and units,
+    nominal values, sigmas, covariance, correlation, consider names and sigmas, condition number."""
+    def arr(a):
+        return np.asarray(a, np.float64).tolist()
+
+    return {"scenario": scen.name, "epoch": scen.epoch.iso, "time_scale": scen.reference.time_scale,
+            "tracking": {"kinds": list(plan.kinds), "arc_s": float(plan.arc_s), "interval_s": float(plan.interval_s),
+                         "estimate": list(plan.estimate), "consider": list(plan.consider)},
+            "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
+            "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
+            "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
+            "condition_number": float(cov.condition_number)}

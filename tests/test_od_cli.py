@@ -1,0 +1,191 @@
+"""``tqdyn od simulate | fit | covariance`` (tqdyn.cli.od, tqdyn.workflows.od; docs/commands.md).
+
+The orbit-determination problem (tqdyn.od.problem) is replaced by the linear stand-in
+tests/od_fake_problem.py, which has its interface: these tests check the command line and the files,
+not the physics.  References: the weighted least-squares solution of the stand-in's linear model by
+numpy's lstsq (independent of tqdyn's estimator) for the printed summary lines; the command-line
+contract (one line on stderr and exit status 2 for bad input, 130 for Ctrl-C, nothing written then).
+The run is tianqin-kepler, 1 day at 600 s (a few seconds).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+import od_fake_problem as fake
+from cli_support import run_cli
+
+
+@pytest.fixture(autouse=True)
+def fake_problem(monkeypatch):
+    import tqdyn.od
+
+    monkeypatch.setitem(sys.modules, "tqdyn.od.problem", fake)
+    monkeypatch.setattr(tqdyn.od, "problem", fake, raising=False)
+    return fake
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    import tqdyn
+
+    d = tmp_path_factory.mktemp("od-run")
+    tqdyn.run("tianqin-kepler", {"run.duration": "1d", "integrator.step": 600}, output=str(d / "run.h5"))
+    return d / "run.h5"
+
+
+def _simulate(run_file, out, capsys, *extra):
+    return run_cli(["od", "simulate", str(run_file), "--tracking", "gnss,slr,isr,dsn", "--arc", "12h", "--seed", "3",
+                    "--output", str(out), *extra], capsys)
+
+
+def _lstsq(meas, scen_names):
+    """Weighted least squares of the stand-in's linear model by numpy: (x, sigma, chi2)."""
+    scen = type("S", (), {"satellites": [type("Sat", (), {"name": n}) for n in scen_names]})
+    jac = fake.design(scen, meas) / meas.sigma[:, None]
+    y = meas.value / meas.sigma
+    x, *_ = np.linalg.lstsq(jac, y, rcond=None)
+    cov = np.linalg.inv(jac.T @ jac)
+    r = y - jac @ x
+    return x, np.sqrt(np.diag(cov)), float(r @ r)
+
+
+def test_simulate_then_fit_prints_the_least_squares_solution(run_file, tmp_path, capsys):
+    """simulate writes the TDM; fit prints one line per parameter (value +- 1-sigma, unit) and chi^2/dof
+    equal to numpy's weighted least squares of the same measurements; EST.h5 holds them."""
+    from tqdyn.formats.od_estimate import read_estimate_file
+    from tqdyn.formats.od_tdm import read_measurements_tdm
+
+    tdm, est = tmp_path / "m.tdm", tmp_path / "est.h5"
+    status, out, err = _simulate(run_file, tdm, capsys)
+    assert status in (0, None), err
+    assert out.splitlines()[0] == ("measurements: 1095 (219 gnss_pseudorange, 219 slr_range, 219 isr_range, "
+                                   "219 dsn_range, 219 dsn_range_rate) over 43200 s, seed 3")
+    status, out, err = run_cli(["od", "fit", str(run_file), str(tdm), "--output", str(est)], capsys)
+    assert status in (0, None), err
+    fields, info = read_measurements_tdm(tdm)
+    assert info["seed"] == "3" and info["run_file"] == "run.h5"
+    meas = fake.Measurements(**fields)
+    names = ["Sat1", "Sat2", "Sat3"]
+    x, sig, chi2 = _lstsq(meas, names)
+    lines = out.splitlines()
+    units = ["m", "m/s^2"] * 3
+    pnames = [f"{s}/{p}" for s in names for p in ("x", "s_x")]
+    for i, (line, n) in enumerate(zip(lines, pnames)):
+        assert line == f"  {n:<8} = {x[i]: .9e} +- {sig[i]:.3e} {units[i]}"
+    assert lines[6].startswith(f"chi2/dof = {chi2:.6g}/{1095 - 6} = {chi2 / 1089:.4g} (p = ")
+    f = read_estimate_file(est)
+    np.testing.assert_allclose(f.parameters["values"], x, rtol=1e-9)
+    np.testing.assert_allclose(f.parameters["sigma"], sig, rtol=1e-9)
+    assert np.array_equal(f.measurements["value"], meas.value)
+    import hashlib
+
+    assert f.attrs["tdm_sha256"] == hashlib.sha256(tdm.read_bytes()).hexdigest()
+    assert "[scenario]" in f.attrs["scenario"] and f.attrs["scenario_name"] == "tianqin-kepler"
+
+
+def test_covariance_prints_sigmas_and_writes_json(run_file, tmp_path, capsys):
+    """covariance prints each parameter's 1-sigma (numpy's inverse normal matrix of the scheduled
+    measurements) and writes them as JSON; a run file works as SCENARIO."""
+    import json
+
+    out_json = tmp_path / "cov.json"
+    status, out, err = run_cli(["od", "covariance", str(run_file), "--tracking", "slr", "--arc", "12h",
+                                "--json", str(out_json)], capsys)
+    assert status in (0, None), err
+    scen = type("S", (), {"satellites": [type("Sat", (), {"name": n}) for n in ("Sat1", "Sat2", "Sat3")]})
+    meas = fake.schedule(scen, fake.Tracking(("slr",), 43200.0))
+    meas.value = np.ones(len(meas.t))
+    _, sig, _ = _lstsq(meas, ("Sat1", "Sat2", "Sat3"))
+    rec = json.loads(out_json.read_text())
+    np.testing.assert_allclose(rec["sigma"], sig, rtol=1e-9)
+    assert rec["tracking"]["kinds"] == ["slr"] and rec["units"][:2] == ["m", "m/s^2"]
+    assert out.splitlines()[1] == f"  Sat1/s_x   sigma = {sig[1]:.3e} m/s^2"
+
+
+def _bad_tdm(tmp_path):
+    p = tmp_path / "bad.tdm"
+    p.write_text("CCSDS_TDM_VERS = 2.0\nCREATION_DATE = 2026-01-01T00:00:00\nORIGINATOR = x\nMETA_START\n"
+                 "  TIME_SYSTEM = TT\n  FOO = 1\n")
+    return p
+
+
+@pytest.mark.parametrize("case, pattern", [
+    ("tracking", r"--tracking: 'radar' is not a tracking type; allowed: gnss, slr, isr, dsn"),
+    ("arc", r"--arc: 2.592e\+06 s is outside the run .*run.h5 \(86400 s from its epoch\)"),
+    ("horizon", "tracking.stations: 'Nowhere' is below the 20 deg elevation mask for the whole arc"),
+    ("sim-output-is-input", r"--output: .*run.h5' is the input RUN.h5"),
+    ("fit-output-is-input", r"--output: .*good.tdm' is the input MEAS.tdm"),
+    ("malformed", r"bad.tdm, line 6: FOO: not a TDM metadata keyword"),
+    ("foreign", r"good.tdm: header: no 'COMMENT tqdyn epoch'"),
+    ("estimate", r"tracking.estimate: 'bogus' is not a parameter group"),
+    ("header", r"good.tdm: header: tqdyn arc_s = 'long'; allowed: a number of seconds > 0"),
+    ("arc-format", r"--arc: 'week' is not a duration"),
+])
+def test_refusals_are_one_line_and_write_nothing(run_file, tmp_path, capsys, case, pattern):
+    """Bad input: exit status 2, one line on stderr, no file at the output path (nor a temporary one)."""
+    good = tmp_path / "good.tdm"
+    status, _, err = _simulate(run_file, good, capsys)
+    assert status in (0, None), err
+    out = tmp_path / "out"
+    sim = ["od", "simulate", str(run_file), "--tracking", "gnss", "--arc", "12h", "--output", str(out)]
+    fit = ["od", "fit", str(run_file), str(good), "--output", str(out)]
+    if case == "foreign":
+        good.write_text(good.read_text().replace("COMMENT tqdyn epoch", "COMMENT epoch"))
+    if case == "header":
+        good.write_text(good.read_text().replace("tqdyn arc_s = 43200.0", "tqdyn arc_s = long"))
+    argv = {"tracking": sim[:4] + ["gnss,radar"] + sim[5:], "arc": sim[:6] + ["30d"] + sim[7:],
+            "horizon": sim + ["--tracking", "slr", "--stations", "Yarragadee,Nowhere"],
+            "sim-output-is-input": sim[:-1] + [str(run_file)], "fit-output-is-input": fit[:-1] + [str(good)],
+            "malformed": ["od", "fit", str(run_file), str(_bad_tdm(tmp_path)), "--output", str(out)],
+            "foreign": fit, "header": fit, "estimate": fit + ["--estimate", "state,bogus"],
+            "arc-format": sim[:6] + ["week"] + sim[7:]}[case]
+    before = sorted(p.name for p in tmp_path.iterdir())
+    status, _, err = run_cli(argv, capsys)
+    assert status == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("tqdyn: error: "), err
+    import re
+
+    assert re.search(pattern, lines[0]), lines[0]
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("command", ["simulate", "fit"])
+def test_ctrl_c_exits_130_without_a_file(run_file, tmp_path, capsys, monkeypatch, command):
+    """Ctrl-C during the work: exit status 130, one line, no output file."""
+    good = tmp_path / "good.tdm"
+    if command == "fit":
+        assert _simulate(run_file, good, capsys)[0] in (0, None)
+
+    def stop(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(fake, command, stop)
+    out = tmp_path / "out"
+    argv = (["od", "simulate", str(run_file), "--tracking", "gnss", "--arc", "1h", "--output", str(out)]
+            if command == "simulate" else ["od", "fit", str(run_file), str(good), "--output", str(out)])
+    status, _, err = run_cli(argv, capsys)
+    assert status == 130 and err.strip() == "tqdyn: error: interrupted; no output file written"
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_front_door_wrappers_match_the_command(run_file, tmp_path, capsys):
+    """tqdyn.od_simulate / od_fit / od_covariance / read_od_estimate give what the commands write."""
+    import tqdyn
+
+    a, b = tmp_path / "a.tdm", tmp_path / "b.tdm"
+    assert _simulate(run_file, a, capsys)[0] in (0, None)
+    s = tqdyn.od_simulate(run_file, ["gnss", "slr", "isr", "dsn"], 43200, output=b, seed=3)
+    assert s.counts["slr_range"] == 219
+    strip = [ln for ln in a.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
+    assert strip == [ln for ln in b.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
+    est = tqdyn.od_fit(str(run_file), b, output=tmp_path / "e.h5", edit_sigma=6.0)
+    f = tqdyn.read_od_estimate(tmp_path / "e.h5")
+    assert np.array_equal(f.parameters["values"], est.values) and f.attrs["edit_sigma"] == 6.0
+    cov = tqdyn.od_covariance("tianqin-kepler", "slr", "12h", estimate="s_frame")
+    assert cov.names == ("Sat1/s_x", "Sat2/s_x", "Sat3/s_x")
