@@ -46,39 +46,23 @@ sees a satellite over the arc, a tracking kind without any visible measurement.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+import dataclasses
 
 import numpy as np
 from scipy import linalg, sparse
 
-from ..astro.ephemeris import ephemeris_named, planetary_gm
-from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
-from ..dynamics.empirical import N_PAR, PARAMETER_NAMES
+from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
 from . import estimator
-from .measurements_dsn import DEEP_SPACE_STATIONS, DSN_DOPPLER_SIGMA_M_S, DSN_RANGE_SIGMA_M, dsn_tracking
-from .measurements_gnss import BEIDOU_MEO, GNSS_SIGMA_M, GPS, pseudorange
-from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
-from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
-from .parameters import STATE_NAMES, OrbitParameters, parameter_names, state_names
+from .parameters import OrbitParameters, parameter_names, state_names
+from .tracking import (DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES, TRACKING_KINDS,
+                       Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match, row_order)
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
-           "build_problem", "compute", "covariance", "fit", "nominal_parameters", "schedule", "simulate"]
+           "build_problem", "compute", "covariance", "fit", "nominal_parameters", "schedule", "simulate",
+           "with_measurements"]
 
-TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
-MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
-#: Measurement types of each tracking kind.
-KIND_TYPES = {"gnss": ("gnss_pseudorange",), "slr": ("slr_range",), "isr": ("isr_range",),
-              "dsn": ("dsn_range", "dsn_range_rate")}
-#: Default noise per measurement type [m, m/s for dsn_range_rate] (the models' defaults).
-DEFAULT_SIGMA = {"gnss_pseudorange": GNSS_SIGMA_M, "slr_range": SLR_SIGMA_M, "isr_range": ISR_ABSOLUTE_SIGMA_M,
-                 "dsn_range": DSN_RANGE_SIGMA_M, "dsn_range_rate": DSN_DOPPLER_SIGMA_M_S}
-#: Parameter groups: name -> the per-satellite parameter names it holds.
-GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETER_NAMES[3:6],
-          "rtn_cos": PARAMETER_NAMES[6:9], "rtn_sin": PARAMETER_NAMES[9:12]}
-_HELIO_KINDS = ("dsn", "isr")
 #: Largest step [s] of the float64 variational equations on geocentric runs (DP87 on TianQin's
 #: 3.6-day orbit: the partials agree with dd differences to ~1e-10 at 600 s).
 _PARTIALS_STEP_GEOCENTRIC = 600.0
@@ -86,164 +70,31 @@ _PARTIALS_STEP_GEOCENTRIC = 600.0
 CLOCK_SIGMA_M = 1000.0
 
 
-def _fail(msg: str):
-    raise ValueError(" ".join(msg.split()))
-
-
-@dataclass(frozen=True)
-class Tracking:
-    """A tracking plan (module docstring).
-
-    kinds: subset of :data:`TRACKING_KINDS`; arc_s [s] from the epoch; interval_s [s] sampling
-    interval, a multiple of ``integrator.step``; sigma: {measurement type: sigma [m or m/s]}
-    overriding :data:`DEFAULT_SIGMA`; stations: SLR (:data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`)
-    and deep-space (:data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`) station names (None:
-    all of them); estimate, consider: parameter groups (:data:`GROUPS`); a_priori_sigma: {group:
-    sigma} a priori sigmas per group (``"state"``: (sigma_r [m], sigma_v [m/s]); the acceleration
-    groups: [m/s^2]), needed for every considered group; gnss_mode: the GNSS reception mode of
-    :func:`~tqdyn.od.measurements_gnss.gnss_visibility`."""
-
-    kinds: tuple
-    arc_s: float
-    interval_s: float = 600.0
-    sigma: dict | None = None
-    stations: tuple | None = None
-    estimate: tuple = ("state", "s_frame")
-    consider: tuple = ()
-    a_priori_sigma: dict | None = None
-    gnss_mode: str = "sidelobes"
-
-    def __post_init__(self):
-        kinds = (self.kinds,) if isinstance(self.kinds, str) else tuple(self.kinds)
-        for k in kinds:
-            if k not in TRACKING_KINDS:
-                _fail(f"tracking.kinds: {k!r} is not allowed; allowed: {', '.join(TRACKING_KINDS)}")
-        if not kinds or len(set(kinds)) != len(kinds):
-            _fail(f"tracking.kinds: {kinds!r}; allowed: distinct kinds of {', '.join(TRACKING_KINDS)}")
-        object.__setattr__(self, "kinds", kinds)
-        for name in ("arc_s", "interval_s"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                _fail(f"tracking.{name}: {v!r} s; allowed: a finite number > 0")
-        if self.interval_s > self.arc_s:
-            _fail(f"tracking.interval_s: {self.interval_s} s is longer than the arc ({self.arc_s} s)")
-        for key, v in (self.sigma or {}).items():
-            if key not in MEASUREMENT_TYPES:
-                _fail(f"tracking.sigma: {key!r} is not allowed; allowed: {', '.join(MEASUREMENT_TYPES)}")
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                _fail(f"tracking.sigma[{key!r}] = {v!r}; allowed: a finite number > 0 (m or m/s)")
-        for name in ("estimate", "consider"):
-            groups = (getattr(self, name),) if isinstance(getattr(self, name), str) else tuple(getattr(self, name))
-            for g in groups:
-                if g not in GROUPS:
-                    _fail(f"tracking.{name}: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
-            object.__setattr__(self, name, groups)
-        if not self.estimate:
-            _fail(f"tracking.estimate: empty; allowed: groups of {', '.join(GROUPS)}")
-        both = set(self.estimate) & set(self.consider)
-        if both:
-            _fail(f"tracking.consider: {sorted(both)[0]!r} is also estimated; a group is estimated or considered")
-        for g, v in (self.a_priori_sigma or {}).items():
-            if g not in GROUPS:
-                _fail(f"tracking.a_priori_sigma: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
-            vals = np.atleast_1d(np.asarray(v, np.float64))
-            if vals.shape != ((2,) if g == "state" else (1,)) or not np.all(vals > 0):
-                _fail(f"tracking.a_priori_sigma[{g!r}] = {v!r}; allowed: "
-                      + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else "a number > 0 (m/s^2)"))
-        for g in self.consider:
-            if g not in (self.a_priori_sigma or {}):
-                _fail(f"tracking.consider: {g!r} has no a priori sigma; give tracking.a_priori_sigma[{g!r}]")
-        if self.stations is not None:
-            st = (self.stations,) if isinstance(self.stations, str) else tuple(self.stations)
-            for s in st:
-                if s not in ILRS_STATIONS and s not in DEEP_SPACE_STATIONS:
-                    _fail(f"tracking.stations: {s!r} is not allowed; allowed: SLR "
-                          f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
-            object.__setattr__(self, "stations", st)
-
-    @property
-    def types(self) -> tuple:
-        """The measurement types of the plan, in :data:`MEASUREMENT_TYPES` order."""
-        return tuple(t for t in MEASUREMENT_TYPES for k in self.kinds if t in KIND_TYPES[k])
-
-    def sigma_of(self, mtype: str) -> float:
-        """Noise sigma of a measurement type [m or m/s]."""
-        return float((self.sigma or {}).get(mtype, DEFAULT_SIGMA[mtype]))
-
-    def times(self) -> np.ndarray:
-        """(n,) sampling times [s since the epoch]: 0, interval, ..., <= arc_s."""
-        n = int(math.floor(self.arc_s / self.interval_s * (1 + 1e-12)))
-        return np.arange(n + 1) * float(self.interval_s)
-
-    def station_names(self, kind: str):
-        """Station names of an SLR or DSN kind (None: the model's defaults)."""
-        if self.stations is None:
-            return None
-        cat = ILRS_STATIONS if kind == "slr" else DEEP_SPACE_STATIONS
-        names = [s for s in self.stations if s in cat]
-        if not names:
-            _fail(f"tracking.stations: none of {list(self.stations)} is a{'n SLR' if kind == 'slr' else ' deep-space'} "
-                  f"station (tracking kind {kind!r}); allowed: {', '.join(cat)}")
-        return names
-
-
-@dataclass
-class Measurements:
-    """Scalar measurements, one row each, ordered by time (module docstring).
-
-    t (m,) [s since the epoch, the run's time scale]; type (m,) str of :data:`MEASUREMENT_TYPES`;
-    sat (m,) int satellite index; peer (m,) str: station name, GNSS id ("G07", "C12") or the
-    emitting satellite's index; value (m,) [m or m/s] (NaN before simulation); sigma (m,)."""
-
-    t: np.ndarray
-    type: np.ndarray
-    sat: np.ndarray
-    peer: np.ndarray
-    value: np.ndarray
-    sigma: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.t.size)
-
-    def select(self, mask) -> "Measurements":
-        """The rows where mask is true (or the given row indices)."""
-        return Measurements(*(np.asarray(a)[mask] for a in (self.t, self.type, self.sat, self.peer, self.value,
-                                                              self.sigma)))
-
-
-# ---------------------------------------------------------------------------------------------
-# scenario checks
-
-
-def _is_helio(scen) -> bool:
-    return scen.reference.central_body == "sun"
-
-
 def _scenario(scenario, tracking: Tracking | None = None):
     """The loaded scenario, checked for orbit determination with the tracking plan."""
     scen = load_scenario(scenario) if isinstance(scenario, str) else scenario
     if scen.constellation.pointing != "none":
-        _fail(f"scenario {scen.name!r}: constellation.pointing = {scen.constellation.pointing!r} is a coupled "
+        fail(f"scenario {scen.name!r}: constellation.pointing = {scen.constellation.pointing!r} is a coupled "
               f"(attitude) run; orbit determination needs point-mass satellites (allowed: \"none\", "
               f"e.g. tianqin-gravity, lisa-gravity, lisa-esa)")
     if scen.integrator.mode != "fixed":
-        _fail(f'scenario {scen.name!r}: integrator.mode = {scen.integrator.mode!r}; allowed: "fixed"')
+        fail(f'scenario {scen.name!r}: integrator.mode = {scen.integrator.mode!r}; allowed: "fixed"')
     if tracking is None:
         return scen
-    if _is_helio(scen):
+    if is_heliocentric(scen):
         for k in tracking.kinds:
-            if k not in _HELIO_KINDS:
-                _fail(f"tracking.kinds: {k!r} is not allowed for the heliocentric scenario {scen.name!r}; "
-                      f"allowed: {', '.join(_HELIO_KINDS)}")
+            if k not in HELIOCENTRIC_KINDS:
+                fail(f"tracking.kinds: {k!r} is not allowed for the heliocentric scenario {scen.name!r}; "
+                      f"allowed: {', '.join(HELIOCENTRIC_KINDS)}")
     if "isr" in tracking.kinds and len(scen.satellites) != 3:
-        _fail(f"tracking.kinds: 'isr' needs three satellites; scenario {scen.name!r} has {len(scen.satellites)}")
+        fail(f"tracking.kinds: 'isr' needs three satellites; scenario {scen.name!r} has {len(scen.satellites)}")
     step = float(scen.integrator.step_s)
     if abs(tracking.interval_s / step - round(tracking.interval_s / step)) > 1e-9:
-        _fail(f"tracking.interval_s: {tracking.interval_s} s is not a multiple of integrator.step = {step} s")
+        fail(f"tracking.interval_s: {tracking.interval_s} s is not a multiple of integrator.step = {step} s")
     eph = ephemeris_named(scen.forces.ephemeris)
     jd_end = scen.epoch.tdb[0] + scen.epoch.tdb[1] + (tracking.arc_s + 86400.0) / 86400.0
     if jd_end > eph.span_jd[1]:
-        _fail(f"tracking.arc_s: {tracking.arc_s} s from the epoch ends beyond the span of the ephemeris "
+        fail(f"tracking.arc_s: {tracking.arc_s} s from the epoch ends beyond the span of the ephemeris "
               f"{eph.name} (JD {eph.span_jd[1]}, less one day for light times); allowed: at most "
               f"{(eph.span_jd[1] - 1.0 - scen.epoch.tdb[0] - scen.epoch.tdb[1]) * 86400.0:.0f} s")
     return scen
@@ -284,90 +135,17 @@ def _partials_step(scen, t) -> float:
     run = float(scen.integrator.step_s)
     k = np.rint(np.asarray(t) / run).astype(np.int64)
     g = int(np.gcd.reduce(k[k > 0])) if np.any(k > 0) else 1
-    cap = run if _is_helio(scen) else max(run, _PARTIALS_STEP_GEOCENTRIC)
+    cap = run if is_heliocentric(scen) else max(run, _PARTIALS_STEP_GEOCENTRIC)
     return run * max(d for d in range(1, g + 1) if g % d == 0 and d * run <= cap)
-
-
-# ---------------------------------------------------------------------------------------------
-# the models on a grid of states
-
-
-@dataclass
-class _Rows:
-    """Computed measurements of one type on a time grid: row arrays (r,)."""
-
-    type: str
-    t_idx: np.ndarray
-    sat: np.ndarray
-    peer: np.ndarray
-    value: np.ndarray
-    visible: np.ndarray
-    d: np.ndarray        # (r, 2, 6): partials wrt the satellite's and the emitter's (r, v)
-    sat2: np.ndarray     # (r,) emitter index (ISR) or -1
-
-
-def _flat(mtype, b, names, obs_value, d_r, d_v, visible):
-    """Rows of an (N, S) observable of satellite b toward peers ``names``."""
-    n, s = obs_value.shape
-    d = np.zeros((n * s, 2, 6))
-    d[:, 0, :3] = d_r.reshape(-1, 3)
-    d[:, 0, 3:] = d_v.reshape(-1, 3)
-    return _Rows(mtype, np.repeat(np.arange(n), s), np.full(n * s, b), np.tile(np.asarray(names, object), n),
-                 obs_value.ravel(), visible.ravel(), d, np.full(n * s, -1))
-
-
-def _evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[_Rows]:
-    """Every computable measurement of ``types`` at t (n,) [s] from states (n, n_sat, 6)
-    [m, m/s]; stations: {kind: names} overriding the tracking plan's."""
-    stations = stations or {}
-    helio = _is_helio(scen)
-    out = []
-    n_sat = states.shape[1]
-    r, v = states[..., :3], states[..., 3:]
-    if "gnss_pseudorange" in types:
-        for b in range(n_sat):
-            for const, prefix in ((GPS, "G"), (BEIDOU_MEO, "C")):
-                o = pseudorange(t, r[:, b], v[:, b], const, mode=tracking.gnss_mode)
-                ids = [f"{prefix}{k + 1:02d}" for k in range(o.value.shape[1])]
-                out.append(_flat("gnss_pseudorange", b, ids, o.value, o.d_r, o.d_v, o.visible))
-    if "slr_range" in types:
-        names = stations.get("slr", tracking.station_names("slr"))
-        for b in range(n_sat):
-            o = slr_range(scen.epoch, t, r[:, b], v[:, b], names)
-            out.append(_flat("slr_range", b, o.extra["stations"], o.value, o.d_r, o.d_v, o.visible))
-    if "dsn_range" in types or "dsn_range_rate" in types:
-        names = stations.get("dsn", tracking.station_names("dsn"))
-        eph = ephemeris_named(scen.forces.ephemeris)
-        for b in range(n_sat):
-            rng, rate = dsn_tracking(scen.epoch, t, r[:, b], v[:, b], names, heliocentric=helio, ephemeris=eph)
-            for mtype, o in (("dsn_range", rng), ("dsn_range_rate", rate)):
-                if mtype in types:
-                    out.append(_flat(mtype, b, o.extra["stations"], o.value, o.d_r, o.d_v, o.visible))
-    if "isr_range" in types:
-        gm = planetary_gm()["sun"] if helio else float(scen.forces.gm_earth)
-        o = isr_range(t, r, v, gm=gm)
-        n, nl = o.value.shape
-        d = np.concatenate([o.d_r, o.d_v], axis=-1).reshape(n * nl, 2, 6)
-        rec, emi = np.asarray(LINK_RECEIVER), np.asarray(LINK_EMITTER)
-        out.append(_Rows("isr_range", np.repeat(np.arange(n), nl), np.tile(rec, n),
-                         np.tile(np.array([str(e) for e in emi], object), n), o.value.ravel(),
-                         o.visible.ravel(), d, np.tile(emi, n)))
-    return out
-
-
-def _order(t, types, sat, peer) -> np.ndarray:
-    """Row order: time, type (MEASUREMENT_TYPES order), satellite, peer."""
-    code = np.array([MEASUREMENT_TYPES.index(x) for x in types], np.int64)
-    return np.lexsort((np.asarray(peer, str), sat, code, t))
 
 
 def _measurements(scen, tracking: Tracking, t, states) -> tuple[Measurements, np.ndarray]:
     """The visible measurements on the grid (values computed from ``states``) and their
     computed values."""
-    rows = [x for x in _evaluate(scen, tracking, t, states, tracking.types) if x.visible.any()]
+    rows = [x for x in evaluate(scen, tracking, t, states, tracking.types) if x.visible.any()]
     for kind in tracking.kinds:
         if not any(x.type in KIND_TYPES[kind] for x in rows):
-            _fail(f"tracking.kinds: {kind!r} gives no visible measurement on the arc of {tracking.arc_s} s "
+            fail(f"tracking.kinds: {kind!r} gives no visible measurement on the arc of {tracking.arc_s} s "
                   f"of scenario {scen.name!r}")
     if tracking.stations is not None:
         seen = {p for x in rows if x.type in ("slr_range", "dsn_range") for p in x.peer[x.visible]}
@@ -375,13 +153,13 @@ def _measurements(scen, tracking: Tracking, t, states) -> tuple[Measurements, np
             if kind in tracking.kinds:
                 for s in tracking.station_names(kind):
                     if s not in seen:
-                        _fail(f"tracking.stations: {s!r} is below its elevation mask for the whole arc "
+                        fail(f"tracking.stations: {s!r} is below its elevation mask for the whole arc "
                               f"({tracking.arc_s} s) of every satellite; leave it out")
     cols = [np.concatenate(a) for a in zip(*[(t[x.t_idx][x.visible], np.full(x.visible.sum(), x.type, object),
                                                x.sat[x.visible], x.peer[x.visible], x.value[x.visible])
                                               for x in rows])]
     tt, ty, sat, peer, val = cols
-    k = _order(tt, ty, sat, peer)
+    k = row_order(tt, ty, sat, peer)
     sigma = np.array([tracking.sigma_of(x) for x in ty[k]])
     meas = Measurements(tt[k], ty[k].astype(str), sat[k].astype(np.int64), peer[k].astype(str),
                         np.full(k.size, np.nan), sigma)
@@ -415,57 +193,11 @@ def simulate(scenario, tracking: Tracking, truth: OrbitParameters | None = None,
     return meas
 
 
-# ---------------------------------------------------------------------------------------------
-# partials
-
-
-def _match(scen, tracking, t_grid, states, meas: Measurements):
-    """(rows index table): for each measurement, its computed value, partials and emitter."""
-    types = tuple(sorted(set(meas.type), key=MEASUREMENT_TYPES.index))
-    stations = {}
-    for kind, mtypes in (("slr", ("slr_range",)), ("dsn", ("dsn_range", "dsn_range_rate"))):
-        sel = np.isin(meas.type, mtypes)
-        if sel.any():
-            stations[kind] = list(dict.fromkeys(meas.peer[sel]))
-    rows = _evaluate(scen, tracking, t_grid, states, types, stations)
-    index = {}
-    for i, x in enumerate(rows):
-        for j, key in enumerate(zip(x.t_idx.tolist(), x.sat.tolist(), x.peer.tolist())):
-            index[(x.type,) + key] = (i, j)
-    ti = np.searchsorted(t_grid, meas.t - 1e-6)
-    m = len(meas)
-    value = np.empty(m)
-    d = np.empty((m, 2, 6))
-    sat2 = np.empty(m, np.int64)
-    for k, key in enumerate(zip(meas.type.tolist(), ti.tolist(), meas.sat.tolist(), meas.peer.tolist())):
-        try:
-            i, j = index[key]
-        except KeyError:
-            _fail(f"measurements: row {k} ({key[0]}, t = {meas.t[k]} s, sat {key[2]}, peer {key[3]!r}) "
-                  f"has no model; allowed: the rows of schedule()")
-        value[k], d[k], sat2[k] = rows[i].value[j], rows[i].d[j], rows[i].sat2[j]
-    return ti, value, d, sat2
-
-
-def _jacobian(scen, p: Partials, ti, d, sat, sat2) -> np.ndarray:
-    """H (m, 18 n_sat): rows d (m, 2, 6) chained with [Phi | Psi] of the full system."""
-    F = np.concatenate([p.stm_full, p.sensitivities_full], axis=2)     # (n_t, 6n, 18n)
-    H = np.zeros((ti.size, F.shape[2]))
-    six = np.arange(6)
-    for lo in range(0, ti.size, 4096):
-        s = slice(lo, lo + 4096)
-        H[s] = np.einsum("mk,mkp->mp", d[s, 0], F[ti[s, None], 6 * sat[s, None] + six])
-        two = np.flatnonzero(sat2[s] >= 0) + lo
-        if two.size:
-            H[two] += np.einsum("mk,mkp->mp", d[two, 1], F[ti[two, None], 6 * sat2[two, None] + six])
-    return H
-
-
 def _compute(scen, tracking, parameters, meas):
     t_grid = np.unique(meas.t)
     p = propagate_with_partials(scen, parameters, t_grid, step=_partials_step(scen, t_grid))
-    ti, h, d, sat2 = _match(scen, tracking, p.t, p.states, meas)
-    H = _jacobian(scen, p, ti, d, meas.sat, sat2)
+    ti, h, d, sat2 = match(scen, tracking, p.t, p.states, meas)
+    H = jacobian(scen, p, ti, d, meas.sat, sat2)
     return h, H, state_names(scen) + parameter_names(scen)
 
 
@@ -537,7 +269,7 @@ def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori
         if a_priori is not None:
             for k, n in enumerate(a_priori.names):
                 if n not in names:
-                    _fail(f"a_priori: parameter {n!r} is not allowed; allowed: {names[0]!r} ... {names[-1]!r}")
+                    fail(f"a_priori: parameter {n!r} is not allowed; allowed: {names[0]!r} ... {names[-1]!r}")
                 hit = np.flatnonzero(sel == names.index(n))
                 if hit.size:
                     values[hit] = a_priori.values[k]
@@ -558,8 +290,8 @@ def _problem(scen, meas: Measurements, tracking: Tracking, a_priori=None, partia
     def evaluate(q):
         par = _with_values(nominal, index, q)
         if partials is not None and np.array_equal(q, _values(nominal)[index]):
-            ti, h, d, sat2 = _match(scen, tracking, partials.t, partials.states, meas)
-            H = _jacobian(scen, partials, ti, d, meas.sat, sat2)
+            ti, h, d, sat2 = match(scen, tracking, partials.t, partials.states, meas)
+            H = jacobian(scen, partials, ti, d, meas.sat, sat2)
         else:
             h, H, _ = _compute(scen, tracking, par, meas)
         return T @ h, np.asarray(T @ H[:, index])
@@ -573,6 +305,7 @@ def _problem(scen, meas: Measurements, tracking: Tracking, a_priori=None, partia
             cache[key] = evaluate(q)
         return cache[key]
 
+    model.transform = T
     y = None if np.all(np.isnan(meas.value)) else T @ meas.value
     return estimator.Problem(model, est, y=y, sigma=sigma, consider=con, groups=labels)
 
@@ -583,22 +316,35 @@ def build_problem(scenario, meas: Measurements, tracking: Tracking, a_priori=Non
     ``tracking.a_priori_sigma`` and ``a_priori`` (an :class:`~tqdyn.od.estimator.Parameters` of
     some parameters: values and sigmas (n,) overriding them), GNSS clocks eliminated (module
     docstring), y None when every value is NaN (a schedule: covariance analysis), groups the
-    measurement types."""
+    measurement types.  ``problem.model.transform`` is the sparse (m', m) map of the measurement
+    rows onto the problem's rows; the model keeps its value at the a priori point, so that
+    :func:`with_measurements` problems share it."""
     scen = _scenario(scenario, tracking)
     return _problem(scen, meas, tracking, a_priori)
 
 
-def covariance(scenario, tracking: Tracking, a_priori=None) -> estimator.Covariance:
-    """Covariance analysis of the tracking plan (no data): one propagation with partials on
-    the plan's grid gives both the schedule and the Jacobian."""
+def with_measurements(problem: estimator.Problem, values) -> estimator.Problem:
+    """The problem of :func:`build_problem` with other measurement values (m,) [m or m/s] of the
+    same rows (e.g. another noise draw); the model, and its evaluation at the a priori point,
+    are shared."""
+    return dataclasses.replace(problem, y=problem.model.transform @ np.asarray(values, np.float64))
+
+
+def covariance(scenario, tracking: Tracking, a_priori=None, **options) -> estimator.Covariance:
+    """Covariance analysis of the tracking plan (no data; options of
+    :func:`tqdyn.od.estimator.covariance_analysis`): one propagation with partials on the plan's
+    grid gives both the schedule and the Jacobian."""
     scen = _scenario(scenario, tracking)
     t = tracking.times()
     p = propagate_with_partials(scen, None, t, step=_partials_step(scen, t))
     meas, _ = _measurements(scen, tracking, p.t, p.states)
-    return estimator.covariance_analysis(_problem(scen, meas, tracking, a_priori, partials=p))
+    return estimator.covariance_analysis(_problem(scen, meas, tracking, a_priori, partials=p), **options)
 
 
 def fit(scenario, meas: Measurements, tracking: Tracking, a_priori=None, **estimate_options) -> estimator.Estimate:
     """Batch least-squares estimate of the plan's parameters from measurements
     (:func:`tqdyn.od.estimator.estimate` with ``estimate_options``)."""
+    if len(meas) and np.all(np.isnan(meas.value)):
+        fail("measurements: every value is NaN (a schedule); simulate or read measurements, "
+             "or use covariance() for a prediction without data")
     return estimator.estimate(build_problem(scenario, meas, tracking, a_priori), **estimate_options)
