@@ -330,13 +330,26 @@ def with_measurements(problem: estimator.Problem, values) -> estimator.Problem:
     return dataclasses.replace(problem, y=problem.model.transform @ np.asarray(values, np.float64))
 
 
-def covariance(scenario, tracking: Tracking, a_priori=None, **options) -> estimator.Covariance:
+def covariance(scenario, tracking: Tracking, a_priori=None, partials: Partials | None = None,
+               **options) -> estimator.Covariance:
     """Covariance analysis of the tracking plan (no data; options of
     :func:`tqdyn.od.estimator.covariance_analysis`): one propagation with partials on the plan's
-    grid gives both the schedule and the Jacobian."""
+    grid gives both the schedule and the Jacobian.  partials: a
+    :func:`~tqdyn.od.variational.propagate_with_partials` of the scenario (its own parameter
+    values) on a grid holding the plan's times, to share one propagation between plans."""
     scen = _scenario(scenario, tracking)
     t = tracking.times()
-    p = propagate_with_partials(scen, None, t, step=_partials_step(scen, t))
+    if partials is None:
+        p = propagate_with_partials(scen, None, t, step=_partials_step(scen, t))
+    else:
+        k = np.searchsorted(partials.t, t - 1e-6)
+        if np.any(k >= partials.t.size) or np.any(np.abs(partials.t[np.minimum(k, partials.t.size - 1)] - t) > 1e-6):
+            fail(f"partials: the grid ({partials.t.size} times to {partials.t[-1]} s) does not hold the plan's "
+                 f"times (every {tracking.interval_s} s to {tracking.arc_s} s)")
+        p = dataclasses.replace(partials, t=partials.t[k], states=partials.states[k],
+                                states_dd=partials.states_dd[k], stm=partials.stm[k],
+                                sensitivities=partials.sensitivities[k], stm_full=partials.stm_full[k],
+                                sensitivities_full=partials.sensitivities_full[k])
     meas, _ = _measurements(scen, tracking, p.t, p.states)
     return estimator.covariance_analysis(_problem(scen, meas, tracking, a_priori, partials=p), **options)
 
