@@ -209,9 +209,9 @@ def compute(scenario, parameters: OrbitParameters | None, meas: Measurements, tr
     :func:`~tqdyn.od.parameters.parameter_names` of the scenario (every parameter; a problem
     selects its columns).  tracking: only its GNSS reception mode matters (default)."""
     scen = _scenario(scenario)
-    tracking = tracking or Tracking(tuple(sorted({k for k in TRACKING_KINDS for x in set(meas.type)
-                                                  if x in KIND_TYPES[k]})), max(float(meas.t.max()), 1.0),
-                                    max(float(meas.t.max()), 1.0))
+    if tracking is None:
+        kinds = tuple(k for k in TRACKING_KINDS if any(x in KIND_TYPES[k] for x in set(meas.type.tolist())))
+        tracking = Tracking(kinds or ("isr",), 1.0, 1.0)
     return _compute(scen, tracking, parameters, meas)
 
 
