@@ -208,3 +208,19 @@ def test_refusals(make, match):
     with pytest.raises(ValueError, match=match) as exc:
         make()
     assert "\n" not in str(exc.value)
+
+
+def test_consider_and_a_priori():
+    """Consider parameters and a priori sigmas reach the estimator: considering the RTN
+    constants (1e-11 m/s^2) can only widen the S-axis sigmas (P_c = P + S P_cc S^T), and a
+    tight a priori sigma (1e-15 m/s^2) on the S-frame constants bounds their sigmas by it."""
+    base = odp.Tracking(("slr",), DAY, 3600.0)
+    c0 = odp.covariance(SCEN, base)
+    cc = odp.covariance(SCEN, dataclasses.replace(base, consider=("rtn",), a_priori_sigma={"rtn": 1e-11}))
+    s = [k for k, n in enumerate(c0.names) if "/s_" in n]
+    assert cc.consider_names and len(cc.consider_names) == 9
+    assert np.allclose(cc.sigma, c0.sigma, rtol=1e-9)
+    assert np.all(cc.consider_sigma[s] >= c0.sigma[s] * (1 - 1e-9))
+    assert np.any(cc.consider_sigma[s] > 1.01 * c0.sigma[s])
+    ca = odp.covariance(SCEN, dataclasses.replace(base, a_priori_sigma={"s_frame": 1e-15}))
+    assert np.all(ca.sigma[s] <= 1e-15 * (1 + 1e-9))

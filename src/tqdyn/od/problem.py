@@ -75,17 +75,13 @@ def _scenario(scenario, tracking: Tracking | None = None):
     scen = load_scenario(scenario) if isinstance(scenario, str) else scenario
     if scen.constellation.pointing != "none":
         fail(f"scenario {scen.name!r}: constellation.pointing = {scen.constellation.pointing!r} is a coupled "
-              f"(attitude) run; orbit determination needs point-mass satellites (allowed: \"none\", "
+             f"(attitude) run; orbit determination needs point-mass satellites (allowed: \"none\", "
               f"e.g. tianqin-gravity, lisa-gravity, lisa-esa)")
     if scen.integrator.mode != "fixed":
         fail(f'scenario {scen.name!r}: integrator.mode = {scen.integrator.mode!r}; allowed: "fixed"')
     if tracking is None:
         return scen
-    if is_heliocentric(scen):
-        for k in tracking.kinds:
-            if k not in HELIOCENTRIC_KINDS:
-                fail(f"tracking.kinds: {k!r} is not allowed for the heliocentric scenario {scen.name!r}; "
-                      f"allowed: {', '.join(HELIOCENTRIC_KINDS)}")
+    _check_kinds(scen, tracking.kinds)
     if "isr" in tracking.kinds and len(scen.satellites) != 3:
         fail(f"tracking.kinds: 'isr' needs three satellites; scenario {scen.name!r} has {len(scen.satellites)}")
     step = float(scen.integrator.step_s)
@@ -95,9 +91,17 @@ def _scenario(scenario, tracking: Tracking | None = None):
     jd_end = scen.epoch.tdb[0] + scen.epoch.tdb[1] + (tracking.arc_s + 86400.0) / 86400.0
     if jd_end > eph.span_jd[1]:
         fail(f"tracking.arc_s: {tracking.arc_s} s from the epoch ends beyond the span of the ephemeris "
-              f"{eph.name} (JD {eph.span_jd[1]}, less one day for light times); allowed: at most "
+             f"{eph.name} (JD {eph.span_jd[1]}, less one day for light times); allowed: at most "
               f"{(eph.span_jd[1] - 1.0 - scen.epoch.tdb[0] - scen.epoch.tdb[1]) * 86400.0:.0f} s")
     return scen
+
+
+def _check_kinds(scen, kinds) -> None:
+    if is_heliocentric(scen):
+        for k in kinds:
+            if k not in HELIOCENTRIC_KINDS:
+                fail(f"tracking.kinds: {k!r} is not allowed for the heliocentric scenario {scen.name!r}; "
+                     f"allowed: {', '.join(HELIOCENTRIC_KINDS)}")
 
 
 def nominal_parameters(scenario) -> OrbitParameters:
@@ -146,7 +150,7 @@ def _measurements(scen, tracking: Tracking, t, states) -> tuple[Measurements, np
     for kind in tracking.kinds:
         if not any(x.type in KIND_TYPES[kind] for x in rows):
             fail(f"tracking.kinds: {kind!r} gives no visible measurement on the arc of {tracking.arc_s} s "
-                  f"of scenario {scen.name!r}")
+                 f"of scenario {scen.name!r}")
     if tracking.stations is not None:
         seen = {p for x in rows if x.type in ("slr_range", "dsn_range") for p in x.peer[x.visible]}
         for kind in ("slr", "dsn"):
@@ -154,7 +158,7 @@ def _measurements(scen, tracking: Tracking, t, states) -> tuple[Measurements, np
                 for s in tracking.station_names(kind):
                     if s not in seen:
                         fail(f"tracking.stations: {s!r} is below its elevation mask for the whole arc "
-                              f"({tracking.arc_s} s) of every satellite; leave it out")
+                             f"({tracking.arc_s} s) of every satellite; leave it out")
     cols = [np.concatenate(a) for a in zip(*[(t[x.t_idx][x.visible], np.full(x.visible.sum(), x.type, object),
                                                x.sat[x.visible], x.peer[x.visible], x.value[x.visible])
                                               for x in rows])]
@@ -212,6 +216,7 @@ def compute(scenario, parameters: OrbitParameters | None, meas: Measurements, tr
     if tracking is None:
         kinds = tuple(k for k in TRACKING_KINDS if any(x in KIND_TYPES[k] for x in set(meas.type.tolist())))
         tracking = Tracking(kinds or ("isr",), 1.0, 1.0)
+    _check_kinds(scen, tracking.kinds)
     return _compute(scen, tracking, parameters, meas)
 
 

@@ -103,7 +103,7 @@ class Tracking:
             vals = np.atleast_1d(np.asarray(v, np.float64))
             if vals.shape != ((2,) if g == "state" else (1,)) or not np.all(vals > 0):
                 fail(f"tracking.a_priori_sigma[{g!r}] = {v!r}; allowed: "
-                      + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else "a number > 0 (m/s^2)"))
+                     + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else "a number > 0 (m/s^2)"))
         for g in self.consider:
             if g not in (self.a_priori_sigma or {}):
                 fail(f"tracking.consider: {g!r} has no a priori sigma; give tracking.a_priori_sigma[{g!r}]")
@@ -112,7 +112,7 @@ class Tracking:
             for s in st:
                 if s not in ILRS_STATIONS and s not in DEEP_SPACE_STATIONS:
                     fail(f"tracking.stations: {s!r} is not allowed; allowed: SLR "
-                          f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
+                         f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
             object.__setattr__(self, "stations", st)
 
     @property
@@ -137,7 +137,7 @@ class Tracking:
         names = [s for s in self.stations if s in cat]
         if not names:
             fail(f"tracking.stations: none of {list(self.stations)} is a{'n SLR' if kind == 'slr' else ' deep-space'} "
-                  f"station (tracking kind {kind!r}); allowed: {', '.join(cat)}")
+                 f"station (tracking kind {kind!r}); allowed: {', '.join(cat)}")
         return names
 
 
@@ -262,7 +262,7 @@ def match(scen, tracking, t_grid, states, meas: Measurements):
             i, j = index[key]
         except KeyError:
             fail(f"measurements: row {k} ({key[0]}, t = {meas.t[k]} s, sat {key[2]}, peer {key[3]!r}) "
-                  f"has no model; allowed: the rows of schedule()")
+                 f"has no model; allowed: the rows of schedule()")
         value[k], d[k], sat2[k] = rows[i].value[j], rows[i].d[j], rows[i].sat2[j]
     return ti, value, d, sat2
 
