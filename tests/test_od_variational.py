@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from tqdyn.dynamics.empirical import PARAMETER_NAMES
-from tqdyn.od.parameters import Parameters, parameter_names
+from tqdyn.od.parameters import OrbitParameters, parameter_names
 from tqdyn.od.variational import propagate_dd, propagate_with_partials
 from tqdyn.scenario import ScenarioError, load_scenario
 
@@ -94,7 +94,7 @@ def _fd(scen, t_out, column, delta):
     y0 = y[0]
     out = []
     for sign in (1.0, -1.0):
-        par = Parameters()
+        par = OrbitParameters()
         if column < 6:
             yp = y0.copy()
             yp[:, column, 0] += sign * delta
@@ -172,7 +172,7 @@ def test_partials_against_finite_differences_tianqin_10d(record_number):
 
 
 def test_parameters_from_scenario_keys_and_python_agree():
-    """[accelerations] keys and Parameters.accelerations give the same dd run; zero keys
+    """[accelerations] keys and OrbitParameters.accelerations give the same dd run; zero keys
     write nothing into the resolved scenario."""
     base = load_scenario("tianqin-kepler", ["run.duration=6h", "integrator.step=600"])
     assert "[accelerations]" not in base.to_toml()
@@ -184,7 +184,7 @@ def test_parameters_from_scenario_keys_and_python_agree():
     acc[0, 4] = 1e-9
     acc[1, 0] = 2e-9
     _, a = propagate_dd(keyed, None, [6 * 3600.0])
-    _, b = propagate_dd(base, Parameters(accelerations=acc), [6 * 3600.0])
+    _, b = propagate_dd(base, OrbitParameters(accelerations=acc), [6 * 3600.0])
     _, c = propagate_dd(base, None, [6 * 3600.0])
     assert np.array_equal(a, b)
     # the along-track displacement of satellite 1 ~ -3/2 a t^2 ~ 0.7 m; satellite 3 untouched
@@ -227,8 +227,8 @@ def test_coupled_partials_lisa_esa(record_number):
     acc = np.zeros((3, 12))
     acc[:, 0] = 1e-9
     t_out = np.array([5.0, 10.0]) * DAY
-    p = propagate_with_partials(scen, Parameters(accelerations=acc), t_out)
-    y0 = propagate_dd(scen, Parameters(accelerations=acc), [0.0])[1][0]
+    p = propagate_with_partials(scen, OrbitParameters(accelerations=acc), t_out)
+    y0 = propagate_dd(scen, OrbitParameters(accelerations=acc), [0.0])[1][0]
     out = {}
     # larger steps than above: the ramp's direction is float64 in the dd runs too (~1e-25 m/s^2
     # noise, ~1e-13 m in 10 days), and the other satellites' responses are only ~1e-7 of the
@@ -236,7 +236,7 @@ def test_coupled_partials_lisa_esa(record_number):
     for name, delta in (("x", 1000.0), ("s_x", 1e-7)):
         ys = []
         for sign in (1.0, -1.0):
-            par = Parameters(accelerations=acc.copy())
+            par = OrbitParameters(accelerations=acc.copy())
             if name == "x":
                 yp = y0.copy()
                 yp[0, 0, 0] += sign * delta

@@ -43,6 +43,13 @@ for f in tianqin-tm-acceleration lisa-tm-acceleration taiji-tm-acceleration tian
     cp "$WORK/closed-loop/closed-loop/$f.png" "docs/figures/closed-loop-$f.png"
 done
 
+# the covariance study of orbit determination (docs/orbit-determination.md; about a minute)
+if [ $QUICK = 1 ]; then
+    python tools/od_study.py --quick --out "$DATA/od-study.json" --figure docs/figures/od-study.png
+else
+    python tools/od_study.py --out "$DATA/od-study.json" --figure docs/figures/od-study.png
+fi
+
 # 3. the pages from the new benchmark and study records (so that the suite's page checks pass)
 python tools/render_docs.py
 

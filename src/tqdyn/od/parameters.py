@@ -1,7 +1,7 @@
 """The parameters of an orbit determination: the satellites' initial states and their
 acceleration parameters (:mod:`tqdyn.dynamics.empirical`).
 
-A :class:`Parameters` holds values; :func:`parameter_names` and :func:`state_names` spell
+An :class:`OrbitParameters` holds values; :func:`parameter_names` and :func:`state_names` spell
 the names ``"<satellite>/<name>"`` used by the partials of :mod:`.variational` (state
 components x, y, z [m], vx, vy, vz [m/s] at the epoch, in the run's frame; accelerations
 s_x ... sin_n [m/s^2], :data:`~tqdyn.dynamics.empirical.PARAMETER_NAMES`).
@@ -18,7 +18,7 @@ import numpy as np
 from ..dynamics.empirical import N_PAR, PARAMETER_NAMES
 from ..scenario.accelerations import AccelerationsConfig
 
-__all__ = ["N_PAR", "PARAMETER_NAMES", "STATE_NAMES", "Parameters", "parameter_names", "scenario_with",
+__all__ = ["N_PAR", "PARAMETER_NAMES", "STATE_NAMES", "OrbitParameters", "parameter_names", "scenario_with",
            "state_names"]
 
 #: Names of the six initial-state components of a satellite.
@@ -26,7 +26,7 @@ STATE_NAMES = ("x", "y", "z", "vx", "vy", "vz")
 
 
 @dataclass
-class Parameters:
+class OrbitParameters:
     """Values of the estimated parameters of a scenario's n_sat satellites.
 
     accelerations : (n_sat, N_PAR) float64 [m/s^2], columns :data:`PARAMETER_NAMES`

@@ -4,7 +4,7 @@ derivatives with respect to the initial states and the acceleration parameters.
 Interface (what an estimator calls in its Gauss-Newton loop)
 ------------------------------------------------------------
 ``propagate_with_partials(scenario, parameters, t_out)`` -> :class:`Partials`: given
-parameter values (:class:`~tqdyn.od.parameters.Parameters`: initial states and the
+parameter values (:class:`~tqdyn.od.parameters.OrbitParameters`: initial states and the
 (n_sat, 12) acceleration parameters; None = the scenario's), the double-double propagation
 of the scenario with those values and, integrated beside it in float64, the state transition
 matrix and the sensitivities, at the requested times:
@@ -61,7 +61,7 @@ from ..dynamics import layout as _lay
 from ..forces.model import build_force_model
 from ..numerics import dp87
 from ..scenario import load_scenario
-from .parameters import Parameters, parameter_names, scenario_with, state_names
+from .parameters import OrbitParameters, parameter_names, scenario_with, state_names
 
 __all__ = ["Partials", "propagate_dd", "propagate_with_partials"]
 
@@ -108,7 +108,7 @@ def _grid(t_out, step: float, name: str) -> np.ndarray:
     return k.astype(np.int64)
 
 
-def propagate_dd(scenario, parameters: Parameters | None = None, t_out=None):
+def propagate_dd(scenario, parameters: OrbitParameters | None = None, t_out=None):
     """The scenario's double-double propagation with the parameter values, sampled at t_out
     [s since the epoch] (default: every step of the scenario's run).  Returns (t (n,),
     states_dd (n, n_sat, 6, 2) [m, m/s, the run's frame])."""
@@ -120,7 +120,7 @@ def propagate_dd(scenario, parameters: Parameters | None = None, t_out=None):
         t_out = np.arange(scen.n_steps + 1) * step
     idx = _grid(t_out, step, "integrator.step")
     n_end = max(int(idx.max()), 1)
-    par = parameters or Parameters()
+    par = parameters or OrbitParameters()
     scen = scenario_with(scen, par.accelerations, n_end * step)
     scen = _with_every_step(scen)
     blocks = []
@@ -138,12 +138,12 @@ def _with_every_step(scen):
     return dataclasses.replace(scen, run=dataclasses.replace(scen.run, output_every=1))
 
 
-def propagate_with_partials(scenario, parameters: Parameters | None = None, t_out=None,
+def propagate_with_partials(scenario, parameters: OrbitParameters | None = None, t_out=None,
                             step: float | None = None) -> Partials:
     """States (dd propagation) and partials (float64 variational equations) at t_out
     [s since the epoch] of a point-mass scenario; see the module docstring."""
     scen = _load(scenario)
-    par = parameters or Parameters()
+    par = parameters or OrbitParameters()
     t, y_dd = propagate_dd(scen, par, t_out)
     run_step = float(scen.integrator.step_s)
     h = run_step if step is None else float(step)
