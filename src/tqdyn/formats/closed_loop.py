@@ -34,7 +34,7 @@ from .._version import __version__ as _TQDYN_VERSION
 from ..closedloop.simulate import Block, Sink
 from .trajectory import OutputError, OutputIOError, check_writable
 from .trajectory._h5safe import _cleanup, _close_h5, _io_reason
-from .trajectory.reader import DAMAGED, damaged_message, open_for_reading
+from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError", "ClosedLoopWriter",
            "ROOT_ATTRS", "read_closed_loop"]
@@ -76,13 +76,6 @@ class ClosedLoopFormatError(ValueError):
     """A file that is not a readable closed-loop file: one line naming the file and what was found."""
 
 
-def _text(a) -> np.ndarray:
-    """A string array as fixed-length UTF-8 bytes (HDF5 filters need fixed-size elements)."""
-    enc = [str(x).encode("utf-8") for x in np.asarray(a).ravel()]
-    width = max([len(e) for e in enc] + [1])
-    return np.array(enc, dtype=f"S{width}").reshape(np.shape(a))
-
-
 def _chunks(shape) -> tuple | None:
     return tuple(max(1, min(int(n), 65536)) for n in shape) if all(int(n) > 0 for n in shape) and shape else None
 
@@ -90,7 +83,7 @@ def _chunks(shape) -> tuple | None:
 def _put(group, name: str, value, dims=(), attrs=None):
     arr = np.asarray(value)
     if arr.dtype.kind in "USO":
-        arr = _text(arr)
+        arr = text_array(arr)
     ch = _chunks(arr.shape)
     ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None)
     ds.attrs["dims"] = ",".join(dims)
@@ -257,25 +250,8 @@ class ClosedLoopWriter(Sink):
 # ---------------------------------------------------------------------------
 
 
-def _native(v):
-    if isinstance(v, bytes):
-        return v.decode("utf-8")
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
 def _values(ds, fname: str, sel=()):
-    try:
-        raw = ds[sel] if sel != () else ds[()]
-    except OSError as exc:
-        low = str(exc).lower()
-        what = ("fails its Fletcher-32 checksum: the file is corrupted" if ("checksum" in low or "fletcher" in low
-                or "filter" in low) else "cannot be read, the file is damaged")
-        raise ClosedLoopFormatError(f"{fname}: dataset {ds.name!r} {what}; re-create it (tqdyn closed-loop)") from None
-    if ds.attrs.get("kind") == "text":
-        return np.char.decode(np.asarray(raw), "utf-8")
-    return raw
+    return read_dataset(ds, fname, ClosedLoopFormatError, "tqdyn closed-loop", sel)
 
 
 class ClosedLoopFile:
@@ -305,7 +281,7 @@ class ClosedLoopFile:
         fname = str(self.path)
         with self._open() as h5:
             g = h5["timeseries"]
-            names = json.loads(_native(g.attrs["outputs"]))
+            names = json.loads(native_attr(g.attrs["outputs"]))
             if outputs is not None:
                 bad = [o for o in outputs if o not in names]
                 if bad:
@@ -316,8 +292,8 @@ class ClosedLoopFile:
             t = _values(g["t"], fname, sel)
             vals = np.stack([_values(g[o], fname, sel) for o in names], axis=-1) if names else \
                 np.zeros((len(t), 0, 0))
-            units = [_native(g[o].attrs.get("units", "")) for o in names]
-            frames = [_native(g[o].attrs.get("frame", "")) for o in names]
+            units = [native_attr(g[o].attrs.get("units", "")) for o in names]
+            frames = [native_attr(g[o].attrs.get("frame", "")) for o in names]
         sat_names = json.loads(self.attrs.get("satellite_names", "[]"))
         return xr.Dataset({"values": (("time", "sat", "output"), vals)},
                           coords={"time": t, "sat": np.arange(1, vals.shape[1] + 1), "sat_name": ("sat", sat_names),
@@ -332,14 +308,15 @@ def _read_budget(h5, fname: str):
 
     g = h5["budget"]
     coords, data = {}, {}
-    order = json.loads(_native(g.attrs.get("coordinates", "[]"))) + json.loads(_native(g.attrs.get("variables", "[]")))
+    order = (json.loads(native_attr(g.attrs.get("coordinates", "[]")))
+             + json.loads(native_attr(g.attrs.get("variables", "[]"))))
     for name in order + sorted(k for k in g if k not in order):
         ds = g[name]
-        dims = tuple(d for d in _native(ds.attrs.get("dims", "")).split(",") if d)
-        attrs = {k: _native(v) for k, v in ds.attrs.items() if k not in ("dims", "kind", "role")}
+        dims = tuple(d for d in native_attr(ds.attrs.get("dims", "")).split(",") if d)
+        attrs = {k: native_attr(v) for k, v in ds.attrs.items() if k not in ("dims", "kind", "role")}
         var = xr.Variable(dims, _values(ds, fname), attrs=attrs)
-        (coords if _native(ds.attrs.get("role")) == "coord" else data)[name] = var
-    return xr.Dataset(data, coords=coords, attrs={k: _native(v) for k, v in g.attrs.items()
+        (coords if native_attr(ds.attrs.get("role")) == "coord" else data)[name] = var
+    return xr.Dataset(data, coords=coords, attrs={k: native_attr(v) for k, v in g.attrs.items()
                                                   if k not in ("variables", "coordinates")})
 
 
@@ -351,7 +328,7 @@ def read_closed_loop(path) -> ClosedLoopFile:
     p, fname, h5 = open_for_reading(path, "closed-loop file", ClosedLoopFormatError)
     try:
         with h5:
-            attrs = {k: _native(v) for k, v in h5.attrs.items()}
+            attrs = {k: native_attr(v) for k, v in h5.attrs.items()}
             fmt, ver = attrs.get("format"), attrs.get("format_version")
             if fmt != FORMAT:
                 raise ClosedLoopFormatError(

@@ -32,7 +32,7 @@ import numpy as np
 from .._version import __version__ as _TQDYN_VERSION
 from .atomic import replacing
 from .trajectory import check_writable
-from .trajectory.reader import DAMAGED, damaged_message, open_for_reading
+from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ROOT_ATTRS", "EstimateFile", "EstimateFormatError", "read_estimate_file",
            "write_estimate_file"]
@@ -109,16 +109,10 @@ class EstimateFile:
         return float(self.parameters["sigma"][list(self.parameters["names"]).index(name)])
 
 
-def _text(a) -> np.ndarray:
-    enc = [str(x).encode("utf-8") for x in np.asarray(a, dtype=object).ravel()]
-    width = max([len(e) for e in enc] + [1])
-    return np.array(enc, dtype=f"S{width}").reshape(np.shape(a))
-
-
 def _put(group, name: str, value, units: str, description: str):
     arr = np.asarray(value)
     if arr.dtype.kind in "USO":
-        arr = _text(arr)
+        arr = text_array(arr)
     chunked = arr.ndim > 0 and arr.size > 0
     ds = group.create_dataset(name, data=arr, chunks=arr.shape if chunked else None, fletcher32=chunked)
     ds.attrs["units"] = units
@@ -167,25 +161,8 @@ def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None
     return out
 
 
-def _native(v):
-    if isinstance(v, bytes):
-        return v.decode("utf-8")
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
 def _read(ds, fname: str):
-    try:
-        raw = ds[()]
-    except OSError as exc:
-        low = str(exc).lower()
-        what = ("fails its Fletcher-32 checksum: the file is corrupted" if ("checksum" in low or "fletcher" in low
-                or "filter" in low) else "cannot be read, the file is damaged")
-        raise EstimateFormatError(f"{fname}: dataset {ds.name!r} {what}; re-create it (tqdyn od fit)") from None
-    if ds.attrs.get("kind") == "text":
-        return np.char.decode(np.asarray(raw), "utf-8")
-    return raw
+    return read_dataset(ds, fname, EstimateFormatError, "tqdyn od fit")
 
 
 def read_estimate_file(path) -> EstimateFile:
@@ -195,7 +172,7 @@ def read_estimate_file(path) -> EstimateFile:
     p, fname, h5 = open_for_reading(path, "estimate file", EstimateFormatError)
     try:
         with h5:
-            attrs = {k: _native(v) for k, v in h5.attrs.items()}
+            attrs = {k: native_attr(v) for k, v in h5.attrs.items()}
             fmt, ver = attrs.get("format"), attrs.get("format_version")
             if fmt != FORMAT:
                 raise EstimateFormatError(f"{fname}: format = {fmt!r}; expected format {FORMAT!r} with "

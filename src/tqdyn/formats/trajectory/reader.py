@@ -16,7 +16,8 @@ from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, Ref
 from .schema import (_COORDS, FIELDS, FORMAT, FORMAT_VERSION, TrajectoryFormatError, _check_attrs, _fmt_shape, _spec,
                      _symbolic, dataset_attrs, parse_vectors, row_fields)
 
-__all__ = ["DAMAGED", "SpacecraftRecord", "Trajectory", "damaged_message", "is_trajectory_file", "open_for_reading",
+__all__ = ["DAMAGED", "SpacecraftRecord", "Trajectory", "damaged_message", "is_trajectory_file", "native_attr",
+           "open_for_reading", "read_dataset", "text_array",
            "read_attributes", "read_trajectory", "run_is_complete"]
 
 
@@ -115,12 +116,37 @@ def _frozen(a) -> np.ndarray:
     return out
 
 
-def _native_attr(value):
+def native_attr(value):
+    """An HDF5 attribute value as a Python value: bytes decoded as UTF-8, numpy scalars as Python scalars."""
     if isinstance(value, bytes):
         return value.decode("utf-8", "replace")
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+def text_array(a) -> np.ndarray:
+    """A string array as fixed-length UTF-8 bytes (HDF5 filters need fixed-size elements); same shape."""
+    enc = [str(x).encode("utf-8") for x in np.asarray(a, dtype=object).ravel()]
+    width = max([len(e) for e in enc] + [1])
+    return np.array(enc, dtype=f"S{width}").reshape(np.shape(a))
+
+
+def read_dataset(ds, fname: str, error: type, remedy: str, sel=()):
+    """The values of the HDF5 dataset ``ds`` (``sel`` a selection, or all) of file ``fname``; text
+    datasets (attribute ``kind = "text"``) decoded to str.  A dataset that fails its Fletcher-32 checksum
+    or cannot be read raises ``error`` (one line naming the file, the dataset and ``remedy``, the command
+    that re-creates it)."""
+    try:
+        raw = ds[sel] if sel != () else ds[()]
+    except OSError as exc:
+        low = str(exc).lower()
+        what = ("fails its Fletcher-32 checksum: the file is corrupted" if ("checksum" in low or "fletcher" in low
+                or "filter" in low) else "cannot be read, the file is damaged")
+        raise error(f"{fname}: dataset {ds.name!r} {what}; re-create it ({remedy})") from None
+    if ds.attrs.get("kind") == "text":
+        return np.char.decode(np.asarray(raw), "utf-8")
+    return raw
 
 
 class Trajectory:
@@ -440,7 +466,7 @@ def read_attributes(path) -> dict:
 
 def _checked_attrs(h5, fname) -> dict:
     """The root attributes of an open file, after the format and version checks."""
-    attrs = {k: _native_attr(v) for k, v in h5.attrs.items()}
+    attrs = {k: native_attr(v) for k, v in h5.attrs.items()}
     fmt = attrs.get("format")
     ver = attrs.get("format_version")
     if fmt != FORMAT:
