@@ -115,5 +115,10 @@ def covariance(scenario, tracking):
     return covariance_analysis(build_problem(scenario, schedule(scenario, tracking), tracking))
 
 
+def residual_rows(meas) -> np.ndarray:
+    """The fit's rows are the measurement rows (no clock elimination)."""
+    return np.arange(len(meas.t), dtype=np.int64)
+
+
 def fit(scenario, meas, tracking, **estimate_options):
     return estimate(build_problem(scenario, meas, tracking), **estimate_options)
