@@ -148,6 +148,7 @@ def plot_od_residuals(est, path, title: str | None = None) -> ResidualFigure:
     grid = np.linspace(-HIST_LIMIT, HIST_LIMIT, 401)
     ah.plot(grid, zk.size * _BIN * np.exp(-0.5 * grid ** 2) / math.sqrt(2 * math.pi), color="k", lw=1.2,
             label="unit normal")
+    ah.set_ylim(0, 1.3 * max(float(np.max(counts)) if counts.size else 0.0, zk.size * _BIN / math.sqrt(2 * math.pi)))
     ah.set_xlabel(f"normalised residual [1] (beyond +-{HIST_LIMIT:g}: outer bins)", fontsize=8)
     ah.set_ylabel(f"rows per {_BIN:g} bin", fontsize=8)
     ah.tick_params(labelsize=7)
