@@ -1,6 +1,7 @@
 """A stand-in for ``tqdyn.od.problem`` with its interface (Tracking, Measurements, schedule, compute,
-simulate, build_problem, covariance, fit) and a linear model, for the tests of the orbit-determination
-files and command line (tests/test_od_files.py, tests/test_od_cli.py).
+simulate, build_problem, covariance, fit, residual_rows) and a linear model, for the tests of the
+orbit-determination files, command line and figure (tests/test_od_files.py, tests/test_od_cli.py,
+tests/test_od_figure.py).
 
 Model: per satellite k (scenario name S) two parameters, ``S/x`` [m] and ``S/s_x`` [m/s^2]; a range
 of satellite k at time t is h = x + s_x t^2 / 2 [m], a range rate h = s_x t [m/s].  Truth: x = 1 m,
@@ -113,6 +114,11 @@ def build_problem(scenario, meas, tracking, a_priori=None) -> Problem:
 
 def covariance(scenario, tracking):
     return covariance_analysis(build_problem(scenario, schedule(scenario, tracking), tracking))
+
+
+def residual_rows(meas) -> np.ndarray:
+    """The fit's rows are the measurement rows (no clock elimination)."""
+    return np.arange(len(meas.t), dtype=np.int64)
 
 
 def fit(scenario, meas, tracking, **estimate_options):

@@ -49,6 +49,8 @@ if [ $QUICK = 1 ]; then
 else
     python tools/od_study.py --out "$DATA/od-study.json" --figure docs/figures/od-study.png
 fi
+# its worked example with the residuals' figure (about a minute)
+python tools/od_residuals.py --out "$DATA/od-residuals.json" --figure docs/figures/od-residuals.png
 
 # 3. the pages from the new benchmark and study records (so that the suite's page checks pass)
 python tools/render_docs.py

@@ -13,7 +13,7 @@ The front door (:mod:`tqdyn.api`)::
 :func:`range_asd`, :func:`requirement_asd`, :func:`breathing_angles`, the closed loop
 (:func:`closed_loop_model`, :func:`closed_loop_budget`, :func:`closed_loop_timeseries`,
 :func:`read_closed_loop`), orbit determination (:func:`od_simulate`, :func:`od_fit`,
-:func:`od_covariance`, :func:`read_od_estimate`) and the
+:func:`od_covariance`, :func:`read_od_estimate`, :func:`plot_od_residuals`) and the
 classes :class:`Scenario`, :class:`Trajectory`, :class:`LightTravelTimes`.
 They are imported on first use, so ``import tqdyn`` stays cheap.
 """
@@ -23,7 +23,8 @@ from ._version import __version__
 __all__ = ["__version__", "LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory",
            "breathing_angles", "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
            "light_travel_times", "load_scenario", "od_covariance", "od_fit", "od_simulate", "open_trajectory",
-           "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd", "run"]
+           "plot_od_residuals", "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd",
+           "run"]
 
 
 def __getattr__(name):

@@ -37,7 +37,8 @@ from .workflows.run import RunSummary, load_run_scenario, output_attrs, run_to_f
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
            "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
            "light_travel_times", "load_scenario", "od_covariance", "od_fit", "od_simulate", "open_trajectory",
-           "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd", "run"]
+           "plot_od_residuals", "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd",
+           "run"]
 
 
 def _overrides(overrides) -> list[str]:
@@ -229,14 +230,15 @@ def od_simulate(run_file, tracking, arc, *, output, seed: int = 0, interval=None
 
 
 def od_fit(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma: float | None = None,
-           overrides: Mapping[str, object] | Sequence[str] = (), **options):
+           overrides: Mapping[str, object] | Sequence[str] = (), figure=None, **options):
     """Fit a scenario (a name, a TOML path or a run file) to the measurements of the TDM ``tdm``, as
-    ``tqdyn od fit`` (``output``: the estimate file, None: none); returns the
-    :class:`tqdyn.od.estimator.Estimate` (:func:`tqdyn.workflows.od.fit_to_file`)."""
+    ``tqdyn od fit`` (``output``: the estimate file, None: none; ``figure``: the residuals' figure,
+    ``.png`` or ``.pdf``, None: none); returns the :class:`tqdyn.od.estimator.Estimate`
+    (:func:`tqdyn.workflows.od.fit_to_file`)."""
     from .workflows.od import fit_to_file
 
     return fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider, edit_sigma=edit_sigma,
-                       overrides=_overrides(overrides), **options)[0]
+                       overrides=_overrides(overrides), figure=figure, **options)[0]
 
 
 def od_covariance(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, stations=None,
@@ -256,3 +258,13 @@ def read_od_estimate(path):
     from .formats.od_estimate import read_estimate_file
 
     return read_estimate_file(path)
+
+
+def plot_od_residuals(estimate, path, title: str | None = None):
+    """Draw the normalised post-fit residuals of an estimate file (its path, or what
+    :func:`read_od_estimate` returned) against time per measurement type and satellite, and their
+    histogram against the unit normal, into ``path`` (``.png`` or ``.pdf``), as ``tqdyn od fit
+    --figure``; returns what was drawn (:class:`tqdyn.analysis.figures_od.ResidualFigure`)."""
+    from .analysis.figures_od import plot_od_residuals as plot
+
+    return plot(estimate if hasattr(estimate, "measurements") else read_od_estimate(estimate), path, title=title)

@@ -97,38 +97,38 @@ def figure_extensions() -> tuple[str, ...]:
     return tuple(sorted(FigureCanvasBase.get_supported_filetypes()))
 
 
-def check_figure_path(path) -> str:
+def check_figure_path(path, option: str = "--plot", formats: Sequence[str] | None = None) -> str:
     """Check, before any work, that a figure can be written at ``path``; returns
     its format (the extension, lower case).
 
-    Raises ValueError ``"--plot: <path> <problem>; allowed: <what>"`` when the
-    extension is missing or not one of :func:`figure_extensions`, the path is a
+    Raises ValueError ``"<option>: <path> <problem>; allowed: <what>"`` when the
+    extension is missing or not one of ``formats`` (default :func:`figure_extensions`), the path is a
     directory, or its directory is missing, not a directory or not writable
     (tried by creating and removing a temporary file in it); ImportError when
     matplotlib is missing.
     """
     shown = repr(str(path))
     path = Path(path)
-    allowed = figure_extensions()
+    allowed = tuple(formats) if formats is not None else figure_extensions()
     ext = path.suffix[1:].lower()
     if str(path) in ("", ".") or path.is_dir():
-        raise ValueError(f"--plot: {shown} is a directory, not a file name; allowed: a file name ending in "
+        raise ValueError(f"{option}: {shown} is a directory, not a file name; allowed: a file name ending in "
                          + ", ".join(f".{e}" for e in allowed))
     if ext not in allowed:
         problem = "has no file extension" if not ext else f"has an unsupported extension .{path.suffix[1:]}"
-        raise ValueError(f"--plot: {shown} {problem}; allowed: a file name ending in "
+        raise ValueError(f"{option}: {shown} {problem}; allowed: a file name ending in "
                          + ", ".join(f".{e}" for e in allowed))
     parent = path.parent
     if not parent.exists():
-        raise ValueError(f"--plot: {shown} is in a directory that does not exist ({str(parent)!r}); "
+        raise ValueError(f"{option}: {shown} is in a directory that does not exist ({str(parent)!r}); "
                          "allowed: a file in an existing, writable directory")
     if not parent.is_dir():
-        raise ValueError(f"--plot: {shown} is in {str(parent)!r}, which is not a directory; "
+        raise ValueError(f"{option}: {shown} is in {str(parent)!r}, which is not a directory; "
                          "allowed: a file in an existing, writable directory")
     try:
         fd, probe = _open_temporary(path)
     except OSError as exc:
-        raise ValueError(f"--plot: {shown} cannot be written in {str(parent)!r} ({exc.strerror or exc}); "
+        raise ValueError(f"{option}: {shown} cannot be written in {str(parent)!r} ({exc.strerror or exc}); "
                          "allowed: a file in an existing, writable directory") from None
     os.close(fd)
     os.unlink(probe)

@@ -2,8 +2,8 @@
 
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.od`: bad input (an unknown
 tracking type, an arc outside the run, a malformed TDM, a station below the horizon for the whole
-arc, an output path that is an input, an unobservable fit) exits with status 2 and one line, nothing
-written; Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages
+arc, an output path that is an input, an unobservable fit, a ``--figure`` that is not a writable
+``.png`` or ``.pdf``) exits with status 2 and one line, nothing written; Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages
 show as a progress bar on stderr (``--quiet``: none).
 """
 
@@ -119,16 +119,18 @@ def simulate(run_file, tracking, arc, seed, interval, stations, output, sets, qu
 @click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame].")
 @click.option("--consider", help="Parameter groups to consider (not estimated, their uncertainty kept).")
 @click.option("--edit-sigma", type=float, help="Leave out measurements beyond K normalised sigmas (off by default).")
+@click.option("--figure", help="Also draw the normalised post-fit residuals and their histogram (.png or .pdf).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def fit(scenario, tdm, output, estimate, consider, edit_sigma, sets, quiet):
+def fit(scenario, tdm, output, estimate, consider, edit_sigma, figure, sets, quiet):
     """Fit SCENARIO (a built-in name, a TOML file or a run file) to the measurements MEAS.tdm by batch
     least squares; print each estimated parameter with its 1-sigma, and chi^2/dof."""
     from ..workflows import od as wf
 
-    stages = _Stages(("reading", "fitting", "writing"), quiet, "od fit")
+    stages = _Stages(("reading", "fitting", "writing") + (("plotting",) if figure else ()), quiet, "od fit")
     est, _, notes = _run(lambda: wf.fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider,
-                                                edit_sigma=edit_sigma, overrides=sets, progress=stages), stages)
+                                                edit_sigma=edit_sigma, overrides=sets, figure=figure,
+                                                progress=stages), stages)
     _notes(notes)
     units = [wf.parameter_unit(n) for n in est.names]
     click.echo("\n".join(summary_lines(est.names, est.values, est.sigma, units,
@@ -138,6 +140,8 @@ def fit(scenario, tdm, output, estimate, consider, edit_sigma, sets, quiet):
                f"(p = {est.chi2_pvalue:.3g}); {m - int(sum(est.edited))} of {m} measurements kept, "
                f"{est.iterations} iterations, condition number {est.condition_number:.3g}")
     click.echo(f"output: {output}")
+    if figure:
+        click.echo(f"figure: {figure}")
 
 
 @od.command("covariance")

@@ -10,9 +10,12 @@ One file holds one batch least-squares fit (``tqdyn od fit SCENARIO MEAS.tdm --o
   ``covariance``, ``correlation``, and the consider parameters' ``consider_names``, the sensitivity
   matrix ``sensitivity``, ``consider_covariance`` and ``consider_sigma``
   (:class:`tqdyn.od.estimator.Estimate`);
-* ``/measurements``: one row per measurement -- ``t`` [s since the scenario epoch, the run's time
-  scale], ``type``, ``sat``, ``peer``, ``value`` and ``sigma`` [m or m/s], the post-fit ``residual``
-  [m or m/s], the ``normalised_residual`` and the ``edited`` mask (1 = left out of the fit).
+* ``/measurements``: one row per measurement (m,) -- ``t`` [s since the scenario epoch, the run's
+  time scale], ``type``, ``sat``, ``peer``, ``value`` and ``sigma`` [m or m/s]; and one row per row
+  of the fit (m',) -- the post-fit ``residual`` [m or m/s], the ``normalised_residual``, the
+  ``edited`` mask (1 = left out of the fit) and ``residual_row``, the index of the (first)
+  measurement the row is formed from (m' < m when GNSS receiver clocks are eliminated:
+  :func:`tqdyn.od.problem.residual_rows`; files without it have m' = m and row i = measurement i).
 
 Every non-empty dataset is chunked with a Fletcher-32 checksum; strings are fixed-length UTF-8 bytes;
 datasets carry ``units`` and ``description``.  Writing is atomic (:func:`tqdyn.formats.atomic.replacing`):
@@ -34,8 +37,8 @@ from .atomic import replacing
 from .trajectory import check_writable
 from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "ROOT_ATTRS", "EstimateFile", "EstimateFormatError", "read_estimate_file",
-           "write_estimate_file"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "ROOT_ATTRS", "EstimateFile", "EstimateFormatError", "estimate_contents",
+           "read_estimate_file", "write_estimate_file"]
 
 FORMAT = "tqdyn-od-estimate"
 """Value of the root attribute ``format``."""
@@ -86,7 +89,10 @@ _MEAS = {
     "residual": ("m or m/s", "post-fit residual y - h(x_hat)"),
     "normalised_residual": ("1", "residual over its post-fit standard deviation"),
     "edited": ("", "1 = left out of the fit by the outlier editing"),
+    "residual_row": ("", "index of the (first) measurement row each residual row is formed from"),
 }
+#: Datasets that files written before them lack (the reader supplies them when it can).
+_OPTIONAL = {"measurements": ("residual_row",)}
 
 
 class EstimateFormatError(ValueError):
@@ -97,9 +103,10 @@ class EstimateFormatError(ValueError):
 class EstimateFile:
     """The contents of an estimate file: ``attrs`` (root attributes, native types), ``parameters``
     ({name: array} of ``/parameters``: names and units as str arrays) and ``measurements`` ({name:
-    array} of ``/measurements``: type and peer as str arrays, edited as bool)."""
+    array} of ``/measurements``: type and peer as str arrays, edited as bool; ``residual_row`` absent
+    only for a file without it whose residual rows are not the measurement rows)."""
 
-    path: pathlib.Path
+    path: pathlib.Path | None
     attrs: dict = field(default_factory=dict)
     parameters: dict = field(default_factory=dict)
     measurements: dict = field(default_factory=dict)
@@ -120,14 +127,8 @@ def _put(group, name: str, value, units: str, description: str):
     ds.attrs["kind"] = "text" if arr.dtype.kind == "S" else "number"
 
 
-def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None) -> pathlib.Path:
-    """Write the estimate file ``path`` atomically.
-
-    estimate: a :class:`tqdyn.od.estimator.Estimate`; measurements: the fitted table (attributes t,
-    type, sat, peer, value, sigma, (m,)); attrs: the root attributes of :data:`ROOT_ATTRS` other than
-    the format's and the fit's (scenario, scenario_name, epoch, time_scale, tdm_file, tdm_sha256,
-    edit_sigma, tracking); units: (n,) the parameters' units.  Raises OutputError (one line)."""
-    out = check_writable(path)
+def _contents(estimate, measurements, attrs: dict, units, residual_rows) -> tuple[dict, dict, dict]:
+    """(root attributes, /parameters, /measurements) of the file, as written."""
     n = len(estimate.names)
     params = {"names": np.array(estimate.names, dtype=object), "units": np.array(units or [""] * n, dtype=object),
               "values": estimate.values, "sigma": estimate.sigma, "covariance": estimate.covariance,
@@ -138,7 +139,9 @@ def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None
             "peer": np.asarray(measurements.peer, dtype=object), "value": measurements.value,
             "sigma": measurements.sigma, "residual": estimate.residuals,
             "normalised_residual": estimate.normalised_residuals,
-            "edited": np.asarray(estimate.edited, dtype=np.uint8)}
+            "edited": np.asarray(estimate.edited, dtype=np.uint8),
+            "residual_row": np.asarray(np.arange(len(estimate.residuals)) if residual_rows is None else residual_rows,
+                                       dtype=np.int64)}
     groups = {str(k): {f: getattr(g, f) for f in ("count", "edited", "rms", "weighted_rms", "normalised_rms")}
               for k, g in (estimate.groups or {}).items()}
     root = {"format": FORMAT, "format_version": FORMAT_VERSION, "tqdyn_version": _TQDYN_VERSION,
@@ -148,6 +151,33 @@ def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None
             "last_step": float(estimate.last_step), "condition_number": float(estimate.condition_number),
             "groups": json.dumps(groups)}
     root.setdefault("edit_sigma", math.nan)
+    return root, params, rows
+
+
+def estimate_contents(estimate, measurements, *, attrs: dict, units=None, residual_rows=None) -> EstimateFile:
+    """What :func:`write_estimate_file` would write, in memory, as :func:`read_estimate_file`
+    returns it (``path`` None): the same arguments."""
+    root, params, rows = _contents(estimate, measurements, attrs, units, residual_rows)
+
+    def native(d):
+        return {k: (np.asarray(v).astype(str) if np.asarray(v).dtype.kind in "OUS" else np.asarray(v))
+                for k, v in d.items()}
+
+    out = EstimateFile(None, dict(root), native(params), native(rows))
+    out.measurements["edited"] = out.measurements["edited"].astype(bool)
+    return out
+
+
+def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None, residual_rows=None) -> pathlib.Path:
+    """Write the estimate file ``path`` atomically.
+
+    estimate: a :class:`tqdyn.od.estimator.Estimate`; measurements: the fitted table (attributes t,
+    type, sat, peer, value, sigma, (m,)); attrs: the root attributes of :data:`ROOT_ATTRS` other than
+    the format's and the fit's (scenario, scenario_name, epoch, time_scale, tdm_file, tdm_sha256,
+    edit_sigma, tracking); units: (n,) the parameters' units; residual_rows: (m',) the measurement
+    row of each residual row (None: the identity, m' = m).  Raises OutputError (one line)."""
+    out = check_writable(path)
+    root, params, rows = _contents(estimate, measurements, attrs, units, residual_rows)
     with replacing(out, "the estimate file") as tmp:
         with h5py.File(tmp, "w") as h5:
             for k, v in root.items():
@@ -183,13 +213,18 @@ def read_estimate_file(path) -> EstimateFile:
             out = EstimateFile(p, attrs)
             for group, names, dest in (("parameters", _PARAM, out.parameters),
                                        ("measurements", _MEAS, out.measurements)):
-                missing = [k for k in names if f"{group}/{k}" not in h5]
+                optional = _OPTIONAL.get(group, ())
+                missing = [k for k in names if f"{group}/{k}" not in h5 and k not in optional]
                 if missing:
                     raise EstimateFormatError(f"{fname}: dataset '/{group}/{missing[0]}' is missing; re-create it "
                                               "(tqdyn od fit)")
                 for k in names:
-                    dest[k] = _read(h5[f"{group}/{k}"], fname)
+                    if f"{group}/{k}" in h5:
+                        dest[k] = _read(h5[f"{group}/{k}"], fname)
     except DAMAGED as exc:
         raise EstimateFormatError(damaged_message(fname, exc, "tqdyn od fit")) from None
-    out.measurements["edited"] = out.measurements["edited"].astype(bool)
+    meas = out.measurements
+    meas["edited"] = meas["edited"].astype(bool)
+    if "residual_row" not in meas and len(meas["residual"]) == len(meas["t"]):
+        meas["residual_row"] = np.arange(len(meas["t"]), dtype=np.int64)
     return out

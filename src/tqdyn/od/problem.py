@@ -60,8 +60,8 @@ from .tracking import (DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, ME
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
-           "build_problem", "compute", "covariance", "fit", "nominal_parameters", "schedule", "simulate",
-           "with_measurements"]
+           "build_problem", "compute", "covariance", "fit", "nominal_parameters", "residual_rows", "schedule",
+           "simulate", "with_measurements"]
 
 #: Largest step [s] of the float64 variational equations on geocentric runs (DP87 on TianQin's
 #: 3.6-day orbit: the partials agree with dd differences to ~1e-10 at 600 s).
@@ -252,6 +252,18 @@ def _clock_elimination(meas: Measurements):
     T = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(out, len(meas)))
     return T, np.concatenate(sig), tuple(str(x) for x in np.concatenate(lab))
+
+
+def residual_rows(meas: Measurements) -> np.ndarray:
+    """For each row of the fit (of :func:`fit`'s residuals, (m',)), the index of the first
+    measurement row it is formed from, (m',) int: the row itself for every type but GNSS, the
+    first pseudorange of its (epoch, satellite) for the clock-free combinations (module
+    docstring; an epoch with one pseudorange forms no row).  Every row formed from a measurement
+    has its time tag, type and satellite."""
+    T = _clock_elimination(meas)[0].tocsr()
+    if T.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    return np.minimum.reduceat(T.indices, T.indptr[:-1]).astype(np.int64)
 
 
 def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori):

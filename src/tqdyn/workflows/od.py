@@ -27,7 +27,7 @@ import numpy as np
 
 from ..formats import trajectory as io
 from ..formats.atomic import replacing
-from ..formats.od_estimate import write_estimate_file
+from ..formats.od_estimate import estimate_contents, write_estimate_file
 from ..formats.od_tdm import read_measurements_tdm, write_measurements_tdm
 from .closed_loop import file_sha256
 from .run import load_run_scenario
@@ -208,10 +208,12 @@ def _header_number(info: dict, key: str, tdm) -> float:
 
 
 def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma=None, overrides=(),
-                progress: Callable[[str], None] | None = None, **options):
+                figure=None, progress: Callable[[str], None] | None = None, **options):
     """Fit the scenario's parameters (``estimate``, ``consider``: names of parameter groups, default
     the plan's) to the measurements of the TDM ``tdm``; write the estimate file ``output`` (None: no
-    file).  Returns (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
+    file) and the residuals' figure ``figure`` (None: none; PNG or PDF by its suffix,
+    :func:`tqdyn.analysis.figures_od.plot_od_residuals`, checked before the fit).  Returns
+    (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
     :func:`tqdyn.od.estimator.estimate` with ``edit_sigma``."""
     say = progress or (lambda stage: None)
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
@@ -221,6 +223,19 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
         raise FileNotFoundError(f"MEAS.tdm: measurement file {str(tdm)!r} does not exist or is not a file")
     inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
     out = _check_output(output, "--output", inputs) if output is not None else None
+    if figure is not None:
+        from ..analysis.figures_od import check_residual_figure_path
+
+        try:
+            check_residual_figure_path(figure)
+        except ImportError as exc:
+            raise ValueError(f"--figure: {str(figure)!r} cannot be drawn ({exc}); allowed: no --figure, or install "
+                             "matplotlib") from None
+        if out is not None and _same(out, figure):
+            raise ValueError(f"--figure: {str(figure)!r} is the output EST.h5; allowed: another file")
+        for label, path in inputs.items():
+            if path is not None and _same(figure, path):
+                raise ValueError(f"--figure: {str(figure)!r} is the input {label}; allowed: another file")
     scen, notes, label = _scenario(scenario, overrides)
     say("reading")
     fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale)
@@ -236,14 +251,26 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
     if edit_sigma is not None:
         options["edit_sigma"] = float(edit_sigma)
     fit = _problem().fit(scen, meas, plan, **options)
+    rows = _problem().residual_rows(meas)
+    units = [parameter_unit(n) for n in fit.names]
+    attrs = {"scenario": scen.to_toml(), "scenario_name": scen.name, "epoch": scen.epoch.iso,
+             "time_scale": scen.reference.time_scale, "tdm_file": pathlib.Path(tdm).name,
+             "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
+             "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
+                                     "estimate": list(plan.estimate), "consider": list(plan.consider)})}
     if out is not None:
         say("writing")
-        attrs = {"scenario": scen.to_toml(), "scenario_name": scen.name, "epoch": scen.epoch.iso,
-                 "time_scale": scen.reference.time_scale, "tdm_file": pathlib.Path(tdm).name,
-                 "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
-                 "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
-                                         "estimate": list(plan.estimate), "consider": list(plan.consider)})}
-        write_estimate_file(out, fit, meas, attrs=attrs, units=[parameter_unit(n) for n in fit.names])
+        write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
+    if figure is not None:
+        from ..analysis.figures_od import plot_od_residuals
+
+        say("plotting")
+        try:
+            plot_od_residuals(estimate_contents(fit, meas, attrs=attrs, units=units, residual_rows=rows), figure)
+        except (OSError, RuntimeError) as exc:  # a full disk, a directory removed since the check
+            raise ValueError(f"--figure: {str(figure)!r} could not be written ({exc}); nothing was written there"
+                             + (f", the estimate file {str(out)!r} was" if out is not None else "")
+                             + "; allowed: a writable file with space for the figure") from None
     return fit, scen, tuple(notes)
 
 
