@@ -11,9 +11,11 @@ A station named ``Nowhere`` is refused as below the horizon for the whole arc.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
+import pytest
 
 from tqdyn.od.estimator import Parameters, Problem, covariance_analysis, estimate
 
@@ -123,3 +125,15 @@ def residual_rows(meas) -> np.ndarray:
 
 def fit(scenario, meas, tracking, **estimate_options):
     return estimate(build_problem(scenario, meas, tracking), **estimate_options)
+
+
+@pytest.fixture(autouse=True)
+def fake_problem(monkeypatch):
+    """Put this stand-in in place of ``tqdyn.od.problem`` for every test of a module that imports
+    this fixture."""
+    import tqdyn.od
+
+    stand_in = sys.modules[__name__]
+    monkeypatch.setitem(sys.modules, "tqdyn.od.problem", stand_in)
+    monkeypatch.setattr(tqdyn.od, "problem", stand_in, raising=False)
+    return stand_in

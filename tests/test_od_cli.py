@@ -10,22 +10,13 @@ The run is tianqin-kepler, 1 day at 600 s (a few seconds).
 
 from __future__ import annotations
 
-import sys
 
 import numpy as np
 import pytest
 
 import od_fake_problem as fake
+from od_fake_problem import fake_problem  # noqa: F401  (autouse: the stand-in replaces tqdyn.od.problem)
 from cli_support import run_cli
-
-
-@pytest.fixture(autouse=True)
-def fake_problem(monkeypatch):
-    import tqdyn.od
-
-    monkeypatch.setitem(sys.modules, "tqdyn.od.problem", fake)
-    monkeypatch.setattr(tqdyn.od, "problem", fake, raising=False)
-    return fake
 
 
 @pytest.fixture(scope="module")

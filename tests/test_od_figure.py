@@ -18,17 +18,9 @@ import numpy as np
 import pytest
 
 import od_fake_problem as fake
+from od_fake_problem import fake_problem  # noqa: F401  (autouse: the stand-in replaces tqdyn.od.problem)
 from cli_support import run_cli
 from tqdyn.od import problem as real_problem      # before the stand-in replaces it
-
-
-@pytest.fixture(autouse=True)
-def fake_problem(monkeypatch):
-    import tqdyn.od
-
-    monkeypatch.setitem(sys.modules, "tqdyn.od.problem", fake)
-    monkeypatch.setattr(tqdyn.od, "problem", fake, raising=False)
-    return fake
 
 
 @pytest.fixture(scope="module")
