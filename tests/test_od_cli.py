@@ -10,7 +10,6 @@ The run is tianqin-kepler, 1 day at 600 s (a few seconds).
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 
