@@ -86,7 +86,7 @@ class Partials:
     @property
     def full_parameter_names(self) -> list[str]:
         """Column names of ``sensitivities_full``."""
-        return parameter_names(self.satellites)
+        return [f"{s}/{p}" for s in self.satellites for p in self.parameter_names]
 
     @property
     def full_state_names(self) -> list[str]:
