@@ -199,7 +199,8 @@ def test_lisa_dsn_and_isr_covariance():
     (lambda: odp.schedule("lisa-gravity", odp.Tracking(("gnss", "isr"), DAY, 21600.0)),
      "tracking.kinds: 'gnss' is not allowed for the heliocentric scenario 'lisa-gravity'; allowed: dsn, isr"),
     (lambda: odp.schedule("tianqin", odp.Tracking(("slr",), DAY)),
-     "tracking: group 's_frame' is not allowed for the coupled scenario 'tianqin'; allowed: state, self_gravity_common"),
+     "tracking: group 's_frame' is not allowed for the coupled scenario 'tianqin'; "
+     "allowed: state, self_gravity_common"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, estimate=("state", "self_gravity_common"))),
      "tracking: group 'self_gravity_common' needs a coupled scenario"),
     (lambda: odp.nominal_parameters(load_scenario("tianqin", ["constellation.free_tms=true"])),

@@ -62,8 +62,9 @@ from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
 from . import coupled, estimator
 from .parameters import OrbitParameters, parameter_names, state_names
-from .tracking import (COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES, TRACKING_KINDS,
-                       Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match, row_order)
+from .tracking import (COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES,
+                       TRACKING_KINDS, Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match,
+                       row_order)
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
@@ -246,7 +247,8 @@ def compute(scenario, parameters: OrbitParameters | None, meas: Measurements, tr
     Returns h (m,) [m or m/s] (GNSS: c tau without the receiver clock), H (m, 18 n_sat; coupled
     runs (m, 9 n_sat)) and the column names: :func:`~tqdyn.od.parameters.state_names` then
     :func:`~tqdyn.od.parameters.parameter_names` of the scenario (coupled runs:
-    :func:`~tqdyn.od.coupled.parameter_names`; every parameter; a problem selects its columns).  tracking: only its GNSS reception mode matters (default)."""
+    :func:`~tqdyn.od.coupled.parameter_names`; every parameter; a problem selects its columns).
+    tracking: only its GNSS reception mode matters (default)."""
     scen = _scenario(scenario)
     if tracking is None:
         kinds = tuple(k for k in TRACKING_KINDS if any(x in KIND_TYPES[k] for x in set(meas.type.tolist())))
