@@ -18,6 +18,7 @@ from scipy import stats
 
 from tqdyn.od import estimator, problem as odp
 from tqdyn.od.parameters import OrbitParameters
+from tqdyn.scenario import load_scenario
 
 DAY = 86400.0
 SCEN = "tianqin-gravity"
@@ -198,7 +199,12 @@ def test_lisa_dsn_and_isr_covariance():
     (lambda: odp.schedule("lisa-gravity", odp.Tracking(("gnss", "isr"), DAY, 21600.0)),
      "tracking.kinds: 'gnss' is not allowed for the heliocentric scenario 'lisa-gravity'; allowed: dsn, isr"),
     (lambda: odp.schedule("tianqin", odp.Tracking(("slr",), DAY)),
-     "constellation.pointing = 'global' is a coupled"),
+     "tracking: group 's_frame' is not allowed for the coupled scenario 'tianqin'; "
+     "allowed: state, self_gravity_common"),
+    (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, estimate=("state", "self_gravity_common"))),
+     "tracking: group 'self_gravity_common' needs a coupled scenario"),
+    (lambda: odp.nominal_parameters(load_scenario("tianqin", ["constellation.free_tms=true"])),
+     "constellation.free_tms = true propagates the test masses"),
     (lambda: odp.fit(SCEN, odp.schedule(SCEN, odp.Tracking(("isr",), 3600.0, 600.0)),
                      odp.Tracking(("isr",), 3600.0, 600.0)), "measurements: every value is NaN"),
 ])

@@ -33,10 +33,13 @@ class OrbitParameters:
         (None: the scenario's ``[accelerations]``, zero by default).
     y0 : initial states at the epoch, (n_sat, 6, 2) double-double or (n_sat, 6) float64
         [m, m/s], the run's frame (None: the scenario's initial states).
+    self_gravity_common : (n_sat, 3) float64 [m/s^2 in S]: ``spacecraft.self_gravity_common``
+        of a coupled run (None: the scenario's).
     """
 
     accelerations: np.ndarray | None = None
     y0: np.ndarray | None = None
+    self_gravity_common: np.ndarray | None = None
 
     def y0_dd(self) -> np.ndarray | None:
         """y0 as a (n_sat, 6, 2) dd array (None if not set)."""
@@ -63,11 +66,22 @@ def state_names(satellites) -> list[str]:
     return [f"{s}/{p}" for s in names for p in STATE_NAMES]
 
 
-def scenario_with(scenario, accelerations=None, duration_s=None):
+def scenario_with(scenario, accelerations=None, duration_s=None, self_gravity_common=None, step_s=None):
     """A copy of the scenario with its ``[accelerations]`` set to (n_sat, N_PAR) values
-    [m/s^2] (None: unchanged) and ``run.duration`` to duration_s [s] (None: unchanged;
-    a multiple of the step in fixed mode)."""
+    [m/s^2] (None: unchanged), ``run.duration`` to duration_s [s] (None: unchanged;
+    a multiple of the step in fixed mode), ``spacecraft.self_gravity_common`` to (n_sat, 3)
+    values [m/s^2 in S] (None: unchanged; float64 values are kept exactly) and
+    ``integrator.step`` to step_s [s] (None: unchanged)."""
     kw = {}
+    if self_gravity_common is not None:
+        sg = np.asarray(self_gravity_common, np.float64)
+        n = len(scenario.satellites)
+        if sg.shape != (n, 3):
+            raise ValueError(f"parameters.self_gravity_common: shape {sg.shape}; allowed: ({n}, 3) [m/s^2 in S]")
+        rows = tuple(tuple(Decimal(repr(float(x))) for x in row) for row in sg)
+        kw["spacecraft"] = dataclasses.replace(scenario.spacecraft, self_gravity_common=rows)
+    if step_s is not None:
+        kw["integrator"] = dataclasses.replace(scenario.integrator, step_s=Decimal(repr(float(step_s))))
     if accelerations is not None:
         acc = np.asarray(accelerations, np.float64)
         n = len(scenario.satellites)

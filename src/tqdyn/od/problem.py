@@ -39,7 +39,14 @@ exactly those of a fit that estimates every clock bias; an epoch with one pseudo
 information and is dropped.  (Position fixes are not used.)  The post-fit residuals of these rows
 are those of the projected measurements.
 
-Refused in one line: coupled runs (attitude or control), GNSS and SLR on heliocentric runs, an
+Coupled runs (``constellation.pointing`` set: attitude, test masses, drag-free and suspension
+control): the parameters are the initial states and the common self-gravity of each satellite's
+test masses (group ``"self_gravity_common"``, ``spacecraft.self_gravity_common`` [m/s^2 in S]),
+with partials by central differences of dd runs of the full coupled dynamics (:mod:`.coupled`);
+the point-mass acceleration groups are refused there, and ``"self_gravity_common"`` on
+point-mass runs.
+
+Refused in one line: coupled runs with free test masses or not three satellites, GNSS and SLR on heliocentric runs, an
 interval off the run's step grid, an arc beyond the ephemeris' span, a named station that never
 sees a satellite over the arc, a tracking kind without any visible measurement.
 """
@@ -53,10 +60,11 @@ from scipy import linalg, sparse
 
 from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
-from . import estimator
+from . import coupled, estimator
 from .parameters import OrbitParameters, parameter_names, state_names
-from .tracking import (DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES, TRACKING_KINDS,
-                       Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match, row_order)
+from .tracking import (COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES,
+                       TRACKING_KINDS, Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match,
+                       row_order)
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
@@ -73,14 +81,19 @@ CLOCK_SIGMA_M = 1000.0
 def _scenario(scenario, tracking: Tracking | None = None):
     """The loaded scenario, checked for orbit determination with the tracking plan."""
     scen = load_scenario(scenario) if isinstance(scenario, str) else scenario
-    if scen.constellation.pointing != "none":
-        fail(f"scenario {scen.name!r}: constellation.pointing = {scen.constellation.pointing!r} is a coupled "
-             f"(attitude) run; orbit determination needs point-mass satellites (allowed: \"none\", "
-              f"e.g. tianqin-gravity, lisa-gravity, lisa-esa)")
+    if _coupled(scen):
+        coupled.check_scenario(scen)
     if scen.integrator.mode != "fixed":
         fail(f'scenario {scen.name!r}: integrator.mode = {scen.integrator.mode!r}; allowed: "fixed"')
     if tracking is None:
         return scen
+    for g in tracking.estimate + tracking.consider:
+        if _coupled(scen) and g not in COUPLED_GROUPS:
+            fail(f"tracking: group {g!r} is not allowed for the coupled scenario {scen.name!r}; allowed: "
+                 f"{', '.join(COUPLED_GROUPS)}")
+        if not _coupled(scen) and g == "self_gravity_common":
+            fail(f"tracking: group {g!r} needs a coupled scenario (constellation.pointing set); "
+                 f"{scen.name!r} is point-mass; allowed: {', '.join(x for x in GROUPS if x != g)}")
     _check_kinds(scen, tracking.kinds)
     if "isr" in tracking.kinds and len(scen.satellites) != 3:
         fail(f"tracking.kinds: 'isr' needs three satellites; scenario {scen.name!r} has {len(scen.satellites)}")
@@ -96,6 +109,15 @@ def _scenario(scenario, tracking: Tracking | None = None):
     return scen
 
 
+def _coupled(scen) -> bool:
+    return scen.constellation.pointing != "none"
+
+
+def _parameter_names(scen) -> list[str]:
+    """Names of the columns of :func:`compute` after the states."""
+    return coupled.parameter_names(scen) if _coupled(scen) else parameter_names(scen)
+
+
 def _check_kinds(scen, kinds) -> None:
     if is_heliocentric(scen):
         for k in kinds:
@@ -106,16 +128,20 @@ def _check_kinds(scen, kinds) -> None:
 
 def nominal_parameters(scenario) -> OrbitParameters:
     """The scenario's own parameter values: initial states (n_sat, 6, 2) dd [m, m/s] and
-    ``[accelerations]`` (n_sat, 12) [m/s^2]."""
+    ``[accelerations]`` (n_sat, 12) [m/s^2]; coupled runs also ``self_gravity_common``
+    (n_sat, 3) [m/s^2 in S]."""
     scen = _scenario(scenario)
     _, y = propagate_dd(scen, None, [0.0])
-    return OrbitParameters(accelerations=scen.accelerations.values(len(scen.satellites)), y0=y[0])
+    return OrbitParameters(accelerations=scen.accelerations.values(len(scen.satellites)), y0=y[0],
+                           self_gravity_common=coupled.nominal_common(scen) if _coupled(scen) else None)
 
 
 def _values(par: OrbitParameters) -> np.ndarray:
-    """All parameter values in the column order of :func:`compute`: states then accelerations."""
+    """All parameter values in the column order of :func:`compute`: states then accelerations
+    (coupled runs: then the common self-gravity)."""
     y0 = par.y0_dd()
-    return np.concatenate([(y0[..., 0] + y0[..., 1]).ravel(), np.asarray(par.accelerations, np.float64).ravel()])
+    p = par.accelerations if par.self_gravity_common is None else par.self_gravity_common
+    return np.concatenate([(y0[..., 0] + y0[..., 1]).ravel(), np.asarray(p, np.float64).ravel()])
 
 
 def _with_values(nominal: OrbitParameters, index: np.ndarray, q: np.ndarray) -> OrbitParameters:
@@ -123,14 +149,17 @@ def _with_values(nominal: OrbitParameters, index: np.ndarray, q: np.ndarray) -> 
     (state components: the dd nominal plus the float64 difference, so q = nominal is exact)."""
     y0 = nominal.y0_dd().copy()
     acc = np.array(nominal.accelerations, np.float64)
+    sg = None if nominal.self_gravity_common is None else np.array(nominal.self_gravity_common, np.float64)
     n_state = y0.shape[0] * 6
     base = _values(nominal)
     for j, v in zip(index, q):
         if j < n_state:
             y0[j // 6, j % 6, 0] += v - base[j]
+        elif sg is not None:
+            sg.flat[j - n_state] = v
         else:
             acc.flat[j - n_state] = v
-    return OrbitParameters(accelerations=acc, y0=y0)
+    return OrbitParameters(accelerations=acc, y0=y0, self_gravity_common=sg)
 
 
 def _partials_step(scen, t) -> float:
@@ -199,19 +228,27 @@ def simulate(scenario, tracking: Tracking, truth: OrbitParameters | None = None,
 
 def _compute(scen, tracking, parameters, meas):
     t_grid = np.unique(meas.t)
-    p = propagate_with_partials(scen, parameters, t_grid, step=_partials_step(scen, t_grid))
+    p = _partials(scen, parameters, t_grid)
     ti, h, d, sat2 = match(scen, tracking, p.t, p.states, meas)
     H = jacobian(scen, p, ti, d, meas.sat, sat2)
-    return h, H, state_names(scen) + parameter_names(scen)
+    return h, H, state_names(scen) + _parameter_names(scen)
+
+
+def _partials(scen, parameters, t) -> Partials:
+    """States and partials at t [s]: the variational equations (point-mass runs) or central
+    differences of dd runs (coupled runs, :mod:`.coupled`)."""
+    prop = coupled.propagate_with_partials if _coupled(scen) else propagate_with_partials
+    return prop(scen, parameters, t, step=_partials_step(scen, t))
 
 
 def compute(scenario, parameters: OrbitParameters | None, meas: Measurements, tracking: Tracking | None = None):
     """Computed measurements and their partials at the parameter values (None: the scenario's).
 
-    Returns h (m,) [m or m/s] (GNSS: c tau without the receiver clock), H (m, 18 n_sat) and the
-    column names: :func:`~tqdyn.od.parameters.state_names` then
-    :func:`~tqdyn.od.parameters.parameter_names` of the scenario (every parameter; a problem
-    selects its columns).  tracking: only its GNSS reception mode matters (default)."""
+    Returns h (m,) [m or m/s] (GNSS: c tau without the receiver clock), H (m, 18 n_sat; coupled
+    runs (m, 9 n_sat)) and the column names: :func:`~tqdyn.od.parameters.state_names` then
+    :func:`~tqdyn.od.parameters.parameter_names` of the scenario (coupled runs:
+    :func:`~tqdyn.od.coupled.parameter_names`; every parameter; a problem selects its columns).
+    tracking: only its GNSS reception mode matters (default)."""
     scen = _scenario(scenario)
     if tracking is None:
         kinds = tuple(k for k in TRACKING_KINDS if any(x in KIND_TYPES[k] for x in set(meas.type.tolist())))
@@ -268,7 +305,7 @@ def residual_rows(meas: Measurements) -> np.ndarray:
 
 def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori):
     """Estimated and considered :class:`~tqdyn.od.estimator.Parameters` and their column indices."""
-    names = state_names(scen) + parameter_names(scen)
+    names = state_names(scen) + _parameter_names(scen)
     base = _values(nominal)
     sats = [s.name for s in scen.satellites]
     sig = tracking.a_priori_sigma or {}
@@ -357,7 +394,7 @@ def covariance(scenario, tracking: Tracking, a_priori=None, partials: Partials |
     scen = _scenario(scenario, tracking)
     t = tracking.times()
     if partials is None:
-        p = propagate_with_partials(scen, None, t, step=_partials_step(scen, t))
+        p = _partials(scen, None, t)
     else:
         k = np.searchsorted(partials.t, t - 1e-6)
         if np.any(k >= partials.t.size) or np.any(np.abs(partials.t[np.minimum(k, partials.t.size - 1)] - t) > 1e-6):

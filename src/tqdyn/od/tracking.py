@@ -24,8 +24,8 @@ from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
 from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
 from .parameters import STATE_NAMES
 
-__all__ = ["DEFAULT_SIGMA", "GROUPS", "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements",
-           "Tracking", "evaluate", "jacobian", "match", "row_order"]
+__all__ = ["COUPLED_GROUPS", "DEFAULT_SIGMA", "GROUPS", "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS",
+           "Measurements",           "Tracking", "evaluate", "jacobian", "match", "row_order"]
 
 TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
 MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
@@ -35,9 +35,13 @@ KIND_TYPES = {"gnss": ("gnss_pseudorange",), "slr": ("slr_range",), "isr": ("isr
 #: Default noise per measurement type [m, m/s for dsn_range_rate] (the models' defaults).
 DEFAULT_SIGMA = {"gnss_pseudorange": GNSS_SIGMA_M, "slr_range": SLR_SIGMA_M, "isr_range": ISR_ABSOLUTE_SIGMA_M,
                  "dsn_range": DSN_RANGE_SIGMA_M, "dsn_range_rate": DSN_DOPPLER_SIGMA_M_S}
-#: Parameter groups: name -> the per-satellite parameter names it holds.
+#: Parameter groups: name -> the per-satellite parameter names it holds ("self_gravity_common":
+#: the rows of ``spacecraft.self_gravity_common`` of a coupled run, :mod:`.coupled`).
 GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETER_NAMES[3:6],
-          "rtn_cos": PARAMETER_NAMES[6:9], "rtn_sin": PARAMETER_NAMES[9:12]}
+          "rtn_cos": PARAMETER_NAMES[6:9], "rtn_sin": PARAMETER_NAMES[9:12],
+          "self_gravity_common": ("sgc_x", "sgc_y", "sgc_z")}
+#: The groups of a coupled run (the others are those of point-mass runs).
+COUPLED_GROUPS = ("state", "self_gravity_common")
 HELIOCENTRIC_KINDS = ("dsn", "isr")
 
 def fail(msg: str):

@@ -86,7 +86,7 @@ class Partials:
     @property
     def full_parameter_names(self) -> list[str]:
         """Column names of ``sensitivities_full``."""
-        return parameter_names(self.satellites)
+        return [f"{s}/{p}" for s in self.satellites for p in self.parameter_names]
 
     @property
     def full_state_names(self) -> list[str]:
@@ -121,7 +121,7 @@ def propagate_dd(scenario, parameters: OrbitParameters | None = None, t_out=None
     idx = _grid(t_out, step, "integrator.step")
     n_end = max(int(idx.max()), 1)
     par = parameters or OrbitParameters()
-    scen = scenario_with(scen, par.accelerations, n_end * step)
+    scen = scenario_with(scen, par.accelerations, n_end * step, par.self_gravity_common)
     scen = _with_every_step(scen)
     blocks = []
     result = dynamics.propagate(scen, sink=blocks.append, y0=par.y0_dd())

@@ -86,13 +86,15 @@ def parse_arc(value, option: str = "--arc") -> float:
 
 def parameter_unit(name: str) -> str:
     """The unit of an estimated parameter from its name ``"<sat>/<component>"``: the initial state's
-    x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters [m/s^2]; "" otherwise."""
+    x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters and a coupled run's common
+    self-gravity [m/s^2]; "" otherwise."""
+    from ..od.coupled import COMMON_NAMES
     from ..od.parameters import PARAMETER_NAMES, STATE_NAMES
 
     last = name.rsplit("/", 1)[-1]
     if last in STATE_NAMES:
         return "m" if last in STATE_NAMES[:3] else "m/s"
-    return "m/s^2" if last in PARAMETER_NAMES else ""
+    return "m/s^2" if last in PARAMETER_NAMES or last in COMMON_NAMES else ""
 
 
 def _same(a, b) -> bool:
