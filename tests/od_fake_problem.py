@@ -101,6 +101,10 @@ def _select(scenario, groups, what):
     return [i for i, nm in enumerate(names(scenario)) if nm.rsplit("/", 1)[1] in comp]
 
 
+def estimated_groups(scenario, tracking) -> tuple:
+    return tracking.estimate
+
+
 def build_problem(scenario, meas, tracking, a_priori=None) -> Problem:
     jac = design(scenario, meas)
     est = _select(scenario, tracking.estimate, "estimate")

@@ -84,3 +84,14 @@ def test_difference_steps(record_number):
     rel = float(np.max(np.max(np.abs(fa - fb), axis=(0, 1)) / np.max(np.abs(fa), axis=(0, 1))))
     record_number("od.coupled_fd_halving_rel", rel)
     assert rel < 1e-15
+
+
+def test_default_groups_follow_the_run():
+    """A plan that names no groups estimates state + S-frame constants on a point-mass run and
+    state + common self-gravity on a coupled one; a considered default group leaves the estimate."""
+    tr = odp.Tracking(("slr",), DAY)
+    assert odp.estimated_groups("tianqin-gravity", tr) == ("state", "s_frame")
+    assert odp.estimated_groups(SCEN, tr) == ("state", "self_gravity_common")
+    tr_c = odp.Tracking(("slr",), DAY, consider=("self_gravity_common",),
+                        a_priori_sigma={"self_gravity_common": 1e-9})
+    assert odp.estimated_groups(SCEN, tr_c) == ("state",)

@@ -198,7 +198,7 @@ def test_lisa_dsn_and_isr_covariance():
      "tracking.stations: 'DSS-63 Madrid' is below its elevation mask for the whole arc"),
     (lambda: odp.schedule("lisa-gravity", odp.Tracking(("gnss", "isr"), DAY, 21600.0)),
      "tracking.kinds: 'gnss' is not allowed for the heliocentric scenario 'lisa-gravity'; allowed: dsn, isr"),
-    (lambda: odp.schedule("tianqin", odp.Tracking(("slr",), DAY)),
+    (lambda: odp.schedule("tianqin", odp.Tracking(("slr",), DAY, estimate=("state", "s_frame"))),
      "tracking: group 's_frame' is not allowed for the coupled scenario 'tianqin'; "
      "allowed: state, self_gravity_common"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, estimate=("state", "self_gravity_common"))),

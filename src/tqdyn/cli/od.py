@@ -116,7 +116,8 @@ def simulate(run_file, tracking, arc, seed, interval, stations, output, sets, qu
 @click.argument("scenario", metavar="SCENARIO")
 @click.argument("tdm", metavar="MEAS.tdm")
 @click.option("--output", "-o", required=True, help="Output estimate file (HDF5, docs/orbit-determination.md).")
-@click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame].")
+@click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "
+              "coupled runs: state,self_gravity_common].")
 @click.option("--consider", help="Parameter groups to consider (not estimated, their uncertainty kept).")
 @click.option("--edit-sigma", type=float, help="Leave out measurements beyond K normalised sigmas (off by default).")
 @click.option("--figure", help="Also draw the normalised post-fit residuals and their histogram (.png or .pdf).")
@@ -149,7 +150,8 @@ def fit(scenario, tdm, output, estimate, consider, edit_sigma, figure, sets, qui
 @click.option("--tracking", required=True, help="Tracking types, comma-separated: gnss, slr, isr, dsn.")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
-@click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame].")
+@click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "
+              "coupled runs: state,self_gravity_common].")
 @click.option("--consider", help="Parameter groups to consider (not estimated, their uncertainty kept).")
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
 @click.option("--json", "json_out", help="Also write the covariance as JSON to this file.")

@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .parameters import OrbitParameters, scenario_with
+from .tracking import fail
 from .variational import Partials, propagate_dd
 
 __all__ = ["COMMON_NAMES", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario",
@@ -44,18 +45,14 @@ STEP_VELOCITY = 2.0 ** -13          # 1.22e-4 m/s
 STEP_COMMON = 2.0 ** -30            # 9.31e-10 m/s^2
 
 
-def _fail(msg: str):
-    raise ValueError(" ".join(msg.split()))
-
-
 def check_scenario(scen) -> None:
     """One-line ValueError unless the coupled scenario's satellites are its whole state (three
     satellites, no free test masses)."""
     if scen.constellation.free_tms:
-        _fail(f"scenario {scen.name!r}: constellation.free_tms = true propagates the test masses as free "
+        fail(f"scenario {scen.name!r}: constellation.free_tms = true propagates the test masses as free "
               f"bodies; orbit determination of a coupled run needs free_tms = false")
     if len(scen.satellites) != 3:
-        _fail(f"scenario {scen.name!r}: a coupled run of {len(scen.satellites)} satellites; allowed: 3")
+        fail(f"scenario {scen.name!r}: a coupled run of {len(scen.satellites)} satellites; allowed: 3")
 
 
 def parameter_names(satellites) -> list[str]:

@@ -46,9 +46,9 @@ with partials by central differences of dd runs of the full coupled dynamics (:m
 the point-mass acceleration groups are refused there, and ``"self_gravity_common"`` on
 point-mass runs.
 
-Refused in one line: coupled runs with free test masses or not three satellites, GNSS and SLR on heliocentric runs, an
-interval off the run's step grid, an arc beyond the ephemeris' span, a named station that never
-sees a satellite over the arc, a tracking kind without any visible measurement.
+Refused in one line: coupled runs with free test masses or not three satellites, GNSS and SLR on
+heliocentric runs, an interval off the run's step grid, an arc beyond the ephemeris' span, a named
+station that never sees a satellite over the arc, a tracking kind without any visible measurement.
 """
 
 from __future__ import annotations
@@ -68,8 +68,8 @@ from .tracking import (COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
-           "build_problem", "compute", "covariance", "fit", "nominal_parameters", "residual_rows", "schedule",
-           "simulate", "with_measurements"]
+           "build_problem", "compute", "covariance", "estimated_groups", "fit", "nominal_parameters", "residual_rows",
+           "schedule", "simulate", "with_measurements"]
 
 #: Largest step [s] of the float64 variational equations on geocentric runs (DP87 on TianQin's
 #: 3.6-day orbit: the partials agree with dd differences to ~1e-10 at 600 s).
@@ -87,7 +87,7 @@ def _scenario(scenario, tracking: Tracking | None = None):
         fail(f'scenario {scen.name!r}: integrator.mode = {scen.integrator.mode!r}; allowed: "fixed"')
     if tracking is None:
         return scen
-    for g in tracking.estimate + tracking.consider:
+    for g in tracking.estimated(_coupled(scen)) + tracking.consider:
         if _coupled(scen) and g not in COUPLED_GROUPS:
             fail(f"tracking: group {g!r} is not allowed for the coupled scenario {scen.name!r}; allowed: "
                  f"{', '.join(COUPLED_GROUPS)}")
@@ -111,6 +111,12 @@ def _scenario(scenario, tracking: Tracking | None = None):
 
 def _coupled(scen) -> bool:
     return scen.constellation.pointing != "none"
+
+
+def estimated_groups(scenario, tracking: Tracking) -> tuple:
+    """The parameter groups the plan estimates on the scenario: its ``estimate``, or by default
+    state and ``s_frame`` (point-mass runs) or state and ``self_gravity_common`` (coupled runs)."""
+    return tracking.estimated(_coupled(_scenario(scenario)))
 
 
 def _parameter_names(scen) -> list[str]:
@@ -310,7 +316,7 @@ def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori
     sats = [s.name for s in scen.satellites]
     sig = tracking.a_priori_sigma or {}
     out = []
-    for groups in (tracking.estimate, tracking.consider):
+    for groups in (tracking.estimated(_coupled(scen)), tracking.consider):
         sel, sigma = [], []
         for g in groups:
             for s in sats:

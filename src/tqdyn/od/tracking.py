@@ -24,8 +24,9 @@ from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
 from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
 from .parameters import STATE_NAMES
 
-__all__ = ["COUPLED_GROUPS", "DEFAULT_SIGMA", "GROUPS", "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS",
-           "Measurements",           "Tracking", "evaluate", "jacobian", "match", "row_order"]
+__all__ = ["COUPLED_GROUPS", "DEFAULT_ESTIMATE", "DEFAULT_ESTIMATE_COUPLED", "DEFAULT_SIGMA", "GROUPS", "KIND_TYPES",
+           "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking", "evaluate", "jacobian", "match",
+           "row_order"]
 
 TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
 MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
@@ -42,7 +43,11 @@ GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETE
           "self_gravity_common": ("sgc_x", "sgc_y", "sgc_z")}
 #: The groups of a coupled run (the others are those of point-mass runs).
 COUPLED_GROUPS = ("state", "self_gravity_common")
+#: The groups estimated when a plan names none: point-mass runs, coupled runs.
+DEFAULT_ESTIMATE = ("state", "s_frame")
+DEFAULT_ESTIMATE_COUPLED = COUPLED_GROUPS
 HELIOCENTRIC_KINDS = ("dsn", "isr")
+
 
 def fail(msg: str):
     raise ValueError(" ".join(msg.split()))
@@ -56,7 +61,8 @@ class Tracking:
     interval, a multiple of ``integrator.step``; sigma: {measurement type: sigma [m or m/s]}
     overriding :data:`DEFAULT_SIGMA`; stations: SLR (:data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`)
     and deep-space (:data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`) station names (None:
-    all of them); estimate, consider: parameter groups (:data:`GROUPS`); a_priori_sigma: {group:
+    all of them); estimate, consider: parameter groups (:data:`GROUPS`; estimate None: the
+    run's defaults, :meth:`estimated`); a_priori_sigma: {group:
     sigma} a priori sigmas per group (``"state"``: (sigma_r [m], sigma_v [m/s]); the acceleration
     groups: [m/s^2]), needed for every considered group; gnss_mode: the GNSS reception mode of
     :func:`~tqdyn.od.measurements_gnss.gnss_visibility`."""
@@ -66,7 +72,7 @@ class Tracking:
     interval_s: float = 600.0
     sigma: dict | None = None
     stations: tuple | None = None
-    estimate: tuple = ("state", "s_frame")
+    estimate: tuple | None = None
     consider: tuple = ()
     a_priori_sigma: dict | None = None
     gnss_mode: str = "sidelobes"
@@ -91,14 +97,16 @@ class Tracking:
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 fail(f"tracking.sigma[{key!r}] = {v!r}; allowed: a finite number > 0 (m or m/s)")
         for name in ("estimate", "consider"):
+            if getattr(self, name) is None and name == "estimate":
+                continue
             groups = (getattr(self, name),) if isinstance(getattr(self, name), str) else tuple(getattr(self, name))
             for g in groups:
                 if g not in GROUPS:
                     fail(f"tracking.{name}: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
             object.__setattr__(self, name, groups)
-        if not self.estimate:
+        if self.estimate is not None and not self.estimate:
             fail(f"tracking.estimate: empty; allowed: groups of {', '.join(GROUPS)}")
-        both = set(self.estimate) & set(self.consider)
+        both = set(self.estimate or ()) & set(self.consider)
         if both:
             fail(f"tracking.consider: {sorted(both)[0]!r} is also estimated; a group is estimated or considered")
         for g, v in (self.a_priori_sigma or {}).items():
@@ -118,6 +126,13 @@ class Tracking:
                     fail(f"tracking.stations: {s!r} is not allowed; allowed: SLR "
                          f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
             object.__setattr__(self, "stations", st)
+
+    def estimated(self, coupled: bool) -> tuple:
+        """The estimated groups: ``estimate``, or when None :data:`DEFAULT_ESTIMATE` (coupled runs:
+        :data:`DEFAULT_ESTIMATE_COUPLED`) without the considered groups."""
+        if self.estimate is not None:
+            return self.estimate
+        return tuple(g for g in (DEFAULT_ESTIMATE_COUPLED if coupled else DEFAULT_ESTIMATE) if g not in self.consider)
 
     @property
     def types(self) -> tuple:

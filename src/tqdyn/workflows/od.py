@@ -259,7 +259,8 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
              "time_scale": scen.reference.time_scale, "tdm_file": pathlib.Path(tdm).name,
              "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
              "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
-                                     "estimate": list(plan.estimate), "consider": list(plan.consider)})}
+                                     "estimate": list(_problem().estimated_groups(scen, plan)),
+                                     "consider": list(plan.consider)})}
     if out is not None:
         say("writing")
         write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
@@ -308,7 +309,8 @@ def covariance_record(cov, scen, plan) -> dict:
 
     return {"scenario": scen.name, "epoch": scen.epoch.iso, "time_scale": scen.reference.time_scale,
             "tracking": {"kinds": list(plan.kinds), "arc_s": float(plan.arc_s), "interval_s": float(plan.interval_s),
-                         "estimate": list(plan.estimate), "consider": list(plan.consider)},
+                         "estimate": list(_problem().estimated_groups(scen, plan)),
+                         "consider": list(plan.consider)},
             "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
             "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
             "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
