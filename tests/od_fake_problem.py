@@ -21,6 +21,8 @@ from tqdyn.od.estimator import Parameters, Problem, covariance_analysis, estimat
 
 TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
 MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
+BIAS_TYPES = ("slr_range", "isr_range", "dsn_range", "dsn_range_rate")
+GROUPS = {"state": ("x",), "s_frame": ("s_x",), "bias": ()}
 HORIZON_MESSAGE = ("tracking.stations: 'Nowhere' is below the 20 deg elevation mask for the whole arc; "
                    "allowed: a station that sees a satellite")
 _ROWS = {"gnss": [("gnss_pseudorange", "G07", 3.0)], "slr": [("slr_range", "Yarragadee", 0.01)],
@@ -37,6 +39,7 @@ class Tracking:
     stations: tuple | None = None
     estimate: tuple = ("state", "s_frame")
     consider: tuple = ()
+    a_priori_sigma: dict | None = None
 
 
 @dataclass
@@ -85,10 +88,13 @@ def compute(scenario, parameters, meas):
     return jac @ np.asarray(parameters, np.float64), jac, names(scenario)
 
 
-def simulate(scenario, tracking, truth=None, seed=0) -> Measurements:
+def simulate(scenario, tracking, truth=None, seed=0, *, bias=None) -> Measurements:
+    """Simulated values; bias {measurement type: value} added to the rows of that type."""
     meas = schedule(scenario, tracking)
     q = np.tile(TRUTH, len(scenario.satellites))
     meas.value = design(scenario, meas) @ q + meas.sigma * np.random.default_rng(seed).standard_normal(len(meas.t))
+    for typ, v in (bias or {}).items():
+        meas.value[meas.type == typ] += v
     return meas
 
 

@@ -114,6 +114,14 @@ def _bad_tdm(tmp_path):
     ("estimate", r"tracking.estimate: 'bogus' is not a parameter group"),
     ("header", r"good.tdm: header: tqdyn arc_s = 'long'; allowed: a number of seconds > 0"),
     ("arc-format", r"--arc: 'week' is not a duration"),
+    ("bias-type", r"--bias: 'gnss_pseudorange' is not allowed; allowed: slr_range, isr_range, dsn_range, "
+                  r"dsn_range_rate"),
+    ("bias-value", r"--bias: slr_range = 'abc' is not allowed; allowed: a finite number"),
+    ("bias-form", r"--bias: 'slr_range' is not allowed; allowed: TYPE=VALUE or TYPE/STATION=VALUE"),
+    ("consider", r"--consider: 's_frame' needs an a priori sigma; allowed: with --a-priori s_frame=SIGMA"),
+    ("a-priori-group", r"--a-priori: 'j2' is not allowed; allowed: state, s_frame"),
+    ("a-priori-state", r"--a-priori: state = '1' is not allowed; allowed: SIGMA_R,SIGMA_V \(m, m/s\)"),
+    ("a-priori-value", r"--a-priori: bias = '-1' is not allowed; allowed: a finite number > 0"),
 ])
 def test_refusals_are_one_line_and_write_nothing(run_file, tmp_path, capsys, case, pattern):
     """Bad input: exit status 2, one line on stderr, no file at the output path (nor a temporary one)."""
@@ -132,7 +140,11 @@ def test_refusals_are_one_line_and_write_nothing(run_file, tmp_path, capsys, cas
             "sim-output-is-input": sim[:-1] + [str(run_file)], "fit-output-is-input": fit[:-1] + [str(good)],
             "malformed": ["od", "fit", str(run_file), str(_bad_tdm(tmp_path)), "--output", str(out)],
             "foreign": fit, "header": fit, "estimate": fit + ["--estimate", "state,bogus"],
-            "arc-format": sim[:6] + ["week"] + sim[7:]}[case]
+            "arc-format": sim[:6] + ["week"] + sim[7:], "bias-type": sim + ["--bias", "gnss_pseudorange=1"],
+            "bias-value": sim + ["--bias", "slr_range=abc"], "bias-form": sim + ["--bias", "slr_range"],
+            "consider": fit + ["--estimate", "state", "--consider", "s_frame"],
+            "a-priori-group": fit + ["--a-priori", "j2=1"], "a-priori-state": fit + ["--a-priori", "state=1"],
+            "a-priori-value": fit + ["--a-priori", "bias=-1"]}[case]
     before = sorted(p.name for p in tmp_path.iterdir())
     status, _, err = run_cli(argv, capsys)
     assert status == 2

@@ -11,6 +11,7 @@ errors of a linear(ised) least-squares estimate with Gaussian noise (Tapley, Sch
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -203,6 +204,15 @@ def test_lisa_dsn_and_isr_covariance():
      "allowed: state, self_gravity_common"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, estimate=("state", "self_gravity_common"))),
      "tracking: group 'self_gravity_common' needs a coupled scenario"),
+    (lambda: odp.covariance(SCEN, odp.Tracking(("gnss",), DAY / 2, 3600.0, estimate=("state", "s_frame", "bias"))),
+     "tracking: group 'bias' but no measurement of slr_range, isr_range, dsn_range, dsn_range_rate"),
+    (lambda: odp.covariance(SCEN, odp.Tracking(("slr", "isr"), DAY / 2, 3600.0, consider=("bias",),
+                                               a_priori_sigma={"bias": {"slr_range": 0.02}})),
+     re.escape("tracking.a_priori_sigma['bias']: no sigma for 'isr_range', whose biases are considered")),
+    (lambda: odp.simulate(SCEN, odp.Tracking(("slr",), DAY / 2, 3600.0), bias={"slr_range/Nowhere": 1.0}),
+     "bias: 'slr_range/Nowhere' is not a bias of these measurements; allowed: a type of"),
+    (lambda: odp.Tracking(("slr",), DAY, a_priori_sigma={"bias": {"gnss_pseudorange": 1.0}}),
+     re.escape("tracking.a_priori_sigma['bias']: 'gnss_pseudorange' is not allowed")),
     (lambda: odp.nominal_parameters(load_scenario("tianqin", ["constellation.free_tms=true"])),
      "constellation.free_tms = true propagates the test masses"),
     (lambda: odp.fit(SCEN, odp.schedule(SCEN, odp.Tracking(("isr",), 3600.0, 600.0)),

@@ -3,8 +3,10 @@
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.od`: bad input (an unknown
 tracking type, an arc outside the run, a malformed TDM, a station below the horizon for the whole
 arc, an output path that is an input, an unobservable fit, a ``--figure`` that is not a writable
-``.png`` or ``.pdf``) exits with status 2 and one line, nothing written; Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages
-show as a progress bar on stderr (``--quiet``: none).
+``.png`` or ``.pdf``, a ``--bias`` or ``--a-priori`` that is not TYPE=VALUE / GROUP=SIGMA, a
+considered group without an a priori sigma) exits with status 2 and one line, nothing written;
+Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages show as a
+progress bar on stderr (``--quiet``: none).
 """
 
 from __future__ import annotations
@@ -95,17 +97,21 @@ def od():
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
+@click.option("--bias", "biases", multiple=True, metavar="TYPE[/PEER]=VALUE",
+              help="A constant measurement bias (m; m/s for dsn_range_rate) added to every station or link of a "
+                   "type (slr_range, isr_range, dsn_range, dsn_range_rate) or to one (slr_range/Graz, "
+                   "isr_range/Sat2->Sat1); repeatable.")
 @click.option("--output", "-o", required=True, help="Output measurement file (CCSDS TDM, KVN).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def simulate(run_file, tracking, arc, seed, interval, stations, output, sets, quiet):
+def simulate(run_file, tracking, arc, seed, interval, stations, biases, output, sets, quiet):
     """Simulate the measurements of a tracking plan on the run RUN.h5: its recorded scenario, with its
     [accelerations] and initial states as the truth, seeded white noise; written as a CCSDS TDM."""
     from ..workflows import od as wf
 
     stages = _Stages(("scheduling", "simulating", "writing"), quiet, "od simulate")
     s = _run(lambda: wf.simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval,
-                                        stations=stations, overrides=sets, progress=stages), stages)
+                                        stations=stations, bias=biases, overrides=sets, progress=stages), stages)
     _notes(s.notes)
     counts = ", ".join(f"{n} {t}" for t, n in s.counts.items())
     click.echo(f"measurements: {sum(s.counts.values())} ({counts}) over {s.tracking.arc_s:g} s, seed {seed}")
@@ -119,18 +125,22 @@ def simulate(run_file, tracking, arc, seed, interval, stations, output, sets, qu
 @click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "
               "coupled runs: state,self_gravity_common].")
 @click.option("--consider", help="Parameter groups to consider (not estimated, their uncertainty kept).")
+@click.option("--a-priori", "a_priori", multiple=True, metavar="GROUP=SIGMA",
+              help="A priori 1-sigma of a parameter group (state=SIGMA_R,SIGMA_V in m, m/s; bias=SIGMA or "
+                   "bias/TYPE=SIGMA in m or m/s; the acceleration groups in m/s^2); needed for --consider; "
+                   "repeatable.")
 @click.option("--edit-sigma", type=float, help="Leave out measurements beyond K normalised sigmas (off by default).")
 @click.option("--figure", help="Also draw the normalised post-fit residuals and their histogram (.png or .pdf).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def fit(scenario, tdm, output, estimate, consider, edit_sigma, figure, sets, quiet):
+def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, figure, sets, quiet):
     """Fit SCENARIO (a built-in name, a TOML file or a run file) to the measurements MEAS.tdm by batch
     least squares; print each estimated parameter with its 1-sigma, and chi^2/dof."""
     from ..workflows import od as wf
 
     stages = _Stages(("reading", "fitting", "writing") + (("plotting",) if figure else ()), quiet, "od fit")
     est, _, notes = _run(lambda: wf.fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider,
-                                                edit_sigma=edit_sigma, overrides=sets, figure=figure,
+                                                a_priori=a_priori, edit_sigma=edit_sigma, overrides=sets, figure=figure,
                                                 progress=stages), stages)
     _notes(notes)
     units = [wf.parameter_unit(n) for n in est.names]
@@ -153,19 +163,23 @@ def fit(scenario, tdm, output, estimate, consider, edit_sigma, figure, sets, qui
 @click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "
               "coupled runs: state,self_gravity_common].")
 @click.option("--consider", help="Parameter groups to consider (not estimated, their uncertainty kept).")
+@click.option("--a-priori", "a_priori", multiple=True, metavar="GROUP=SIGMA",
+              help="A priori 1-sigma of a parameter group (state=SIGMA_R,SIGMA_V in m, m/s; bias=SIGMA or "
+                   "bias/TYPE=SIGMA in m or m/s; the acceleration groups in m/s^2); needed for --consider; "
+                   "repeatable.")
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
 @click.option("--json", "json_out", help="Also write the covariance as JSON to this file.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def covariance(scenario, tracking, arc, interval, estimate, consider, stations, json_out, sets, quiet):
+def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, stations, json_out, sets, quiet):
     """Predict, without measurements, how well a tracking plan determines SCENARIO's parameters: the
     1-sigma of each (and with --consider the consider sigma)."""
     from ..workflows import od as wf
 
     stages = _Stages(("covariance", "writing") if json_out else ("covariance",), quiet, "od covariance")
     cov, _, notes = _run(lambda: wf.covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate,
-                                                  consider=consider, stations=stations, overrides=sets, json_out=json_out,
-                                                  progress=stages), stages)
+                                                  consider=consider, a_priori=a_priori, stations=stations,
+                                                  overrides=sets, json_out=json_out, progress=stages), stages)
     _notes(notes)
     units = [wf.parameter_unit(n) for n in cov.names]
     click.echo("\n".join(summary_lines(cov.names, None, cov.sigma, units,

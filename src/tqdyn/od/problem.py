@@ -54,6 +54,7 @@ station that never sees a satellite over the arc, a tracking kind without any vi
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 from scipy import linalg, sparse
@@ -62,14 +63,14 @@ from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
 from . import coupled, estimator
 from .parameters import OrbitParameters, parameter_names, state_names
-from .tracking import (COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES, MEASUREMENT_TYPES,
-                       TRACKING_KINDS, Measurements, Tracking, evaluate, fail, is_heliocentric, jacobian, match,
-                       row_order)
+from .tracking import (BIAS_TYPES, COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES,
+                       MEASUREMENT_TYPES, TRACKING_KINDS, Measurements, Tracking, bias_design, bias_keys, bias_type,
+                       evaluate, fail, is_heliocentric, jacobian, match, row_order)
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
-           "build_problem", "compute", "covariance", "estimated_groups", "fit", "nominal_parameters", "residual_rows",
-           "schedule", "simulate", "with_measurements"]
+           "build_problem", "compute", "covariance", "estimated_groups", "fit", "measurement_biases",
+           "nominal_parameters", "residual_rows", "schedule", "simulate", "with_measurements"]
 
 #: Largest step [s] of the float64 variational equations on geocentric runs (DP87 on TianQin's
 #: 3.6-day orbit: the partials agree with dd differences to ~1e-10 at 600 s).
@@ -212,15 +213,41 @@ def schedule(scenario, tracking: Tracking) -> Measurements:
     return _measurements(scen, tracking, t, y[..., 0] + y[..., 1])[0]
 
 
+def measurement_biases(scen, meas: Measurements, bias: dict) -> np.ndarray:
+    """The bias (m,) [m or m/s] of each measurement row from ``bias`` {key: value}: a key is a
+    measurement type of :data:`BIAS_TYPES` (every station or link of it), or a bias parameter's
+    name with or without its ``"bias/"`` prefix (``"slr_range/Yarragadee"``,
+    ``"isr_range/Sat2->Sat1"``: one of them; it overrides its type's value)."""
+    keys = np.array(bias_keys(meas, [s.name for s in scen.satellites]), dtype=object)
+    out = np.zeros(len(meas))
+    known = sorted(set(keys.tolist()) - {""})
+    for key in sorted(bias, key=lambda k: "/" in k):        # types first, single biases override them
+        v = bias[key]
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
+            fail(f"bias[{key!r}] = {v!r}; allowed: a finite number (m, m/s for dsn_range_rate)")
+        if key in BIAS_TYPES:
+            out[meas.type == key] = v
+            continue
+        name = key if key.startswith("bias/") else f"bias/{key}"
+        if name not in known:
+            fail(f"bias: {key!r} is not a bias of these measurements; allowed: a type of {', '.join(BIAS_TYPES)} "
+                 f"or one of {', '.join(n[5:] for n in known) or '(none)'}")
+        out[keys == name] = v
+    return out
+
+
 def simulate(scenario, tracking: Tracking, truth: OrbitParameters | None = None, seed: int = 0, *,
-             noise: bool = True) -> Measurements:
+             noise: bool = True, bias: dict | None = None) -> Measurements:
     """Simulated measurements: the models on the dd propagation with the ``truth`` parameter
     values (None: the scenario's), visibility from that run, plus white noise of each row's
     sigma and, on GNSS pseudoranges, a receiver clock bias per satellite and epoch (normal,
-    :data:`CLOCK_SIGMA_M`), both from ``numpy.random.default_rng(seed)`` (noise False: neither)."""
+    :data:`CLOCK_SIGMA_M`), both from ``numpy.random.default_rng(seed)`` (noise False: neither),
+    plus the constant measurement biases ``bias`` (:func:`measurement_biases`; None: none)."""
     scen = _scenario(scenario, tracking)
     t, y = propagate_dd(scen, truth, tracking.times())
     meas, value = _measurements(scen, tracking, t, y[..., 0] + y[..., 1])
+    if bias:
+        value = value + measurement_biases(scen, meas, bias)
     if noise:
         rng = np.random.default_rng(seed)
         value = value + meas.sigma * rng.standard_normal(len(meas))
@@ -309,16 +336,33 @@ def residual_rows(meas: Measurements) -> np.ndarray:
     return np.minimum.reduceat(T.indices, T.indptr[:-1]).astype(np.int64)
 
 
-def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori):
-    """Estimated and considered :class:`~tqdyn.od.estimator.Parameters` and their column indices."""
-    names = state_names(scen) + _parameter_names(scen)
-    base = _values(nominal)
+def _bias_sigma(value, name: str) -> float:
+    """The a priori sigma of the bias ``name`` from ``tracking.a_priori_sigma["bias"]`` (a number,
+    or {type: number}; absent: none, inf)."""
+    if isinstance(value, dict):
+        return float(value.get(bias_type(name), np.inf))
+    return float(value)
+
+
+def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori, bias_names=()):
+    """Estimated and considered :class:`~tqdyn.od.estimator.Parameters` and their column indices
+    (columns: the states, the scenario's parameters, then the biases ``bias_names``, nominal 0)."""
+    names = state_names(scen) + _parameter_names(scen) + list(bias_names)
+    base = np.concatenate([_values(nominal), np.zeros(len(bias_names))])
     sats = [s.name for s in scen.satellites]
     sig = tracking.a_priori_sigma or {}
     out = []
     for groups in (tracking.estimated(_coupled(scen)), tracking.consider):
         sel, sigma = [], []
         for g in groups:
+            if g == "bias":
+                sel += [names.index(n) for n in bias_names]
+                sigma += [_bias_sigma(sig.get(g, np.inf), n) for n in bias_names]
+                if groups is tracking.consider and not np.all(np.isfinite(sigma[-len(bias_names):])):
+                    typ = next(bias_type(n) for n in bias_names if not np.isfinite(_bias_sigma(sig[g], n)))
+                    fail(f"tracking.a_priori_sigma['bias']: no sigma for {typ!r}, whose biases are considered; "
+                         f"give one per type of {', '.join(sorted({bias_type(n) for n in bias_names}))}")
+                continue
             for s in sats:
                 for j, pn in enumerate(GROUPS[g]):
                     sel.append(names.index(f"{s}/{pn}"))
@@ -342,18 +386,29 @@ def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori
 
 def _problem(scen, meas: Measurements, tracking: Tracking, a_priori=None, partials: Partials | None = None):
     nominal = nominal_parameters(scen)
-    (est, i_est), (con, i_con) = _parameter_sets(scen, tracking, nominal, a_priori)
+    groups = tracking.estimated(_coupled(scen)) + tracking.consider
+    bias_names, B = bias_design(meas, [s.name for s in scen.satellites]) if "bias" in groups else ([], None)
+    if "bias" in groups and not bias_names:
+        fail(f"tracking: group 'bias' but no measurement of {', '.join(BIAS_TYPES)}; leave it out")
+    (est, i_est), (con, i_con) = _parameter_sets(scen, tracking, nominal, a_priori, bias_names)
     index = np.concatenate([i_est, i_con])
+    n_base = _values(nominal).size
+    base = np.concatenate([_values(nominal), np.zeros(len(bias_names))])
+    orbit = index < n_base
     T, sigma, labels = _clock_elimination(meas)
     cache = {}
 
     def evaluate(q):
-        par = _with_values(nominal, index, q)
-        if partials is not None and np.array_equal(q, _values(nominal)[index]):
+        par = _with_values(nominal, index[orbit], q[orbit])
+        if partials is not None and np.array_equal(q[orbit], base[index[orbit]]):
             ti, h, d, sat2 = match(scen, tracking, partials.t, partials.states, meas)
             H = jacobian(scen, partials, ti, d, meas.sat, sat2)
         else:
             h, H, _ = _compute(scen, tracking, par, meas)
+        if B is not None:
+            b = base[n_base:].copy()
+            b[index[~orbit] - n_base] = q[~orbit]
+            h, H = h + B @ b, np.hstack([H, B])
         return T @ h, np.asarray(T @ H[:, index])
 
     def model(q):

@@ -24,9 +24,9 @@ from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
 from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
 from .parameters import STATE_NAMES
 
-__all__ = ["COUPLED_GROUPS", "DEFAULT_ESTIMATE", "DEFAULT_ESTIMATE_COUPLED", "DEFAULT_SIGMA", "GROUPS", "KIND_TYPES",
-           "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking", "evaluate", "jacobian", "match",
-           "row_order"]
+__all__ = ["BIAS_TYPES", "COUPLED_GROUPS", "DEFAULT_ESTIMATE", "DEFAULT_ESTIMATE_COUPLED", "DEFAULT_SIGMA", "GROUPS",
+           "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking", "bias_design", "bias_keys",
+           "bias_type", "evaluate", "jacobian", "match", "row_order"]
 
 TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
 MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
@@ -37,15 +37,21 @@ KIND_TYPES = {"gnss": ("gnss_pseudorange",), "slr": ("slr_range",), "isr": ("isr
 DEFAULT_SIGMA = {"gnss_pseudorange": GNSS_SIGMA_M, "slr_range": SLR_SIGMA_M, "isr_range": ISR_ABSOLUTE_SIGMA_M,
                  "dsn_range": DSN_RANGE_SIGMA_M, "dsn_range_rate": DSN_DOPPLER_SIGMA_M_S}
 #: Parameter groups: name -> the per-satellite parameter names it holds ("self_gravity_common":
-#: the rows of ``spacecraft.self_gravity_common`` of a coupled run, :mod:`.coupled`).
+#: the rows of ``spacecraft.self_gravity_common`` of a coupled run, :mod:`.coupled`; "bias": the
+#: measurement biases, per station or link rather than per satellite, :func:`bias_design`).
 GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETER_NAMES[3:6],
           "rtn_cos": PARAMETER_NAMES[6:9], "rtn_sin": PARAMETER_NAMES[9:12],
-          "self_gravity_common": ("sgc_x", "sgc_y", "sgc_z")}
-#: The groups of a coupled run (the others are those of point-mass runs).
-COUPLED_GROUPS = ("state", "self_gravity_common")
+          "self_gravity_common": ("sgc_x", "sgc_y", "sgc_z"), "bias": ()}
+#: The groups of a coupled run (the others but "bias" are those of point-mass runs).
+COUPLED_GROUPS = ("state", "self_gravity_common", "bias")
+#: Measurement types with a constant bias parameter (group "bias", :func:`bias_design`): one per
+#: ground station and type (SLR and deep-space: the station's range calibration, its frequency
+#: offset) and one per one-way inter-satellite link (the ranging offsets of its two ends).
+#: GNSS pseudoranges have none: a bias common to a receiver's pseudoranges is its clock.
+BIAS_TYPES = ("slr_range", "isr_range", "dsn_range", "dsn_range_rate")
 #: The groups estimated when a plan names none: point-mass runs, coupled runs.
 DEFAULT_ESTIMATE = ("state", "s_frame")
-DEFAULT_ESTIMATE_COUPLED = COUPLED_GROUPS
+DEFAULT_ESTIMATE_COUPLED = ("state", "self_gravity_common")
 HELIOCENTRIC_KINDS = ("dsn", "isr")
 
 
@@ -112,10 +118,21 @@ class Tracking:
         for g, v in (self.a_priori_sigma or {}).items():
             if g not in GROUPS:
                 fail(f"tracking.a_priori_sigma: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
+            if g == "bias" and isinstance(v, dict):
+                for typ, x in v.items():
+                    if typ not in BIAS_TYPES:
+                        fail(f"tracking.a_priori_sigma['bias']: {typ!r} is not allowed; allowed: "
+                             f"{', '.join(BIAS_TYPES)}")
+                    if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
+                        fail(f"tracking.a_priori_sigma['bias'][{typ!r}] = {x!r}; allowed: a finite number > 0 "
+                             f"(m, m/s for dsn_range_rate)")
+                continue
             vals = np.atleast_1d(np.asarray(v, np.float64))
             if vals.shape != ((2,) if g == "state" else (1,)) or not np.all(vals > 0):
                 fail(f"tracking.a_priori_sigma[{g!r}] = {v!r}; allowed: "
-                     + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else "a number > 0 (m/s^2)"))
+                     + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else
+                        "a number > 0 (m, m/s for dsn_range_rate) or {type: number}" if g == "bias" else
+                        "a number > 0 (m/s^2)"))
         for g in self.consider:
             if g not in (self.a_priori_sigma or {}):
                 fail(f"tracking.consider: {g!r} has no a priori sigma; give tracking.a_priori_sigma[{g!r}]")
@@ -250,6 +267,40 @@ def evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[
                          np.tile(np.array([str(e) for e in emi], object), n), o.value.ravel(),
                          o.visible.ravel(), d, np.tile(emi, n)))
     return out
+
+
+def bias_keys(meas: "Measurements", satellite_names) -> list[str]:
+    """The name of the bias parameter of each measurement row: ``"bias/<type>/<station>"`` (SLR,
+    deep-space), ``"bias/isr_range/<emitter>-><receiver>"`` (satellite names); "" for a type
+    without a bias (:data:`BIAS_TYPES`)."""
+    out = []
+    for mtype, sat, peer in zip(meas.type.tolist(), meas.sat.tolist(), meas.peer.tolist()):
+        if mtype not in BIAS_TYPES:
+            out.append("")
+        elif mtype == "isr_range":
+            out.append(f"bias/{mtype}/{satellite_names[int(peer)]}->{satellite_names[int(sat)]}")
+        else:
+            out.append(f"bias/{mtype}/{peer}")
+    return out
+
+
+def bias_type(name: str) -> str:
+    """The measurement type of a bias parameter's name (:func:`bias_keys`)."""
+    return name.split("/")[1]
+
+
+def bias_design(meas: "Measurements", satellite_names) -> tuple[list[str], np.ndarray]:
+    """The bias parameters of the measurement rows and their partials: names (nb) in the order of
+    first appearance (:func:`bias_keys`) and B (m, nb), 1 where a row carries the bias [unit of the
+    row per unit of the bias]."""
+    keys = bias_keys(meas, satellite_names)
+    names = list(dict.fromkeys(k for k in keys if k))
+    col = {n: j for j, n in enumerate(names)}
+    B = np.zeros((len(keys), len(names)))
+    for i, k in enumerate(keys):
+        if k:
+            B[i, col[k]] = 1.0
+    return names, B
 
 
 def row_order(t, types, sat, peer) -> np.ndarray:

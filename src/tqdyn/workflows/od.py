@@ -69,6 +69,80 @@ def parse_names(text, option: str) -> tuple[str, ...]:
     return tuple(s.strip() for s in items if s.strip())
 
 
+def _key_values(items, option: str, what: str):
+    """``KEY=VALUE`` strings (or a mapping) -> [(key, value text)]; ValueError (one line) otherwise."""
+    if isinstance(items, dict):
+        return [(str(k), v) for k, v in items.items()]
+    out = []
+    for item in ([items] if isinstance(items, str) else list(items or ())):
+        key, sep, value = str(item).rpartition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise ValueError(f"{option}: {item!r} is not allowed; allowed: {what}")
+        out.append((key.strip(), value.strip()))
+    return out
+
+
+def _number(text, option: str, key: str, positive: bool) -> float:
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        v = math.nan
+    if isinstance(text, bool) or not math.isfinite(v) or (positive and v <= 0):
+        raise ValueError(f"{option}: {key} = {text!r} is not allowed; allowed: a finite number"
+                         + (" > 0" if positive else ""))
+    return v
+
+
+def parse_biases(items, option: str = "--bias") -> dict:
+    """``TYPE=VALUE`` or ``TYPE/PEER=VALUE`` (repeated; or a mapping) -> {key: value [m, m/s for
+    dsn_range_rate]}, the measurement biases of ``tqdyn.od``'s ``problem.simulate``."""
+    allowed = _problem().BIAS_TYPES
+    out = {}
+    for key, value in _key_values(items, option, "TYPE=VALUE or TYPE/STATION=VALUE"):
+        if key.removeprefix("bias/").split("/")[0] not in allowed:
+            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(allowed)} "
+                             f"(or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
+        out[key] = _number(value, option, key, positive=False)
+    return out
+
+
+def parse_a_priori(items, option: str = "--a-priori") -> dict:
+    """``GROUP=SIGMA`` (``state=SIGMA_R,SIGMA_V``, ``bias=SIGMA`` or ``bias/TYPE=SIGMA``; repeated, or a
+    mapping such as {"state": (100.0, 0.01), "bias": {"slr_range": 0.02}}) -> ``Tracking.a_priori_sigma``
+    {group: sigma} [m, m/s, m/s^2]."""
+    groups = _problem().GROUPS
+    pairs = []
+    for key, value in _key_values(items, option, "GROUP=SIGMA (state=SIGMA_R,SIGMA_V)"):
+        if key == "bias" and isinstance(value, dict):
+            pairs += [(f"bias/{t}", v) for t, v in value.items()]
+        else:
+            pairs.append((key, ",".join(str(v) for v in value) if isinstance(value, (list, tuple)) else value))
+    out: dict = {}
+    for key, value in pairs:
+        group, _, typ = key.partition("/")
+        if group not in groups or (typ and (group != "bias" or typ not in _problem().BIAS_TYPES)):
+            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(groups)} (or bias/TYPE, TYPE "
+                             f"one of {', '.join(_problem().BIAS_TYPES)})")
+        parts = value.split(",") if isinstance(value, str) else [value]
+        if len(parts) != (2 if group == "state" else 1):
+            raise ValueError(f"{option}: {key} = {value!r} is not allowed; allowed: "
+                             + ("SIGMA_R,SIGMA_V (m, m/s)" if group == "state" else "one number"))
+        sig = [_number(x, option, key, positive=True) for x in parts]
+        if group == "bias" and "bias" in out and bool(typ) != isinstance(out["bias"], dict):
+            raise ValueError(f"{option}: bias is given with and without a type; allowed: one of the two")
+        if typ:
+            out.setdefault("bias", {})[typ] = sig[0]
+        else:
+            out[group] = tuple(sig) if group == "state" else sig[0]
+    return out
+
+
+def _check_consider(con_names, a_priori: dict) -> None:
+    for g in con_names:
+        if g not in a_priori:
+            raise ValueError(f"--consider: {g!r} needs an a priori sigma; allowed: with --a-priori {g}=SIGMA")
+
+
 def parse_arc(value, option: str = "--arc") -> float:
     """A duration (seconds, or ``7d``, ``12h``, ``30min`` as ``--duration`` takes it) -> seconds > 0."""
     from ..scenario import ScenarioError
@@ -87,10 +161,13 @@ def parse_arc(value, option: str = "--arc") -> float:
 def parameter_unit(name: str) -> str:
     """The unit of an estimated parameter from its name ``"<sat>/<component>"``: the initial state's
     x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters and a coupled run's common
-    self-gravity [m/s^2]; "" otherwise."""
+    self-gravity [m/s^2], the measurement biases ``"bias/<type>/..."`` [m, m/s for range rates];
+    "" otherwise."""
     from ..od.coupled import COMMON_NAMES
     from ..od.parameters import PARAMETER_NAMES, STATE_NAMES
 
+    if name.startswith("bias/"):
+        return "m/s" if name.split("/")[1] == "dsn_range_rate" else "m"
     last = name.rsplit("/", 1)[-1]
     if last in STATE_NAMES:
         return "m" if last in STATE_NAMES[:3] else "m/s"
@@ -157,13 +234,15 @@ def _interval(value) -> float | None:
     return None if value is None else parse_arc(value, "--interval")
 
 
-def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, overrides=(),
-                    progress: Callable[[str], None] | None = None) -> SimulateSummary:
+def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
+                    overrides=(), progress: Callable[[str], None] | None = None) -> SimulateSummary:
     """Simulate the measurements of ``tracking`` (kinds) over ``arc`` from the run file's scenario (its
     ``[accelerations]`` are the truth) with noise seed ``seed``, and write them as a TDM to ``output``.
-    stations: ground-station names (None: the plan's defaults)."""
+    stations: ground-station names (None: the plan's defaults); bias: constant measurement biases
+    (:func:`parse_biases`; None: none), recorded in the TDM's header."""
     say = progress or (lambda stage: None)
     kinds = parse_tracking(tracking)
+    biases = parse_biases(bias)
     arc_s = parse_arc(arc)
     interval_s = _interval(interval)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
@@ -180,10 +259,12 @@ def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=
     say("scheduling")
     p.schedule(scen, plan)  # visibility refusals (a station below the horizon) before the simulation
     say("simulating")
-    meas = p.simulate(scen, plan, None, seed)
+    meas = p.simulate(scen, plan, None, seed, bias=biases)
     info = {"tracking": ",".join(kinds), "arc_s": repr(arc_s), "interval_s": repr(float(plan.interval_s)),
             "seed": str(seed), "scenario": scen.name, "run_file": pathlib.Path(run_file).name,
             "run_sha256": file_sha256(run_file)}
+    if biases:
+        info["bias"] = json.dumps(biases)
     if plan.stations is not None:
         info["stations"] = ",".join(plan.stations)
     say("writing")
@@ -209,16 +290,19 @@ def _header_number(info: dict, key: str, tdm) -> float:
     return v
 
 
-def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edit_sigma=None, overrides=(),
-                figure=None, progress: Callable[[str], None] | None = None, **options):
+def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_priori=None, edit_sigma=None,
+                overrides=(), figure=None, progress: Callable[[str], None] | None = None, **options):
     """Fit the scenario's parameters (``estimate``, ``consider``: names of parameter groups, default
     the plan's) to the measurements of the TDM ``tdm``; write the estimate file ``output`` (None: no
     file) and the residuals' figure ``figure`` (None: none; PNG or PDF by its suffix,
-    :func:`tqdyn.analysis.figures_od.plot_od_residuals`, checked before the fit).  Returns
+    :func:`tqdyn.analysis.figures_od.plot_od_residuals`, checked before the fit).  a_priori: a
+    priori sigmas per group (:func:`parse_a_priori`), needed for each considered group.  Returns
     (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
     :func:`tqdyn.od.estimator.estimate` with ``edit_sigma``."""
     say = progress or (lambda stage: None)
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
+    sig = parse_a_priori(a_priori)
+    _check_consider(con_names, sig)
     if edit_sigma is not None and not (isinstance(edit_sigma, (int, float)) and edit_sigma > 0):
         raise ValueError(f"--edit-sigma: {edit_sigma!r} is not allowed; allowed: a number > 0")
     if not os.path.isfile(os.fspath(tdm)):
@@ -247,7 +331,8 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
     arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
     _check_arc(scen, arc_s, label)
     interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
-    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, **_stations(info.get("stations")))
+    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
+                     **_stations(info.get("stations")))
     meas = _measurements(fields)
     say("fitting")
     if edit_sigma is not None:
@@ -260,7 +345,7 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
              "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
              "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
                                      "estimate": list(_problem().estimated_groups(scen, plan)),
-                                     "consider": list(plan.consider)})}
+                                     "consider": list(plan.consider), "a_priori_sigma": sig})}
     if out is not None:
         say("writing")
         write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
@@ -277,20 +362,24 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, edi
     return fit, scen, tuple(notes)
 
 
-def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, stations=None,
-                  overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
+def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, a_priori=None,
+                  stations=None, overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
     """The predicted covariance (:class:`tqdyn.od.estimator.Covariance`) of the tracking plan on the
-    scenario, and (optionally) its JSON file ``json_out``.  Returns (covariance, scenario, notes)."""
+    scenario (a_priori: as :func:`fit_to_file`), and (optionally) its JSON file ``json_out``.
+    Returns (covariance, scenario, notes)."""
     say = progress or (lambda stage: None)
     kinds = parse_tracking(tracking)
     arc_s = parse_arc(arc)
     interval_s = _interval(interval)
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
+    sig = parse_a_priori(a_priori)
+    _check_consider(con_names, sig)
     inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
     out = _check_output(json_out, "--json", inputs) if json_out is not None else None
     scen, notes, label = _scenario(scenario, overrides)
     _check_arc(scen, arc_s, label)
-    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, **_stations(stations))
+    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
+                     **_stations(stations))
     say("covariance")
     cov = _problem().covariance(scen, plan)
     if out is not None:
@@ -310,7 +399,7 @@ def covariance_record(cov, scen, plan) -> dict:
     return {"scenario": scen.name, "epoch": scen.epoch.iso, "time_scale": scen.reference.time_scale,
             "tracking": {"kinds": list(plan.kinds), "arc_s": float(plan.arc_s), "interval_s": float(plan.interval_s),
                          "estimate": list(_problem().estimated_groups(scen, plan)),
-                         "consider": list(plan.consider)},
+                         "consider": list(plan.consider), "a_priori_sigma": plan.a_priori_sigma or {}},
             "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
             "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
             "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
