@@ -8,6 +8,7 @@ the epochs of a geocentric run; bit equality for the round trips.
 
 from __future__ import annotations
 
+import datetime
 import types
 from decimal import Decimal
 
@@ -207,3 +208,69 @@ def test_interrupted_estimate_write_leaves_nothing(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         write_estimate_file(tmp_path / "est.h5", est, meas, attrs={})
     assert list(tmp_path.iterdir()) == []
+
+
+def _ccsds_ndm_segments(path):
+    """The segments of a TDM as the PyPI package ccsds-ndm (an independent reader generated from the
+    CCSDS schemas) parses them."""
+    ndm_io = pytest.importorskip("ccsds_ndm.ndm_io")
+    import pathlib
+
+    return ndm_io.NdmIo().from_path(pathlib.Path(path)).body.segment
+
+
+def _text(v) -> str:
+    """An enumeration member's value or a plain string (ccsds-ndm returns either)."""
+    return str(getattr(v, "value", v))
+
+
+def test_tdm_read_by_ccsds_ndm(tmp_path):
+    """A measurement file of tqdyn parsed by ccsds-ndm 3.1 (its KVN reader): one segment per
+    (type, satellite, peer, sigma); TIME_SYSTEM, the participants, PATH, MODE, RANGE_UNITS (of the
+    ranges) and TIMETAG_REF as the table of docs/orbit-determination.md says; every epoch as written and every
+    value (km, km/s) equal to the table's m, m/s / 1000 to the float64 rounding of ccsds-ndm's parse
+    of the decimal (1 ulp), every epoch the TT of the UTC epoch + t (TT - UTC = 64.184 s in 2004)."""
+    meas = _table()
+    names = ["TQ1", "TQ2", "TQ3"]
+    path = write_measurements_tdm(tmp_path / "m.tdm", meas, epoch=EPOCH, time_scale="TT", satellite_names=names)
+    segs = _ccsds_ndm_segments(path)
+    keys = list(dict.fromkeys(zip(meas.type.tolist(), meas.sat.tolist(), meas.peer.tolist(), meas.sigma.tolist())))
+    assert len(segs) == len(keys)
+    paths = {"gnss_pseudorange": "1,2", "isr_range": "1,2", "slr_range": "1,2,1", "dsn_range": "1,2,1",
+             "dsn_range_rate": "1,2,1"}
+    for seg, (typ, sat, peer, sig) in zip(segs, keys):
+        md = seg.metadata
+        rows = (meas.type == typ) & (meas.sat == sat) & (meas.peer == peer)
+        assert _text(md.time_system) == "TT" and _text(md.mode) == "SEQUENTIAL"
+        assert md.participant_2 == names[sat]
+        assert md.participant_1 == (names[int(peer)] if typ == "isr_range" else peer)
+        assert md.path == paths[typ]
+        assert _text(md.range_units) == ("None" if typ == "dsn_range_rate" else "km")
+        assert (md.timetag_ref is None) == (paths[typ] == "1,2,1")
+        obs = seg.data.observation
+        value = np.array([(o.doppler_instantaneous if typ == "dsn_range_rate" else o.range) for o in obs]) * 1e3
+        assert np.allclose(value, meas.value[rows], rtol=4.5e-16, atol=0), typ
+        tt0 = datetime.datetime(2004, 6, 6, 0, 1, 4, 184000)     # the UTC epoch + 32 s + 32.184 s
+        want = [(tt0 + datetime.timedelta(seconds=float(x))).strftime("%Y-%m-%dT%H:%M:%S.%f") + "000"
+                for x in meas.t[rows]]
+        assert [o.epoch for o in obs] == want
+
+
+def test_tdm_written_by_ccsds_ndm_is_read(tmp_path):
+    """The same file written back by ccsds-ndm (its own KVN layout: aligned keywords, blank lines,
+    its float formatting) is read by tqdyn: types, satellites, peers, sigmas and time tags exactly,
+    values to the 1-ulp rounding of ccsds-ndm's km floats."""
+    pytest.importorskip("ccsds_ndm")
+    from ccsds_ndm.mapping import NDMFileFormats
+    from ccsds_ndm.ndm_io import NdmIo
+
+    meas = _table()
+    path = write_measurements_tdm(tmp_path / "m.tdm", meas, epoch=EPOCH, time_scale="TT",
+                                  satellite_names=["TQ1", "TQ2", "TQ3"])
+    other = tmp_path / "ndm.tdm"
+    NdmIo().to_file(NdmIo().from_path(path), NDMFileFormats.KVN, other)
+    assert other.read_text() != path.read_text()
+    fields, _ = read_measurements_tdm(other, epoch=EPOCH, time_scale="TT")
+    for f in ("t", "type", "sat", "peer", "sigma"):
+        assert np.array_equal(fields[f], getattr(meas, f)), f
+    assert np.allclose(fields["value"], meas.value, rtol=4.5e-16, atol=0)

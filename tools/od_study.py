@@ -3,7 +3,8 @@
 For TianQin (tianqin-gravity) and LISA (lisa-gravity), the formal 1-sigma of each satellite's
 DC self-gravity per S axis (the S-frame constant acceleration, estimated together with the
 initial states, no a priori) against the arc length, for each tracking plan, by covariance
-analysis (tqdyn.od.problem.covariance: measurement noise only, no data).  One propagation with
+analysis (tqdyn.od.problem.covariance: measurement noise only, no data; for TianQin also with
+constant measurement biases considered, :data:`TIANQIN_BIAS_SIGMA`).  One propagation with
 partials over the longest arc is shared by every plan and arc of a mission.
 
 Usage:
@@ -35,10 +36,17 @@ PAPER_SHIFT_KM = 100.0
 #: reported with their sigmas, beyond it as unobservable.
 MAX_CONDITION = 1e12
 
+#: Measurement biases considered in the plan "combined_biases" (one per SLR station, one per one-way
+#: inter-satellite link; tqdyn.od.problem's group "bias") [m]: SLR 1 cm, the order of the ILRS
+#: stations' systematic range errors (mm to cm: Luceri et al. 2019, J. Geod. 93, 2357); ISR 0.5 m,
+#: the absolute-ranging sigma itself (an assumption).
+TIANQIN_BIAS_SIGMA = {"slr_range": 0.01, "isr_range": 0.5}
+
 MISSIONS = {
     "tianqin": {"scenario": "tianqin-gravity", "interval_s": 1800.0, "arcs_days": [1, 2, 4, 7, 14, 30],
                 "plans": {"gnss": ("gnss",), "slr": ("slr",), "isr": ("isr",),
-                          "combined": ("gnss", "slr", "isr")}},
+                          "combined": ("gnss", "slr", "isr"), "combined_biases": ("gnss", "slr", "isr")},
+                "bias_sigma": {"combined_biases": TIANQIN_BIAS_SIGMA}},
     "lisa": {"scenario": "lisa-gravity", "interval_s": 21600.0, "arcs_days": [1, 2, 4, 7, 14, 30, 90],
              "plans": {"dsn": ("dsn",), "isr": ("isr",), "combined": ("dsn", "isr")}},
 }
@@ -53,10 +61,14 @@ def _study(mission: str, cfg: dict, quick: bool) -> dict:
     out = {"scenario": cfg["scenario"], "interval_s": cfg["interval_s"], "arcs_days": arcs,
            "propagation_wall_s": time.perf_counter() - t0, "plans": {}}
     for plan, kinds in cfg["plans"].items():
+        bias = cfg.get("bias_sigma", {}).get(plan)
         res = {"kinds": list(kinds), "sigma": [], "sigma_x_max": [], "sigma_y_max": [], "sigma_z_max": [],
                "common_y": [], "orbit_90d_m": [], "condition_number": [], "status": []}
+        if bias:
+            res["consider_bias_sigma"] = dict(bias)
         for arc in arcs:
-            tr = odp.Tracking(kinds, arc * DAY, cfg["interval_s"], estimate=("state", "s_frame"))
+            extra = {"consider": ("bias",), "a_priori_sigma": {"bias": bias}} if bias else {}
+            tr = odp.Tracking(kinds, arc * DAY, cfg["interval_s"], estimate=("state", "s_frame"), **extra)
             try:
                 c = odp.covariance(cfg["scenario"], tr, partials=p, max_condition=MAX_CONDITION)
             except ValueError as exc:
@@ -69,9 +81,11 @@ def _study(mission: str, cfg: dict, quick: bool) -> dict:
                 continue
             sats = sorted({n.split("/")[0] for n in c.names}, key=lambda s: c.names.index(f"{s}/x"))
             idx = np.array([[c.names.index(f"{s}/{a}") for a in ("s_x", "s_y", "s_z")] for s in sats])
-            sig = c.sigma[idx]                                       # (3 sats, 3 axes) m/s^2
+            # with biases considered: their consider sigma and covariance (noise and biases)
+            sigma, cov = (c.consider_sigma, c.consider_covariance) if bias else (c.sigma, c.covariance)
+            sig = sigma[idx]                                         # (3 sats, 3 axes) m/s^2
             iy = idx[:, 1]
-            common_y = float(np.sqrt(c.covariance[np.ix_(iy, iy)].sum()) / len(iy))
+            common_y = float(np.sqrt(cov[np.ix_(iy, iy)].sum()) / len(iy))
             res["sigma"].append(sig.tolist())
             for a, key in enumerate(("sigma_x_max", "sigma_y_max", "sigma_z_max")):
                 res[key].append(float(sig[:, a].max()))
@@ -101,7 +115,7 @@ def _figure(data: dict, path: Path) -> None:
             for key, ls in (("sigma_y_max", "-"), ("sigma_x_max", ":")):
                 v = np.array([np.nan if x is None else x for x in res[key]])
                 ax.loglog(arcs, v, ls, marker="o", ms=3, color=f"C{k}",
-                          label=f"{plan} ({'Y_S' if key == 'sigma_y_max' else 'X_S'})")
+                          label=f"{plan.replace('_biases', ' + biases')} ({'Y_S' if key == 'sigma_y_max' else 'X_S'})")
         ax.axhline(PAPER_ACC, color="k", lw=0.8, ls="--")
         ax.text(arcs[0], PAPER_ACC * 1.4, "1e-9 m/s$^2$: ~100 km in 90 d (TianQin)", fontsize=7)
         ax.set_title(title)
@@ -110,7 +124,7 @@ def _figure(data: dict, path: Path) -> None:
         ax.legend(fontsize=7, ncol=2, loc="lower left")
     axes[0].set_ylabel("1-sigma of the DC self-gravity [m/s$^2$]\n(largest of the three satellites)")
     fig.suptitle("Calibrating self-gravity from tracking: formal 1-sigma (covariance analysis, state + S-frame "
-                 "constants estimated)", fontsize=9)
+                 "constants estimated; + biases: SLR station and link biases considered)", fontsize=9)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -126,7 +140,9 @@ def main(argv=None) -> int:
     data = {**provenance("tools/od_study.py"),
             "description": "Formal 1-sigma [m/s^2] of each satellite's DC self-gravity per S axis (X_S toward "
                            "the incentre, Y_S the flight direction, Z_S normal), state and S-frame constants "
-                           "estimated without a priori, by covariance analysis (tqdyn.od.problem.covariance); "
+                           "estimated without a priori, by covariance analysis (tqdyn.od.problem.covariance; "
+                           "plan combined_biases: the consider sigma with the measurement biases of "
+                           "consider_bias_sigma [m] considered); "
                            "common_y: the mean of the three Y_S constants; orbit_90d_m: the along-track shift "
                            "of 90 days it leaves (100 km per 1e-9 m/s^2, the paper).",
             "max_condition": MAX_CONDITION, "sigma": dict(odp.DEFAULT_SIGMA), "missions": {}}

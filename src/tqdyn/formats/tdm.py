@@ -19,7 +19,8 @@ metadata block.  Writes are atomic (:func:`tqdyn.formats.atomic.replacing`).
 
 XML: the PyPI package ``ccsds-ndm`` (3.1.1, GPL-3.0-or-later, depends on
 ``lxml`` and ``xsdata``) reads and writes TDM XML and KVN through an object
-tree generated from the CCSDS schemas; it is not a tqdyn dependency.
+tree generated from the CCSDS schemas; it is not a tqdyn dependency (the tests use it as an
+independent reader and writer of tqdyn's measurement files, tests/test_od_files.py).
 :func:`read_tdm` refuses an XML file with a message that says so.
 """
 
