@@ -345,7 +345,8 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
              "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
              "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
                                      "estimate": list(_problem().estimated_groups(scen, plan)),
-                                     "consider": list(plan.consider), "a_priori_sigma": sig})}
+                                     "consider": list(plan.consider),
+                                     "a_priori_sigma": plan.a_priori_sigma or {}})}
     if out is not None:
         say("writing")
         write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
