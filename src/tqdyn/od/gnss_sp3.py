@@ -39,13 +39,14 @@ class SP3Constellation:
     :class:`tqdyn.astro.timescales.Epoch` (t = 0); points : samples of the interpolation (even,
     >= 4); eop, use_eop : as :func:`tqdyn.astro.earth_orientation.itrs_to_gcrs`.
 
-    Attributes: name (the file's name), ids (K,) satellite ids, t (n,) sample times [s TT since
+    Attributes: path, name (the file's path and name), ids (K,) satellite ids, t (n,) sample times [s TT since
     the epoch], positions (n, K, 3) GCRS [m] (NaN: absent), span (first, last) allowed times [s].
     """
 
     def __init__(self, orbits: SP3Orbits, epoch, *, points: int = POINTS, eop=None, use_eop: bool = True):
         if points < 4 or points % 2:
             raise ValueError(f"SP3 interpolation points: {points!r}; allowed: an even number >= 4")
+        self.path = orbits.path
         self.name = os.path.basename(orbits.path)
         self.ids = tuple(orbits.satellites)
         self.points = int(points)
