@@ -217,42 +217,46 @@ def read_closed_loop(path):
 
 
 def od_simulate(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
-                overrides: Mapping[str, object] | Sequence[str] = ()):
+                sp3=None, overrides: Mapping[str, object] | Sequence[str] = ()):
     """Simulate tracking on a run, as ``tqdyn od simulate``: the run file's scenario (its
     ``[accelerations]`` and initial states are the truth), ``tracking`` ``"gnss,slr,isr"`` or a sequence
     of ``tqdyn.od``'s ``problem.TRACKING_KINDS``, ``arc`` seconds or ``"7d"``, seeded noise, constant
     measurement biases ``bias`` ({"slr_range": 0.02, "slr_range/Graz": -0.01, ...} [m, m/s for
-    dsn_range_rate]), written as a CCSDS TDM to ``output``.  Returns :class:`tqdyn.workflows.od.SimulateSummary`
-    (:func:`tqdyn.workflows.od.simulate_to_tdm`)."""
+    dsn_range_rate]), GNSS transmitters from the SP3 files ``sp3`` (a path or a list; None: the nominal
+    GPS and BeiDou constellations), written as a CCSDS TDM to ``output``.  Returns
+    :class:`tqdyn.workflows.od.SimulateSummary` (:func:`tqdyn.workflows.od.simulate_to_tdm`)."""
     from .workflows.od import simulate_to_tdm
 
     return simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval, stations=stations,
-                           bias=bias, overrides=_overrides(overrides))
+                           bias=bias, sp3=sp3, overrides=_overrides(overrides))
 
 
 def od_fit(scenario, tdm, *, output=None, estimate=None, consider=None, a_priori=None,
-           edit_sigma: float | None = None, overrides: Mapping[str, object] | Sequence[str] = (), figure=None,
+           edit_sigma: float | None = None, sp3=None, overrides: Mapping[str, object] | Sequence[str] = (), figure=None,
            **options):
     """Fit a scenario (a name, a TOML path or a run file) to the measurements of the TDM ``tdm``, as
     ``tqdyn od fit`` (``output``: the estimate file, None: none; ``figure``: the residuals' figure,
     ``.png`` or ``.pdf``, None: none; ``a_priori``: {group: sigma}, e.g. {"bias": 0.05, "state":
-    (100.0, 0.01)}, needed for each considered group); returns the
+    (100.0, 0.01)}, needed for each considered group; ``sp3``: the SP3 files the TDM was simulated
+    with, as :func:`od_simulate`); returns the
     :class:`tqdyn.od.estimator.Estimate` (:func:`tqdyn.workflows.od.fit_to_file`)."""
     from .workflows.od import fit_to_file
 
     return fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider, a_priori=a_priori,
-                       edit_sigma=edit_sigma, overrides=_overrides(overrides), figure=figure, **options)[0]
+                       edit_sigma=edit_sigma, sp3=sp3, overrides=_overrides(overrides), figure=figure,
+                       **options)[0]
 
 
 def od_covariance(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, a_priori=None,
-                  stations=None, overrides: Mapping[str, object] | Sequence[str] = (), json=None):
+                  stations=None, sp3=None, overrides: Mapping[str, object] | Sequence[str] = (), json=None):
     """The predicted covariance of a tracking plan on a scenario, as ``tqdyn od covariance``; returns the
     :class:`tqdyn.od.estimator.Covariance` (``json``: also write it there; ``a_priori`` as
-    :func:`od_fit`; :func:`tqdyn.workflows.od.covariance_of`)."""
+    :func:`od_fit`, ``sp3`` as :func:`od_simulate`; :func:`tqdyn.workflows.od.covariance_of`)."""
     from .workflows.od import covariance_of
 
     return covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate, consider=consider,
-                         a_priori=a_priori, stations=stations, overrides=_overrides(overrides), json_out=json)[0]
+                         a_priori=a_priori, stations=stations, sp3=sp3, overrides=_overrides(overrides),
+                         json_out=json)[0]
 
 
 def read_od_estimate(path):

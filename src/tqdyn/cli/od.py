@@ -4,7 +4,9 @@ Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.od`: bad
 tracking type, an arc outside the run, a malformed TDM, a station below the horizon for the whole
 arc, an output path that is an input, an unobservable fit, a ``--figure`` that is not a writable
 ``.png`` or ``.pdf``, a ``--bias`` or ``--a-priori`` that is not TYPE=VALUE / GROUP=SIGMA, a
-considered group without an a priori sigma) exits with status 2 and one line, nothing written;
+considered group without an a priori sigma, an ``--sp3`` file that is missing, malformed, too short
+for the arc or other than the one a TDM was simulated with) exits with status 2 and one line,
+nothing written;
 Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages show as a
 progress bar on stderr (``--quiet``: none).
 """
@@ -101,17 +103,21 @@ def od():
               help="A constant measurement bias (m; m/s for dsn_range_rate) added to every station or link of a "
                    "type (slr_range, isr_range, dsn_range, dsn_range_rate) or to one (slr_range/Graz, "
                    "isr_range/Sat2->Sat1); repeatable.")
+@click.option("--sp3", "sp3", multiple=True, metavar="FILE",
+              help="GNSS transmitter orbits from this SP3-c/d file instead of the nominal GPS and BeiDou "
+                   "constellations (repeatable: one file per set of satellites).")
 @click.option("--output", "-o", required=True, help="Output measurement file (CCSDS TDM, KVN).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def simulate(run_file, tracking, arc, seed, interval, stations, biases, output, sets, quiet):
+def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, output, sets, quiet):
     """Simulate the measurements of a tracking plan on the run RUN.h5: its recorded scenario, with its
     [accelerations] and initial states as the truth, seeded white noise; written as a CCSDS TDM."""
     from ..workflows import od as wf
 
     stages = _Stages(("scheduling", "simulating", "writing"), quiet, "od simulate")
     s = _run(lambda: wf.simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval,
-                                        stations=stations, bias=biases, overrides=sets, progress=stages), stages)
+                                        stations=stations, bias=biases, sp3=sp3, overrides=sets,
+                                        progress=stages), stages)
     _notes(s.notes)
     counts = ", ".join(f"{n} {t}" for t, n in s.counts.items())
     click.echo(f"measurements: {sum(s.counts.values())} ({counts}) over {s.tracking.arc_s:g} s, seed {seed}")
@@ -130,17 +136,21 @@ def simulate(run_file, tracking, arc, seed, interval, stations, biases, output, 
                    "bias/TYPE=SIGMA in m or m/s; the acceleration groups in m/s^2); needed for --consider; "
                    "repeatable.")
 @click.option("--edit-sigma", type=float, help="Leave out measurements beyond K normalised sigmas (off by default).")
+@click.option("--sp3", "sp3", multiple=True, metavar="FILE",
+              help="GNSS transmitter orbits from this SP3-c/d file, one MEAS.tdm was simulated with (its header "
+                   "names them); repeatable.")
 @click.option("--figure", help="Also draw the normalised post-fit residuals and their histogram (.png or .pdf).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, figure, sets, quiet):
+def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, figure, sets, quiet):
     """Fit SCENARIO (a built-in name, a TOML file or a run file) to the measurements MEAS.tdm by batch
     least squares; print each estimated parameter with its 1-sigma, and chi^2/dof."""
     from ..workflows import od as wf
 
     stages = _Stages(("reading", "fitting", "writing") + (("plotting",) if figure else ()), quiet, "od fit")
     est, _, notes = _run(lambda: wf.fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider,
-                                                a_priori=a_priori, edit_sigma=edit_sigma, overrides=sets, figure=figure,
+                                                a_priori=a_priori, edit_sigma=edit_sigma, sp3=sp3, overrides=sets,
+                                                figure=figure,
                                                 progress=stages), stages)
     _notes(notes)
     units = [wf.parameter_unit(n) for n in est.names]
@@ -168,10 +178,14 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, figure,
                    "bias/TYPE=SIGMA in m or m/s; the acceleration groups in m/s^2); needed for --consider; "
                    "repeatable.")
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
+@click.option("--sp3", "sp3", multiple=True, metavar="FILE",
+              help="GNSS transmitter orbits from this SP3-c/d file instead of the nominal GPS and BeiDou "
+                   "constellations (repeatable: one file per set of satellites).")
 @click.option("--json", "json_out", help="Also write the covariance as JSON to this file.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, stations, json_out, sets, quiet):
+def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, stations, sp3, json_out, sets,
+               quiet):
     """Predict, without measurements, how well a tracking plan determines SCENARIO's parameters: the
     1-sigma of each (and with --consider the consider sigma)."""
     from ..workflows import od as wf
@@ -179,7 +193,7 @@ def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, 
     stages = _Stages(("covariance", "writing") if json_out else ("covariance",), quiet, "od covariance")
     cov, _, notes = _run(lambda: wf.covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate,
                                                   consider=consider, a_priori=a_priori, stations=stations,
-                                                  overrides=sets, json_out=json_out, progress=stages), stages)
+                                                  sp3=sp3, overrides=sets, json_out=json_out, progress=stages), stages)
     _notes(notes)
     units = [wf.parameter_unit(n) for n in cov.names]
     click.echo("\n".join(summary_lines(cov.names, None, cov.sigma, units,

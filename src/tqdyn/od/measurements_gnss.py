@@ -16,10 +16,12 @@ node longitudes counted from the GCRS x axis at the epoch:
   ("Development of the BeiDou Navigation Satellite System (Version 4.0)",
   2019: 24 MEO in a Walker 24/3/1 at 21,528 km altitude).
 
-(Precise orbits from an SP3 file are the alternative for real data; no
-maintained PyPI reader was found: ``sp3`` 1.1.1, 2022, downloads and
+Precise orbits from SP3 files a user supplies are the alternative
+(:class:`tqdyn.od.gnss_sp3.SP3Constellation`, same interface plus the
+satellites' ids; the files are read by :func:`tqdyn.readers.sp3.read_sp3`:
+no maintained PyPI reader was found -- ``sp3`` 1.1.1, 2022, downloads and
 interpolates through astropy; ``georinex`` 1.16.2, 2023, reads SP3 into
-xarray.  A reader is not part of this module.)
+xarray).  A tracking plan names which (``Tracking.gnss_orbits``).
 
 Visibility (:func:`gnss_visibility`), per transmitter and epoch:
 
@@ -43,7 +45,7 @@ Visibility (:func:`gnss_visibility`), per transmitter and epoch:
 
 Pseudorange (:func:`pseudorange`): c tau + c dt_r, with c tau =
 |r(t) - r_G(t - tau)| + c (Earth Shapiro delay, ~2-3 cm) solved by fixed
-point (transmitter on its Keplerian orbit at the emission time), the
+point (transmitter on its orbit at the emission time), the
 receiver clock bias c dt_r [m] an estimated nuisance per epoch (partial 1:
 ``extra["d_clock"]``), transmitter clocks assumed corrected, no
 ionosphere (rays passing > 100 km above the surface cross it only near the
@@ -169,7 +171,9 @@ def pseudorange(t, r, v, constellation: WalkerConstellation = GPS, *, mode: str 
     """GNSS pseudoranges (without the receiver clock bias) at a receiver.
 
     t : (N,) reception times [s TT since the epoch]; r, v : (N, 3) receiver
-    GCRS position [m] and velocity [m/s] at t; constellation : transmitters.
+    GCRS position [m] and velocity [m/s] at t; constellation : transmitters
+    (a :class:`WalkerConstellation` or anything with its ``states(t)``, e.g.
+    :class:`tqdyn.od.gnss_sp3.SP3Constellation`; NaN states are not visible).
 
     Returns an Observable: value (N, K) = c tau [m] (add the clock bias
     c dt_r (N,) [m] per epoch, e.g. ``simulate(obs, sigma, bias=clock[:, None])``),

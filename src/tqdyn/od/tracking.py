@@ -71,7 +71,11 @@ class Tracking:
     run's defaults, :meth:`estimated`); a_priori_sigma: {group:
     sigma} a priori sigmas per group (``"state"``: (sigma_r [m], sigma_v [m/s]); the acceleration
     groups: [m/s^2]), needed for every considered group; gnss_mode: the GNSS reception mode of
-    :func:`~tqdyn.od.measurements_gnss.gnss_visibility`."""
+    :func:`~tqdyn.od.measurements_gnss.gnss_visibility`; gnss_orbits: the GNSS transmitters, a tuple
+    of constellations with ``states(t)`` and ``ids`` (:class:`~tqdyn.od.gnss_sp3.SP3Constellation`,
+    whose ids name the peers; distinct ids), None: the nominal Walker constellations
+    :data:`~tqdyn.od.measurements_gnss.GPS` (peers "G01"..) and
+    :data:`~tqdyn.od.measurements_gnss.BEIDOU_MEO` ("C01"..)."""
 
     kinds: tuple
     arc_s: float
@@ -82,6 +86,7 @@ class Tracking:
     consider: tuple = ()
     a_priori_sigma: dict | None = None
     gnss_mode: str = "sidelobes"
+    gnss_orbits: tuple | None = None
 
     def __post_init__(self):
         kinds = (self.kinds,) if isinstance(self.kinds, str) else tuple(self.kinds)
@@ -143,6 +148,20 @@ class Tracking:
                     fail(f"tracking.stations: {s!r} is not allowed; allowed: SLR "
                          f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
             object.__setattr__(self, "stations", st)
+        if self.gnss_orbits is not None:
+            orbits = tuple(self.gnss_orbits) if isinstance(self.gnss_orbits, (list, tuple)) else (self.gnss_orbits,)
+            seen: set = set()
+            for o in orbits:
+                if not (callable(getattr(o, "states", None)) and getattr(o, "ids", None)):
+                    fail(f"tracking.gnss_orbits: {o!r} is not allowed; allowed: constellations with states(t) and ids")
+                dup = seen & set(o.ids)
+                if dup:
+                    fail(f"tracking.gnss_orbits: satellite {sorted(dup)[0]!r} is in two of them; allowed: "
+                         "distinct satellites (one file per satellite)")
+                seen |= set(o.ids)
+            if not orbits:
+                fail("tracking.gnss_orbits: empty; allowed: None (the nominal constellations) or constellations")
+            object.__setattr__(self, "gnss_orbits", orbits)
 
     def estimated(self, coupled: bool) -> tuple:
         """The estimated groups: ``estimate``, or when None :data:`DEFAULT_ESTIMATE` (coupled runs:
@@ -230,6 +249,13 @@ def _flat(mtype, b, names, obs_value, d_r, d_v, visible):
                  obs_value.ravel(), visible.ravel(), d, np.full(n * s, -1))
 
 
+def _gnss_sources(tracking: Tracking):
+    """(constellation, id prefix or None: the constellation's own ids) of the plan's GNSS transmitters."""
+    if tracking.gnss_orbits is None:
+        return ((GPS, "G"), (BEIDOU_MEO, "C"))
+    return tuple((o, None) for o in tracking.gnss_orbits)
+
+
 def evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[_Rows]:
     """Every computable measurement of ``types`` at t (n,) [s] from states (n, n_sat, 6)
     [m, m/s]; stations: {kind: names} overriding the tracking plan's."""
@@ -240,9 +266,9 @@ def evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[
     r, v = states[..., :3], states[..., 3:]
     if "gnss_pseudorange" in types:
         for b in range(n_sat):
-            for const, prefix in ((GPS, "G"), (BEIDOU_MEO, "C")):
+            for const, prefix in _gnss_sources(tracking):
                 o = pseudorange(t, r[:, b], v[:, b], const, mode=tracking.gnss_mode)
-                ids = [f"{prefix}{k + 1:02d}" for k in range(o.value.shape[1])]
+                ids = list(const.ids) if prefix is None else [f"{prefix}{k + 1:02d}" for k in range(o.value.shape[1])]
                 out.append(_flat("gnss_pseudorange", b, ids, o.value, o.d_r, o.d_v, o.visible))
     if "slr_range" in types:
         names = stations.get("slr", tracking.station_names("slr"))

@@ -234,17 +234,79 @@ def _interval(value) -> float | None:
     return None if value is None else parse_arc(value, "--interval")
 
 
+def _sp3_paths(sp3, kinds) -> list:
+    """The ``--sp3`` files (a path or a sequence; None: none), checked to exist and to go with GNSS
+    tracking; ValueError / FileNotFoundError (one line) otherwise."""
+    paths = [sp3] if isinstance(sp3, (str, os.PathLike)) else list(sp3 or ())
+    if paths and "gnss" not in kinds:
+        raise ValueError(f"--sp3: the tracking ({','.join(kinds)}) has no gnss; allowed: --sp3 with gnss tracking")
+    for path in paths:
+        if not os.path.isfile(os.fspath(path)):
+            raise FileNotFoundError(f"--sp3: SP3 file {str(path)!r} does not exist or is not a file")
+    return paths
+
+
+def _sp3_orbits(paths, scen, arc_s: float) -> dict:
+    """{"gnss_orbits": the SP3 constellations of ``paths`` on the scenario's epoch} (no files: {}),
+    each checked to cover the arc (and the second before it: the signals' emission times)."""
+    if not paths:
+        return {}
+    from ..od.gnss_sp3 import sp3_constellation
+
+    orbits = tuple(sp3_constellation(path, scen.epoch) for path in paths)
+    for o in orbits:
+        lo, hi = o.span
+        if lo > -1.0 or hi < arc_s:
+            raise ValueError(f"--sp3: {o.name} covers t = {lo:.6g} to {hi:.6g} s TT since the epoch (its epochs "
+                             f"less {o.points // 2 - 1} samples at each end); allowed: a file covering the arc, "
+                             f"-1 to {arc_s:g} s")
+    return {"gnss_orbits": orbits}
+
+
+def _sp3_record(paths) -> list:
+    """[[file name, SHA-256], ...] of the SP3 files (the TDM header's ``sp3``)."""
+    return [[pathlib.Path(path).name, file_sha256(path)] for path in paths]
+
+
+def _sp3_record_of(plan) -> list:
+    return [[o.name, file_sha256(o.path)] for o in plan.gnss_orbits if hasattr(o, "path")]
+
+
+def _check_sp3_against(info: dict, paths, tdm) -> None:
+    """Refuse (one line) SP3 files other than those the TDM was simulated with (SHA-256)."""
+    try:
+        used = [tuple(x) for x in json.loads(info["sp3"])] if info.get("sp3") else []
+    except (ValueError, TypeError):
+        raise ValueError(f"{tdm}: header: tqdyn sp3 = {info['sp3']!r}; allowed: a JSON list of [file, sha256]") \
+            from None
+    given = [tuple(x) for x in _sp3_record(paths)]
+    if not used and given:
+        raise ValueError(f"--sp3: {tdm} was simulated with the nominal GNSS constellations (no SP3 file); allowed: "
+                         "no --sp3")
+    if used and not given:
+        raise ValueError(f"--sp3: {tdm} was simulated with the SP3 file(s) {', '.join(n for n, _ in used)}; "
+                         "allowed: --sp3 with the same file(s)")
+    if sorted(h for _, h in used) != sorted(h for _, h in given):
+        other = [n for n, h in given if h not in {u for _, u in used}]
+        raise ValueError(f"--sp3: {', '.join(other) or 'the files given'} (by SHA-256) "
+                         f"{'is' if len(other) == 1 else 'are'} not the SP3 file(s) {tdm} was simulated with "
+                         f"({', '.join(n for n, _ in used)}); allowed: the same file(s)")
+
+
 def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
-                    overrides=(), progress: Callable[[str], None] | None = None) -> SimulateSummary:
+                    sp3=None, overrides=(), progress: Callable[[str], None] | None = None) -> SimulateSummary:
     """Simulate the measurements of ``tracking`` (kinds) over ``arc`` from the run file's scenario (its
     ``[accelerations]`` are the truth) with noise seed ``seed``, and write them as a TDM to ``output``.
     stations: ground-station names (None: the plan's defaults); bias: constant measurement biases
-    (:func:`parse_biases`; None: none), recorded in the TDM's header."""
+    (:func:`parse_biases`; None: none), recorded in the TDM's header; sp3: SP3 files of the GNSS
+    transmitters (a path or a sequence; None: the nominal constellations), their names and SHA-256
+    recorded in the header."""
     say = progress or (lambda stage: None)
     kinds = parse_tracking(tracking)
     biases = parse_biases(bias)
     arc_s = parse_arc(arc)
     interval_s = _interval(interval)
+    sp3_paths = _sp3_paths(sp3, kinds)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ValueError(f"--seed: {seed!r} is not allowed; allowed: an integer >= 0")
     if not io.is_trajectory_file(run_file):
@@ -255,7 +317,7 @@ def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=
     scen, notes, label = _scenario(run_file, overrides)
     _check_arc(scen, arc_s, label)
     p = _problem()
-    plan = _tracking(kinds, arc_s, interval_s, **_stations(stations))
+    plan = _tracking(kinds, arc_s, interval_s, **_stations(stations), **_sp3_orbits(sp3_paths, scen, arc_s))
     say("scheduling")
     p.schedule(scen, plan)  # visibility refusals (a station below the horizon) before the simulation
     say("simulating")
@@ -267,6 +329,8 @@ def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=
         info["bias"] = json.dumps(biases)
     if plan.stations is not None:
         info["stations"] = ",".join(plan.stations)
+    if sp3_paths:
+        info["sp3"] = json.dumps(_sp3_record(sp3_paths))
     say("writing")
     path = write_measurements_tdm(out, meas, epoch=scen.epoch, time_scale=scen.reference.time_scale,
                                   satellite_names=[s.name for s in scen.satellites], info=info)
@@ -291,12 +355,14 @@ def _header_number(info: dict, key: str, tdm) -> float:
 
 
 def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_priori=None, edit_sigma=None,
-                overrides=(), figure=None, progress: Callable[[str], None] | None = None, **options):
+                sp3=None, overrides=(), figure=None, progress: Callable[[str], None] | None = None, **options):
     """Fit the scenario's parameters (``estimate``, ``consider``: names of parameter groups, default
     the plan's) to the measurements of the TDM ``tdm``; write the estimate file ``output`` (None: no
     file) and the residuals' figure ``figure`` (None: none; PNG or PDF by its suffix,
     :func:`tqdyn.analysis.figures_od.plot_od_residuals`, checked before the fit).  a_priori: a
-    priori sigmas per group (:func:`parse_a_priori`), needed for each considered group.  Returns
+    priori sigmas per group (:func:`parse_a_priori`), needed for each considered group.  sp3: the
+    SP3 files the TDM was simulated with (its header names them; refused when they differ, by
+    SHA-256; None: none, the nominal constellations).  Returns
     (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
     :func:`tqdyn.od.estimator.estimate` with ``edit_sigma``."""
     say = progress or (lambda stage: None)
@@ -328,11 +394,13 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
     kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
         tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
     parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
+    sp3_paths = _sp3_paths(sp3, kinds)
+    _check_sp3_against(info, sp3_paths, tdm)
     arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
     _check_arc(scen, arc_s, label)
     interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
-                     **_stations(info.get("stations")))
+                     **_stations(info.get("stations")), **_sp3_orbits(sp3_paths, scen, arc_s))
     meas = _measurements(fields)
     say("fitting")
     if edit_sigma is not None:
@@ -346,7 +414,8 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
              "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
                                      "estimate": list(_problem().estimated_groups(scen, plan)),
                                      "consider": list(plan.consider),
-                                     "a_priori_sigma": plan.a_priori_sigma or {}})}
+                                     "a_priori_sigma": plan.a_priori_sigma or {},
+                                     **({"sp3": _sp3_record(sp3_paths)} if sp3_paths else {})})}
     if out is not None:
         say("writing")
         write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
@@ -364,14 +433,15 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
 
 
 def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, a_priori=None,
-                  stations=None, overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
+                  stations=None, sp3=None, overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
     """The predicted covariance (:class:`tqdyn.od.estimator.Covariance`) of the tracking plan on the
-    scenario (a_priori: as :func:`fit_to_file`), and (optionally) its JSON file ``json_out``.
+    scenario (a_priori, sp3: as :func:`simulate_to_tdm`'s), and (optionally) its JSON file ``json_out``.
     Returns (covariance, scenario, notes)."""
     say = progress or (lambda stage: None)
     kinds = parse_tracking(tracking)
     arc_s = parse_arc(arc)
     interval_s = _interval(interval)
+    sp3_paths = _sp3_paths(sp3, kinds)
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
     sig = parse_a_priori(a_priori)
     _check_consider(con_names, sig)
@@ -380,7 +450,7 @@ def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, cons
     scen, notes, label = _scenario(scenario, overrides)
     _check_arc(scen, arc_s, label)
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
-                     **_stations(stations))
+                     **_stations(stations), **_sp3_orbits(sp3_paths, scen, arc_s))
     say("covariance")
     cov = _problem().covariance(scen, plan)
     if out is not None:
@@ -400,7 +470,8 @@ def covariance_record(cov, scen, plan) -> dict:
     return {"scenario": scen.name, "epoch": scen.epoch.iso, "time_scale": scen.reference.time_scale,
             "tracking": {"kinds": list(plan.kinds), "arc_s": float(plan.arc_s), "interval_s": float(plan.interval_s),
                          "estimate": list(_problem().estimated_groups(scen, plan)),
-                         "consider": list(plan.consider), "a_priori_sigma": plan.a_priori_sigma or {}},
+                         "consider": list(plan.consider), "a_priori_sigma": plan.a_priori_sigma or {},
+                         **({"sp3": _sp3_record_of(plan)} if getattr(plan, "gnss_orbits", None) else {})},
             "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
             "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
             "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
