@@ -100,6 +100,39 @@ def test_walker_sp3_read_back_gives_the_walker_states(walker_file, epoch, record
     assert dv < 1e-5, dv
 
 
+def test_consecutive_files_are_joined(tmp_path, walker_file, epoch):
+    """The same samples split into two consecutive files (sharing the midnight epoch, as some
+    analysis centres' daily files do) and given together give the constellation of the single file
+    exactly (the same samples, the same interpolation); BeiDou satellites in a third file stay a
+    constellation of their own; a second file that disagrees at the shared epoch by 1 m is refused
+    in one line, and a missing day (a gap in the epochs) too."""
+    from tqdyn.od.gnss_sp3 import sp3_constellation, sp3_constellations
+    from tqdyn.od.measurements_gnss import BEIDOU_MEO, GPS
+
+    day1, day2, bds = tmp_path / "d1.sp3", tmp_path / "d2.sp3", tmp_path / "c.sp3"
+    write_walker_sp3(day1, GPS, epoch, -2 * 3600.0, 86400.0)
+    write_walker_sp3(day2, GPS, epoch, 86400.0, 2 * 86400.0)
+    write_walker_sp3(bds, BEIDOU_MEO, epoch, -2 * 3600.0, 2 * 86400.0, prefix="C")
+    one = sp3_constellation(walker_file, epoch, use_eop=False)
+    joined, cbd = sp3_constellations([day2, bds, day1], epoch, use_eop=False)      # order: of the first file
+    assert joined.ids == one.ids and joined.name == "d1.sp3+d2.sp3" and cbd.ids[0] == "C01"
+    assert joined.span == one.span
+    t = np.linspace(one.span[0], one.span[1], 500)
+    assert np.array_equal(joined.states(t)[0], one.states(t)[0])
+    text = day2.read_text().splitlines()
+    k = next(i for i, line in enumerate(text) if line.startswith("PG01"))
+    text[k] = text[k][:4] + f"{float(text[k][4:18]) + 1e-3:14.6f}" + text[k][18:]      # +1 m in x
+    bad = tmp_path / "d2bad.sp3"
+    bad.write_text("\n".join(text) + "\n")
+    with pytest.raises(ValueError, match=r"^d2bad.sp3: satellite G01 at MJD \d+ \+ \d+ s is 1 m from the earlier "
+                                         r"file's position; allowed: files that agree where they overlap$"):
+        sp3_constellations([day1, bad], epoch, use_eop=False)
+    day3 = tmp_path / "d3.sp3"
+    write_walker_sp3(day3, GPS, epoch, 3 * 86400.0, 4 * 86400.0)
+    with pytest.raises(ValueError, match=r"^d1.sp3\+d3.sp3: epoch \d+ is 172800 s after the previous one"):
+        sp3_constellations([day1, day3], epoch, use_eop=False)
+
+
 def test_pseudoranges_from_the_sp3_file_match_the_nominal_ones(walker_file, epoch):
     """Pseudoranges at a receiver on a 1e5 km circular orbit (TianQin's radius) over a day from the
     SP3 constellation against the analytic Walker one: same visibility, values equal to < 1 cm

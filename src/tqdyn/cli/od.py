@@ -105,7 +105,8 @@ def od():
                    "isr_range/Sat2->Sat1); repeatable.")
 @click.option("--sp3", "sp3", multiple=True, metavar="FILE",
               help="GNSS transmitter orbits from this SP3-c/d file instead of the nominal GPS and BeiDou "
-                   "constellations (repeatable: one file per set of satellites).")
+                   "constellations (repeatable: files of other satellites, or consecutive days of the same ones, "
+                   "which are joined in time).")
 @click.option("--output", "-o", required=True, help="Output measurement file (CCSDS TDM, KVN).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
@@ -180,7 +181,8 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
 @click.option("--sp3", "sp3", multiple=True, metavar="FILE",
               help="GNSS transmitter orbits from this SP3-c/d file instead of the nominal GPS and BeiDou "
-                   "constellations (repeatable: one file per set of satellites).")
+                   "constellations (repeatable: files of other satellites, or consecutive days of the same ones, "
+                   "which are joined in time).")
 @click.option("--json", "json_out", help="Also write the covariance as JSON to this file.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")

@@ -22,9 +22,9 @@ import os
 import numpy as np
 
 from ..astro.earth_orientation import itrs_to_gcrs
-from ..readers.sp3 import TT_MINUS, SP3Orbits, read_sp3
+from ..readers.sp3 import TT_MINUS, SP3Orbits, merge_sp3, read_sp3
 
-__all__ = ["POINTS", "SP3Constellation", "sp3_constellation"]
+__all__ = ["POINTS", "SP3Constellation", "sp3_constellation", "sp3_constellations"]
 
 #: Number of samples of the Lagrange interpolation (degree POINTS - 1), even.
 POINTS = 10
@@ -111,6 +111,19 @@ class SP3Constellation:
         r, v = np.einsum("np,npki->nki", w, g), np.einsum("np,npki->nki", dw, g) / self.step
         r[nan], v[nan] = np.nan, np.nan
         return r, v
+
+
+def sp3_constellations(paths, epoch, **options) -> tuple:
+    """The :class:`SP3Constellation` s of the SP3 files ``paths`` on the scenario epoch: files that
+    share a satellite are joined in time (:func:`tqdyn.readers.sp3.merge_sp3`: consecutive daily
+    files), the others give one constellation each; options as the class takes them."""
+    groups: list[list] = []                       # [(index of the first file, orbits), ...] per group
+    for i, orbits in enumerate(read_sp3(p) for p in paths):
+        hit = [g for g in groups if any(set(o.satellites) & set(orbits.satellites) for _, o in g)]
+        groups = [g for g in groups if g not in hit] + [[(i, orbits)] + [x for g in hit for x in g]]
+    groups.sort(key=lambda g: min(i for i, _ in g))               # in the order the files were given
+    return tuple(SP3Constellation(g[0][1] if len(g) == 1 else merge_sp3([o for _, o in g]), epoch, **options)
+                 for g in groups)
 
 
 def sp3_constellation(path, epoch, **options) -> SP3Constellation:

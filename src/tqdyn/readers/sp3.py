@@ -23,6 +23,9 @@ What is read (columns are 1-based, as in the format documents):
 Returned in SI: positions [m] in the file's terrestrial frame, clocks [s], epochs as modified
 Julian day numbers and seconds of the day in the file's time system (:data:`TT_MINUS`: its offset
 to TT).  Malformed lines raise a one-line ``ValueError`` naming the file, the line and the field.
+
+Consecutive files of the same satellites (the daily files of an analysis centre) are joined in
+time by :func:`merge_sp3`.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SP3Orbits", "TT_MINUS", "read_sp3"]
+__all__ = ["SP3Orbits", "TT_MINUS", "merge_sp3", "read_sp3"]
 
 #: TT minus the file's time system [s] (constant offsets): GPS time (and Galileo's, QZSS's,
 #: aligned with it) = TAI - 19 s, so TT = GPST + 51.184 s; BeiDou time BDT = GPST - 14 s;
@@ -186,3 +189,50 @@ def read_sp3(path) -> SP3Orbits:
     sod = np.array([e[1] for e in epochs], np.float64)
     return SP3Orbits(path, version, coord, orbit_type, agency, time_system, float(interval), tuple(sats), mjd, sod,
                      pos, clk)
+
+
+#: Largest difference [m] between two files' positions of a satellite at the same epoch for
+#: :func:`merge_sp3` to take them as one (the files' 1 mm resolution, with margin).
+MERGE_TOLERANCE_M = 0.01
+
+
+def merge_sp3(parts) -> SP3Orbits:
+    """One :class:`SP3Orbits` from several files of one time system and epoch interval (e.g.
+    consecutive daily files): the union of their epochs (in time order) and satellites (in order
+    of first appearance); a satellite absent from a file is NaN at that file's epochs.  An epoch
+    in two files (the shared midnight) keeps the first file's value and is refused (one-line
+    ValueError) when the two positions of a satellite differ by more than
+    :data:`MERGE_TOLERANCE_M`.  ``path`` joins the files' paths with ``"+"``."""
+    parts = sorted(parts, key=lambda o: (int(o.mjd[0]), float(o.sod[0])))
+    first = parts[0]
+    names = "+".join(os.path.basename(o.path) for o in parts)
+    for o in parts[1:]:
+        for field in ("time_system", "interval_s"):
+            if getattr(o, field) != getattr(first, field):
+                raise ValueError(f"{os.path.basename(o.path)}: {field} = {getattr(o, field)!r}, "
+                                 f"{os.path.basename(first.path)} has {getattr(first, field)!r}; allowed: files of "
+                                 f"one {field.replace('_s', '')} to join")
+    sats = list(dict.fromkeys(s for o in parts for s in o.satellites))
+    col = {s: k for k, s in enumerate(sats)}
+    keys = sorted({(int(m), float(d)) for o in parts for m, d in zip(o.mjd, o.sod)})
+    row = {k: i for i, k in enumerate(keys)}
+    pos = np.full((len(keys), len(sats), 3), np.nan)
+    clk = np.full((len(keys), len(sats)), np.nan)
+    for o in parts:
+        for e, key in enumerate(zip(o.mjd.tolist(), o.sod.tolist())):
+            i = row[(int(key[0]), float(key[1]))]
+            for k, s in enumerate(o.satellites):
+                new = o.positions[e, k]
+                old = pos[i, col[s]]
+                if np.all(np.isfinite(old)):
+                    if np.all(np.isfinite(new)) and np.max(np.abs(new - old)) > MERGE_TOLERANCE_M:
+                        raise ValueError(f"{os.path.basename(o.path)}: satellite {s} at MJD {key[0]} + {key[1]:g} s "
+                                         f"is {np.max(np.abs(new - old)):.3g} m from the earlier file's position; "
+                                         f"allowed: files that agree where they overlap")
+                    continue
+                pos[i, col[s]] = new
+                clk[i, col[s]] = o.clocks[e, k]
+    mjd = np.array([k[0] for k in keys], np.int64)
+    sod = np.array([k[1] for k in keys], np.float64)
+    return SP3Orbits(names, first.version, first.coordinate_system, first.orbit_type, first.agency,
+                     first.time_system, first.interval_s, tuple(sats), mjd, sod, pos, clk)

@@ -251,9 +251,9 @@ def _sp3_orbits(paths, scen, arc_s: float) -> dict:
     each checked to cover the arc (and the second before it: the signals' emission times)."""
     if not paths:
         return {}
-    from ..od.gnss_sp3 import sp3_constellation
+    from ..od.gnss_sp3 import sp3_constellations
 
-    orbits = tuple(sp3_constellation(path, scen.epoch) for path in paths)
+    orbits = sp3_constellations(paths, scen.epoch)
     for o in orbits:
         lo, hi = o.span
         if lo > -1.0 or hi < arc_s:
@@ -266,10 +266,6 @@ def _sp3_orbits(paths, scen, arc_s: float) -> dict:
 def _sp3_record(paths) -> list:
     """[[file name, SHA-256], ...] of the SP3 files (the TDM header's ``sp3``)."""
     return [[pathlib.Path(path).name, file_sha256(path)] for path in paths]
-
-
-def _sp3_record_of(plan) -> list:
-    return [[o.name, file_sha256(o.path)] for o in plan.gnss_orbits if hasattr(o, "path")]
 
 
 def _check_sp3_against(info: dict, paths, tdm) -> None:
@@ -455,15 +451,16 @@ def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, cons
     cov = _problem().covariance(scen, plan)
     if out is not None:
         say("writing")
-        rec = covariance_record(cov, scen, plan)
+        rec = covariance_record(cov, scen, plan, sp3_paths)
         with replacing(out, "the covariance JSON") as tmp:
             tmp.write_text(json.dumps(rec, indent=1) + "\n", encoding="utf-8")
     return cov, scen, tuple(notes)
 
 
-def covariance_record(cov, scen, plan) -> dict:
+def covariance_record(cov, scen, plan, sp3_paths=()) -> dict:
     """The JSON record of a predicted covariance: scenario, tracking plan, parameter names and units,
-    nominal values, sigmas, covariance, correlation, consider names and sigmas, condition number."""
+    nominal values, sigmas, covariance, correlation, consider names and sigmas, condition number (and the
+    names and SHA-256 of the SP3 files ``sp3_paths``, when given)."""
     def arr(a):
         return np.asarray(a, np.float64).tolist()
 
@@ -471,7 +468,7 @@ def covariance_record(cov, scen, plan) -> dict:
             "tracking": {"kinds": list(plan.kinds), "arc_s": float(plan.arc_s), "interval_s": float(plan.interval_s),
                          "estimate": list(_problem().estimated_groups(scen, plan)),
                          "consider": list(plan.consider), "a_priori_sigma": plan.a_priori_sigma or {},
-                         **({"sp3": _sp3_record_of(plan)} if getattr(plan, "gnss_orbits", None) else {})},
+                         **({"sp3": _sp3_record(sp3_paths)} if sp3_paths else {})},
             "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
             "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
             "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
