@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .parameters import OrbitParameters, scenario_with
+from .parameters import OrbitParameters, per_satellite_names, scenario_with
 from .tracking import fail
 from .variational import Partials, propagate_dd
 
@@ -58,8 +58,7 @@ def check_scenario(scen) -> None:
 def parameter_names(satellites) -> list[str]:
     """``"<sat>/sgc_x"`` ... of every common self-gravity parameter, satellite by satellite
     (satellites: names, or a scenario)."""
-    names = [s.name for s in satellites.satellites] if hasattr(satellites, "satellites") else list(satellites)
-    return [f"{s}/{p}" for s in names for p in COMMON_NAMES]
+    return per_satellite_names(satellites, COMMON_NAMES)
 
 
 def nominal_common(scen) -> np.ndarray:
@@ -116,13 +115,6 @@ def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, ste
         yp, ym = _runs(scen, plus, t, h), _runs(scen, minus, t, h)
         diff = (yp[..., 0] - ym[..., 0]) + (yp[..., 1] - ym[..., 1])      # (n, n_sat, 6)
         out[:, :, j] = diff.reshape(t.size, 6 * n_sat) / den
-    stm_full, sens_full = out[:, :, :6 * n_sat], out[:, :, 6 * n_sat:]
-    stm = np.empty((t.size, n_sat, 6, 6))
-    sens = np.empty((t.size, n_sat, 6, 3))
-    for b in range(n_sat):
-        stm[:, b] = stm_full[:, 6 * b:6 * b + 6, 6 * b:6 * b + 6]
-        sens[:, b] = sens_full[:, 6 * b:6 * b + 6, 3 * b:3 * b + 3]
-    return Partials(t=t, states=y_dd[..., 0] + y_dd[..., 1], states_dd=y_dd, stm=stm, sensitivities=sens,
-                    stm_full=stm_full, sensitivities_full=sens_full,
-                    satellites=tuple(s.name for s in scen.satellites), parameter_names=COMMON_NAMES)
+    return Partials.from_full(t, y_dd, out[:, :, :6 * n_sat], out[:, :, 6 * n_sat:],
+                              [s.name for s in scen.satellites], COMMON_NAMES)
 

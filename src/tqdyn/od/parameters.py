@@ -18,8 +18,8 @@ import numpy as np
 from ..dynamics.empirical import N_PAR, PARAMETER_NAMES
 from ..scenario.accelerations import AccelerationsConfig
 
-__all__ = ["N_PAR", "PARAMETER_NAMES", "STATE_NAMES", "OrbitParameters", "parameter_names", "scenario_with",
-           "state_names"]
+__all__ = ["N_PAR", "PARAMETER_NAMES", "STATE_NAMES", "OrbitParameters", "parameter_names", "per_satellite_names",
+           "scenario_with", "state_names"]
 
 #: Names of the six initial-state components of a satellite.
 STATE_NAMES = ("x", "y", "z", "vx", "vy", "vz")
@@ -53,17 +53,22 @@ class OrbitParameters:
         return y
 
 
+def per_satellite_names(satellites, components) -> list[str]:
+    """``"<sat>/<component>"`` of each component, satellite by satellite (satellites: names, or
+    a scenario)."""
+    names = [s.name for s in satellites.satellites] if hasattr(satellites, "satellites") else list(satellites)
+    return [f"{s}/{p}" for s in names for p in components]
+
+
 def parameter_names(satellites) -> list[str]:
     """``"<sat>/<name>"`` of every acceleration parameter, satellite by satellite
     (satellites: names, or a scenario)."""
-    names = [s.name for s in satellites.satellites] if hasattr(satellites, "satellites") else list(satellites)
-    return [f"{s}/{p}" for s in names for p in PARAMETER_NAMES]
+    return per_satellite_names(satellites, PARAMETER_NAMES)
 
 
 def state_names(satellites) -> list[str]:
     """``"<sat>/<component>"`` of every initial-state component, satellite by satellite."""
-    names = [s.name for s in satellites.satellites] if hasattr(satellites, "satellites") else list(satellites)
-    return [f"{s}/{p}" for s in names for p in STATE_NAMES]
+    return per_satellite_names(satellites, STATE_NAMES)
 
 
 def scenario_with(scenario, accelerations=None, duration_s=None, self_gravity_common=None, step_s=None):

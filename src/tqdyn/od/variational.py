@@ -61,7 +61,7 @@ from ..dynamics import layout as _lay
 from ..forces.model import build_force_model
 from ..numerics import dp87
 from ..scenario import load_scenario
-from .parameters import OrbitParameters, parameter_names, scenario_with, state_names
+from .parameters import OrbitParameters, per_satellite_names, scenario_with, state_names
 
 __all__ = ["Partials", "propagate_dd", "propagate_with_partials"]
 
@@ -83,10 +83,26 @@ class Partials:
     satellites: tuple
     parameter_names: tuple = PARAMETER_NAMES
 
+    @classmethod
+    def from_full(cls, t, states_dd, stm_full, sensitivities_full, satellites,
+                  parameter_names=PARAMETER_NAMES) -> "Partials":
+        """The Partials of the full-system matrices stm_full (n, 6 n_sat, 6 n_sat) and
+        sensitivities_full (n, 6 n_sat, p n_sat) at t (n,) [s], with the dd states (n, n_sat, 6, 2):
+        ``stm`` and ``sensitivities`` are their diagonal blocks, satellite by satellite."""
+        n_sat, n_p = states_dd.shape[1], len(parameter_names)
+        stm = np.empty((len(t), n_sat, 6, 6))
+        sens = np.empty((len(t), n_sat, 6, n_p))
+        for b in range(n_sat):
+            stm[:, b] = stm_full[:, 6 * b:6 * b + 6, 6 * b:6 * b + 6]
+            sens[:, b] = sensitivities_full[:, 6 * b:6 * b + 6, n_p * b:n_p * (b + 1)]
+        return cls(t=t, states=states_dd[..., 0] + states_dd[..., 1], states_dd=states_dd, stm=stm,
+                   sensitivities=sens, stm_full=stm_full, sensitivities_full=sensitivities_full,
+                   satellites=tuple(satellites), parameter_names=tuple(parameter_names))
+
     @property
     def full_parameter_names(self) -> list[str]:
         """Column names of ``sensitivities_full``."""
-        return [f"{s}/{p}" for s in self.satellites for p in self.parameter_names]
+        return per_satellite_names(self.satellites, self.parameter_names)
 
     @property
     def full_state_names(self) -> list[str]:
@@ -161,15 +177,7 @@ def propagate_with_partials(scenario, parameters: OrbitParameters | None = None,
     if y0 is None:
         y0 = dynamics.initial_state(sv, model, system)
     phi, psi = _integrate(sv, model, system, y0[..., 0] + y0[..., 1], h, int(idx.max()))
-    n_sat = y_dd.shape[1]
-    stm = np.empty((len(idx), n_sat, 6, 6))
-    sens = np.empty((len(idx), n_sat, 6, N_PAR))
-    for b in range(n_sat):
-        stm[:, b] = phi[idx][:, 6 * b:6 * b + 6, 6 * b:6 * b + 6]
-        sens[:, b] = psi[idx][:, 6 * b:6 * b + 6, N_PAR * b:N_PAR * (b + 1)]
-    return Partials(t=t, states=y_dd[..., 0] + y_dd[..., 1], states_dd=y_dd, stm=stm, sensitivities=sens,
-                    stm_full=phi[idx], sensitivities_full=psi[idx],
-                    satellites=tuple(s.name for s in sv.satellites))
+    return Partials.from_full(t, y_dd, phi[idx], psi[idx], [s.name for s in sv.satellites])
 
 
 def _integrate(scen, model, system, y0, h: float, n_steps: int):
