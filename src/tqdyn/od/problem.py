@@ -352,13 +352,13 @@ def _parameter_sets(scen, tracking: Tracking, nominal: OrbitParameters, a_priori
     sats = [s.name for s in scen.satellites]
     sig = tracking.a_priori_sigma or {}
     out = []
-    for groups in (tracking.estimated(_coupled(scen)), tracking.consider):
+    for considered, groups in ((False, tracking.estimated(_coupled(scen))), (True, tracking.consider)):
         sel, sigma = [], []
         for g in groups:
             if g == "bias":
                 sel += [names.index(n) for n in bias_names]
                 sigma += [_bias_sigma(sig.get(g, np.inf), n) for n in bias_names]
-                if groups is tracking.consider and not np.all(np.isfinite(sigma[-len(bias_names):])):
+                if considered and not np.all(np.isfinite(sigma[-len(bias_names):])):
                     typ = next(bias_type(n) for n in bias_names if not np.isfinite(_bias_sigma(sig[g], n)))
                     fail(f"tracking.a_priori_sigma['bias']: no sigma for {typ!r}, whose biases are considered; "
                          f"give one per type of {', '.join(sorted({bias_type(n) for n in bias_names}))}")

@@ -268,14 +268,16 @@ def _sp3_record(paths) -> list:
     return [[pathlib.Path(path).name, file_sha256(path)] for path in paths]
 
 
-def _check_sp3_against(info: dict, paths, tdm) -> None:
-    """Refuse (one line) SP3 files other than those the TDM was simulated with (SHA-256)."""
+def _check_sp3_against(info: dict, paths, tdm) -> list:
+    """Refuse (one line) SP3 files other than those the TDM was simulated with (SHA-256); else
+    their :func:`_sp3_record`."""
     try:
         used = [tuple(x) for x in json.loads(info["sp3"])] if info.get("sp3") else []
     except (ValueError, TypeError):
         raise ValueError(f"{tdm}: header: tqdyn sp3 = {info['sp3']!r}; allowed: a JSON list of [file, sha256]") \
             from None
-    given = [tuple(x) for x in _sp3_record(paths)]
+    record = _sp3_record(paths)
+    given = [tuple(x) for x in record]
     if not used and given:
         raise ValueError(f"--sp3: {tdm} was simulated with the nominal GNSS constellations (no SP3 file); allowed: "
                          "no --sp3")
@@ -287,6 +289,7 @@ def _check_sp3_against(info: dict, paths, tdm) -> None:
         raise ValueError(f"--sp3: {', '.join(other) or 'the files given'} (by SHA-256) "
                          f"{'is' if len(other) == 1 else 'are'} not the SP3 file(s) {tdm} was simulated with "
                          f"({', '.join(n for n, _ in used)}); allowed: the same file(s)")
+    return record
 
 
 def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
@@ -391,7 +394,7 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
     parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
     sp3_paths = _sp3_paths(sp3, kinds)
-    _check_sp3_against(info, sp3_paths, tdm)
+    sp3_record = _check_sp3_against(info, sp3_paths, tdm)
     arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
     _check_arc(scen, arc_s, label)
     interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
@@ -411,7 +414,7 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
                                      "estimate": list(_problem().estimated_groups(scen, plan)),
                                      "consider": list(plan.consider),
                                      "a_priori_sigma": plan.a_priori_sigma or {},
-                                     **({"sp3": _sp3_record(sp3_paths)} if sp3_paths else {})})}
+                                     **({"sp3": sp3_record} if sp3_record else {})})}
     if out is not None:
         say("writing")
         write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
