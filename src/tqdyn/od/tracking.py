@@ -157,7 +157,8 @@ class Tracking:
                 dup = seen & set(o.ids)
                 if dup:
                     fail(f"tracking.gnss_orbits: satellite {sorted(dup)[0]!r} is in two of them; allowed: "
-                         "distinct satellites (one file per satellite)")
+                         "distinct satellites (tqdyn.od.gnss_sp3.sp3_constellations joins the files of the same "
+                         "satellites)")
                 seen |= set(o.ids)
             if not orbits:
                 fail("tracking.gnss_orbits: empty; allowed: None (the nominal constellations) or constellations")
