@@ -52,6 +52,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..numerics import lagrange
 from ..numerics.lagrange import MARGIN, POINTS
 
 __all__ = ["LINEAR_FIELDS", "LPF_DRIFT_M_PER_RAD_PER_S", "LPF_TEMPERATURE_COEFFICIENT_M_PER_RAD_PER_K", "MOSAS",
@@ -354,14 +355,8 @@ def _delay(x: np.ndarray, dt: float, tau) -> np.ndarray:
     ok = (base - (_HALF - 1) >= 0) & (base + _HALF <= n - 1)
     out = np.full(n, np.nan)
     k, frac = base[ok], frac[ok]
-    acc = np.zeros(k.size)
-    for j, off in enumerate(_NODES):
-        w = np.ones(k.size)
-        for q, offq in enumerate(_NODES):
-            if q != j:
-                w *= (frac - offq) / (off - offq)
-        acc += w * x[k + off]
-    out[ok] = acc
+    w = lagrange.weights(frac, _NODES)                                            # (n_ok, 8)
+    out[ok] = np.sum(w * x[k[:, None] + np.asarray(_NODES)[None, :]], axis=1)
     return out
 
 

@@ -16,12 +16,12 @@ than POINTS/2 - 1 samples (where the window would be off-centre) are refused.
 
 from __future__ import annotations
 
-import math
 import os
 
 import numpy as np
 
 from ..astro.earth_orientation import itrs_to_gcrs
+from ..numerics import lagrange
 from ..readers.sp3 import TT_MINUS, SP3Orbits, merge_sp3, read_sp3
 
 __all__ = ["POINTS", "SP3Constellation", "sp3_constellation", "sp3_constellations"]
@@ -67,25 +67,9 @@ class SP3Constellation:
         self.positions = np.einsum("nij,nkj->nki", rot, orbits.positions)            # (n, K, 3)
         half = points // 2
         self.span = (float(self.t[half - 1]), float(self.t[n - half]))
-        offs = np.arange(points, dtype=np.float64)
-        self._denom = np.array([math.prod(float(offs[j] - offs[m]) for m in range(points) if m != j)
-                                for j in range(points)])
 
     def __repr__(self) -> str:
         return f"SP3Constellation({self.name!r}, {len(self.ids)} satellites)"
-
-    def _weights(self, u):
-        """Lagrange weights (N, p) and their derivatives (N, p) [per grid step] at u (N,), u
-        counted in steps from the window's first node."""
-        p = self.points
-        d = u[:, None] - np.arange(p, dtype=np.float64)[None, :]                     # (N, p)
-        eye = np.eye(p, dtype=bool)
-        full = np.where(eye[None], 1.0, d[:, None, :])                               # (N, j, m): m != j
-        w = np.prod(full, axis=2) / self._denom
-        # derivative: sum over k != j of prod over m != j, k
-        two = np.where(eye[None, :, None, :] | eye[None, None, :, :], 1.0, d[:, None, None, :])
-        dw = np.sum(np.where(eye[None], 0.0, np.prod(two, axis=3)), axis=2) / self._denom
-        return w, dw
 
     def states(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Positions [m] and velocities [m/s] (N, K, 3), GCRS, at t (N,) [s TT since the epoch]
@@ -105,7 +89,7 @@ class SP3Constellation:
         nan = ~np.isfinite(t)
         u = np.where(nan, self.points // 2, (t - self.t[0]) / self.step)
         start = np.clip(np.floor(u).astype(np.int64) - (half - 1), 0, n - self.points)  # (N,)
-        w, dw = self._weights(u - start)
+        w, dw = lagrange.weights(u - start, np.arange(self.points), derivative=True)
         idx = start[:, None] + np.arange(self.points)[None, :]                        # (N, p)
         g = self.positions[idx]                                                       # (N, p, K, 3)
         r, v = np.einsum("np,npki->nki", w, g), np.einsum("np,npki->nki", dw, g) / self.step
