@@ -392,8 +392,9 @@ def _problem(scen, meas: Measurements, tracking: Tracking, a_priori=None, partia
         fail(f"tracking: group 'bias' but no measurement of {', '.join(BIAS_TYPES)}; leave it out")
     (est, i_est), (con, i_con) = _parameter_sets(scen, tracking, nominal, a_priori, bias_names)
     index = np.concatenate([i_est, i_con])
-    n_base = _values(nominal).size
-    base = np.concatenate([_values(nominal), np.zeros(len(bias_names))])
+    values = _values(nominal)
+    n_base = values.size
+    base = np.concatenate([values, np.zeros(len(bias_names))])
     orbit = index < n_base
     T, sigma, labels = _clock_elimination(meas)
     cache = {}
