@@ -66,9 +66,11 @@ def test_light_paths_and_range_asd():
         tqdyn.range_asd(lt, "14")
 
 
-@pytest.mark.parametrize("old, new", [("tqdyn.io", "tqdyn.formats.trajectory"), ("tqdyn.sweep", "tqdyn.workflows.sweep")])
-def test_version_01_import_paths_warn_and_reexport(old, new):
-    """The 0.1 shims still give the same objects, and importing them warns."""
+@pytest.mark.parametrize("old, new", [("tqdyn.io", "tqdyn.formats.trajectory"), ("tqdyn.sweep", "tqdyn.workflows.sweep"),
+                                      ("tqdyn.analysis.lisa_estimates", "tqdyn.constellation.estimates")])
+def test_old_import_paths_warn_and_reexport(old, new):
+    """The 0.1 shims and the 0.2 path of the LISA estimates still give the same objects, and importing
+    them warns."""
     import importlib
     import sys
 

@@ -27,7 +27,7 @@ PACKAGE = pathlib.Path(tqdyn.__file__).resolve().parent
 #: cannot borrow tqdyn's physics; only the workflows use them
 #: (:func:`test_only_workflows_use_the_peers`).
 LAYERS = ("_version", "numerics", "peers", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
-          "closedloop", "od",
+          "closedloop", "ttl", "od",
           "formats", "analysis", "workflows", "cli", "<front>")
 #: Top-level modules outside the layer packages: the front door and the
 #: version-0.1 import paths kept for users' scripts (they re-export).
@@ -44,6 +44,7 @@ FORBIDDEN = {
     "dynamics": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "scenario": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "closedloop": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
+    "ttl": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "od": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "formats": ("matplotlib", "click", "dask", "distributed", "tqdm"),
     "analysis": ("click", "dask", "distributed", "tqdm"),

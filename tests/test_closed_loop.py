@@ -114,10 +114,11 @@ def _margins_agree(cl, rel=1e-9):
 
 @pytest.mark.parametrize("mission", MISSIONS)
 def test_windowed_margins_equal_the_full_grid_at_the_representative_working_point(mission):
-    """tqdyn.closedloop.study's first-principles working point and default design of each mission."""
-    from tqdyn.closedloop.study import _plant, representative_working_point
+    """tqdyn.closedloop.missions.representative_working_point (the first-principles working point) and the
+    default design of each mission."""
+    from tqdyn.closedloop.missions import representative_plant, representative_working_point
 
-    _margins_agree(build_closed_loop(_plant(mission), representative_working_point(mission),
+    _margins_agree(build_closed_loop(representative_plant(mission), representative_working_point(mission),
                                      default_controllers(mission)))
 
 
@@ -223,7 +224,7 @@ def test_dc_limit_reproduces_the_nominal_split_of_a_coupled_run(tianqin_runs):
     (Table IV minus no self-gravity; compiled kernel, three control conditions) -- the signs and the
     split.  Difference: the loop includes the reaction of the suspension on the spacecraft (m/M =
     4e-3 of A), the nominal control does not; the bound is 2 m/M of |A|."""
-    from tqdyn.analysis.closed_loop import closed_loop_model
+    from tqdyn.closedloop.model import closed_loop_model
 
     with_sg, without = tianqin_runs
     model = closed_loop_model(with_sg)
@@ -246,14 +247,14 @@ def test_dc_limit_reproduces_the_nominal_split_of_a_coupled_run(tianqin_runs):
 @pytest.mark.parametrize("sat", [0, 1, 2])
 def test_windowed_margins_equal_the_full_grid_at_a_coupled_runs_working_point(tianqin_runs, sat):
     """The working points of a coupled TianQin run (tqdyn.propagate, Table IV self-gravity)."""
-    from tqdyn.analysis.closed_loop import closed_loop_model
+    from tqdyn.closedloop.model import closed_loop_model
 
     _margins_agree(closed_loop_model(tianqin_runs[0]).loops[sat][0][1])
 
 
 def test_entry_point_refuses_a_pure_gravity_run():
     import tqdyn
-    from tqdyn.analysis.closed_loop import ClosedLoopError, closed_loop_model
+    from tqdyn.closedloop.model import ClosedLoopError, closed_loop_model
 
     tr = tqdyn.propagate("tianqin-gravity", {"run.duration": "1h", "integrator.step": 600})
     with pytest.raises(ClosedLoopError, match="missing") as e:
@@ -261,8 +262,85 @@ def test_entry_point_refuses_a_pure_gravity_run():
     assert "\n" not in str(e.value)
 
 
+def _with_scenario(traj, text):
+    """A shallow copy of the trajectory ``traj`` whose recorded scenario is ``text``."""
+    import copy
+
+    out = copy.copy(traj)
+    out.scenario_toml = text
+    return out
+
+
+@pytest.mark.parametrize("config", [None, "given"])
+def test_a_recorded_scenario_that_does_not_load_is_refused_in_one_line(tianqin_runs, config):
+    """A run whose recorded scenario does not load (here an unknown key under [forces]) is refused in one
+    line naming the trajectory and the key, whether the [closed_loop] settings come from that scenario
+    (config None: they were replaced by the defaults) or are given (the gravity gradient was set to
+    zero).  Reference: the key written into the text here."""
+    from tqdyn.closedloop.model import ClosedLoopError, closed_loop_model
+    from tqdyn.scenario.closed_loop import ClosedLoopConfig
+
+    traj = tianqin_runs[0]
+    assert "\n[forces]\n" in traj.scenario_toml
+    bad = _with_scenario(traj, traj.scenario_toml.replace("\n[forces]\n", "\n[forces]\nnot_a_key = 1\n", 1))
+    with pytest.raises(ClosedLoopError) as e:
+        closed_loop_model(bad, None if config is None else ClosedLoopConfig())
+    msg = str(e.value)
+    assert msg.startswith("the in-memory trajectory: its recorded scenario does not load (forces.not_a_key)")
+    assert "\n" not in msg and len(msg) <= 200
+
+
+def test_a_file_whose_scenario_does_not_load_is_named(tianqin_runs, tmp_path):
+    """The refusal names the file a trajectory was read from (its path); the error of the scenario's
+    loader is one of TOML here (a truncated text)."""
+    from tqdyn.closedloop.model import ClosedLoopError, closed_loop_model
+
+    bad = _with_scenario(tianqin_runs[0], "[scenario\n")
+    bad.path = tmp_path / "run.h5"
+    with pytest.raises(ClosedLoopError, match=r"^'.*run\.h5': its recorded scenario does not load; allowed: "):
+        closed_loop_model(bad)
+
+
+def test_the_recorded_gravity_gradient_enters_the_working_point(tianqin_runs):
+    """The working point's gravity gradient is the run's (Earth GM/r^3 ~ 4e-10 s^-2 at TianQin's 1e8 m,
+    the largest eigenvalue 2 GM/r^3 of the point-mass tide), not zero."""
+    from tqdyn.closedloop.model import closed_loop_model
+
+    wp = closed_loop_model(tianqin_runs[0]).parts[0][0][1]
+    ev = np.linalg.eigvalsh(0.5 * (wp.gamma + wp.gamma.T))
+    assert ev[-1] == pytest.approx(2 * 3.986004415e14 / 1e8 ** 3, rel=0.01)
+
+
+def test_the_closed_loop_settings_defaults_are_the_scenarios_table():
+    """The model's settings without a [closed_loop] section are tqdyn.scenario.closed_loop.CLOSED_LOOP_KEYS'
+    defaults, and docs/scenarios.md's table states the same values (the reference: the page)."""
+    import pathlib
+    import re
+
+    from tqdyn.scenario.closed_loop import CLOSED_LOOP_KEYS, ClosedLoopConfig
+
+    s = ClosedLoopConfig().settings()
+    assert s == {k: d for k, (_kind, d) in CLOSED_LOOP_KEYS.items() if k != "mission"}
+    page = (pathlib.Path(__file__).resolve().parent.parent / "docs" / "scenarios.md").read_text(encoding="utf-8")
+    rows = dict(re.findall(r"^\| (`[^|]+`) \| ([^|]+) \|", page, flags=re.M))
+    assert float(rows["`fs`"]) == s["fs"] and int(rows["`seed`"]) == s["seed"]
+    assert [float(x) for x in rows["`f_min`, `f_max`, `n_freq`"].split(",")] == [s["f_min"], s["f_max"], s["n_freq"]]
+    assert rows["`segment`"].strip() == '`"1d"`' and s["segment"] == 86400.0
+    assert rows["`attitude_z_sensor`"].strip() == f'`"{s["attitude_z_sensor"]}"`'
+
+
+@pytest.mark.parametrize("sensor", ["dws", "star_tracker"])
+def test_the_interconnection_leaves_no_signal_unconnected(sensor):
+    """python-control's own check of the named interconnection (unused_signals: every block input fed,
+    every block output used) finds nothing, for both attitude-z sensors: no misnamed signal."""
+    p, wp = _model("lisa")
+    cl = build_closed_loop(p, wp, default_controllers("lisa"), sensor)
+    assert cl.system.unused_signals() == ({}, {})
+
+
 def test_entry_point_budget_and_series_are_xarray(tianqin_runs):
-    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_model, closed_loop_timeseries
+    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_timeseries
+    from tqdyn.closedloop.model import closed_loop_model
 
     model = closed_loop_model(tianqin_runs[0])
     calls = []
@@ -275,11 +353,11 @@ def test_entry_point_budget_and_series_are_xarray(tianqin_runs):
 
 
 def test_design_numbers_dc_path_is_far_below_the_requirement():
-    """tqdyn.closedloop.study.design_numbers() at the first-principles working points (Table IV
+    """tqdyn.analysis.closed_loop_paths.design_numbers() at the first-principles working points (Table IV
     self-gravity, DC suspension 8.4e-11 m/s^2): the DC self-gravity's path (1e-6 actuation noise x
     the DC force x 1e-3 cross-talk, ~1e-19 m/s^2/Hz^1/2 by that product) is below 1e-3 of the
     requirement at 1 mHz for every mission; the stiffness path is |K| x jitter."""
-    from tqdyn.closedloop.study import design_numbers
+    from tqdyn.analysis.closed_loop_paths import design_numbers
 
     fresh = design_numbers()
     for m, v in fresh["missions"].items():

@@ -55,7 +55,8 @@ def test_the_command_writes_what_the_entry_points_compute(runs, made):
     import hashlib
 
     import tqdyn
-    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_model, closed_loop_timeseries
+    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_timeseries
+    from tqdyn.closedloop.model import closed_loop_model
     from tqdyn.formats.closed_loop import read_closed_loop
     from tqdyn.scenario import loads_scenario
 

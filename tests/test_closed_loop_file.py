@@ -22,7 +22,8 @@ F = np.logspace(-4, 0, 8)
 @pytest.fixture(scope="module")
 def model_and_budget():
     import tqdyn
-    from tqdyn.analysis.closed_loop import closed_loop_budget, closed_loop_model
+    from tqdyn.analysis.closed_loop import closed_loop_budget
+    from tqdyn.closedloop.model import closed_loop_model
 
     traj = tqdyn.propagate("tianqin", {"run.duration": "2h", "integrator.step": 600})
     model = closed_loop_model(traj)

@@ -25,7 +25,7 @@ from tqdyn.closedloop.controllers import lead_lag_pid
 from tqdyn.closedloop.loop import build_closed_loop
 from tqdyn.closedloop.missions import CROSSOVER_HZ, default_controllers, default_noise, default_plant
 from tqdyn.closedloop.one_dof import two_tm_axis_loop
-from tqdyn.closedloop.study import _plant, representative_working_point
+from tqdyn.closedloop.missions import representative_plant, representative_working_point
 
 # published (PRL 116, 231101; PRD 99, 122003)
 DG_FLOOR = 5.2e-15          # m s^-2 / Hz^1/2, 0.7 .. 20 mHz
@@ -119,7 +119,7 @@ def lisa_dc_limit():
     wp = representative_working_point("lisa")
     A = np.array([[0.0, 1e-10, 0.0], [0.0, -1e-10, 0.0]])
     wp = dataclasses.replace(wp, a_suspension=A, self_gravity=np.zeros((2, 3)), a_dragfree=np.zeros(3))
-    p = _plant("lisa")
+    p = representative_plant("lisa")
     cl = build_closed_loop(p, wp, default_controllers("lisa"))
     check_stable(cl)
     return p, cl
@@ -166,7 +166,7 @@ def test_mosa_actuator_path_to_the_science_axis_is_crosstalk_of_the_suspension_f
     the sensitive axis: a = crosstalk |T_sus| |rho| (tau/I_m) |S_mosa|.  The budget agrees within 0.3 %
     (measured 0.05 % at 1-20 mHz) at LISA's representative working point."""
     wp = representative_working_point("lisa")
-    p = _plant("lisa")
+    p = representative_plant("lisa")
     cl = build_closed_loop(p, wp, default_controllers("lisa"))
     f = np.array([1e-3, 5e-3, 1e-2, 2e-2])
     noise = default_noise("lisa")

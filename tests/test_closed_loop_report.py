@@ -47,9 +47,10 @@ def test_figures_are_written(tmp_path):
     from tqdyn.closedloop.budget import loop_gains, loop_margins, noise_budget
     from tqdyn.closedloop.loop import build_closed_loop
     from tqdyn.closedloop.missions import default_controllers, default_noise, requirement
-    from tqdyn.closedloop.study import _plant, representative_working_point
+    from tqdyn.closedloop.missions import representative_plant, representative_working_point
 
-    cl = build_closed_loop(_plant("tianqin"), representative_working_point("tianqin"), default_controllers("tianqin"))
+    cl = build_closed_loop(representative_plant("tianqin"), representative_working_point("tianqin"),
+                           default_controllers("tianqin"))
     f = np.logspace(-5, 0, 60)
     outs = ["tm1_acceleration", "tm1_sc_jitter"]
     b, sources = noise_budget(cl, default_noise("tianqin"), f, outputs=outs)

@@ -55,8 +55,8 @@ def _reference(files, times):
 
     import tqdyn
     from tqdyn.analysis.ttl_budget import worst_case_coefficients
-    from tqdyn.closedloop.ttl import link_ttl
-    from tqdyn.closedloop.ttl_budget import ANGLE_OUTPUTS, mosa_angles_from_outputs
+    from tqdyn.ttl.coupling import link_ttl
+    from tqdyn.ttl.budget import ANGLE_OUTPUTS, mosa_angles_from_outputs
     from tqdyn.formats.closed_loop import read_closed_loop
 
     ts = read_closed_loop(files["closed_loop"]).timeseries(list(ANGLE_OUTPUTS))
@@ -130,7 +130,7 @@ def test_x2_with_ttl_minus_without_is_the_x2_of_the_ttl(chain, record_number):
 
 
 def test_injection_enters_like_lisa_instruments_own_ttl(chain, tmp_path, record_number):
-    """The derivation (tqdyn.closedloop.ttl_injection): LISA Instrument with its own TTL (random coefficients,
+    """The derivation (tqdyn.ttl.injection): LISA Instrument with its own TTL (random coefficients,
     different for every MOSA; its angular jitters the only noise) and LISA Instrument with no jitter but the
     file -(nu0/c) link_ttl(its jitter velocities) at the readout_isi_carrier / _usb points (16 Hz, its physics
     grid; tqdyn's delays from the orbit file's light travel times) give the same science readouts: carrier and
@@ -143,7 +143,7 @@ def test_injection_enters_like_lisa_instruments_own_ttl(chain, tmp_path, record_
     import h5py
     from lisainstrument import Instrument
 
-    from tqdyn.closedloop.ttl import TTLCoefficients, link_ttl
+    from tqdyn.ttl.coupling import TTLCoefficients, link_ttl
     from tqdyn.formats.lisa_injection import write_lisa_injection
 
     files, _ = chain
@@ -184,7 +184,7 @@ def test_injection_enters_like_lisa_instruments_own_ttl(chain, tmp_path, record_
 
 
 def test_tm_injection_enters_like_lisa_instruments_test_mass_noise(chain, tmp_path, record_number):
-    """The test-mass point (tqdyn.closedloop.ttl_injection): LISA Instrument with its own test-mass noise (the
+    """The test-mass point (tqdyn.ttl.injection): LISA Instrument with its own test-mass noise (the
     only noise) and LISA Instrument with no noise but that velocity (m/s, 16 Hz) at ``tm_ij`` give the same
     test-mass interferometer readouts, carrier and sideband (< 1e-12 relative RMS, full band; measured 4e-16:
     the spline of the file is exact at its samples), and the science interferometers see nothing of it."""

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from cli_support import run_cli
-from tqdyn.analysis import lisa_estimates as le
+from tqdyn.constellation import estimates as le
 from tqdyn.analysis.metrics import orbit_deviation
 from tqdyn.astro.oem_states import states_at, to_heliocentric
 from tqdyn.formats.trajectory import read_trajectory
@@ -218,7 +218,7 @@ def test_coupled_lisa_on_esas_orbit_matches_the_identity_on_esas_files(runs):
 
 
 def test_cw_closed_forms_solve_the_hill_equations():
-    # tqdyn.analysis.lisa_estimates.cartwheel_sg_displacement (the docs' closed forms) against scipy's integration
+    # tqdyn.constellation.estimates.cartwheel_sg_displacement (the docs' closed forms) against scipy's integration
     # of x'' = 3n^2 x + 2n y' + f_x, y'' = -2n x' + f_y, z'' = -n^2 z + f_z with f along X_S = -rho_hat,
     # Y_S = N x rho_hat, Z_S = -N of a cartwheel satellite.  Measured agreement ~1e-10 relative; bound 1e-7.
     from scipy.integrate import solve_ivp

@@ -1,4 +1,4 @@
-"""Tilt-to-length coupling of the six links (tqdyn.closedloop.ttl).
+"""Tilt-to-length coupling of the six links (tqdyn.ttl.coupling).
 
 References: (a) the analytic sine (a linear TTL of a sinusoidal jitter is the coefficient times the
 sine, delayed by tau for the distant term); (b), (c) LISA Instrument 2.3's own formulas
@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from tqdyn.closedloop import ttl
+from tqdyn.ttl import coupling as ttl
 
 DT = 0.25  # s, LISA Instrument's default physics step
 N = 2000

@@ -1,9 +1,9 @@
-"""The single-link TTL budget from the closed loop (tqdyn.closedloop.ttl_budget, tqdyn.analysis.ttl_budget).
+"""The single-link TTL budget from the closed loop (tqdyn.ttl.budget, tqdyn.analysis.ttl_budget).
 
-References: LISA Instrument 2.3's MOSA angle formulas (tqdyn.closedloop.ttl.mosa_angles, itself checked
+References: LISA Instrument 2.3's MOSA angle formulas (tqdyn.ttl.coupling.mosa_angles, itself checked
 against LISA Instrument in tests/test_ttl.py) under the frame identification x_sc = X_S, z_sc = -Z_S; the
 analytic ASD of a static single-input transfer (|sum_k c_k g_k| x ASD); the Welch estimate's own
-statistics on a seeded closed-loop time series passed through tqdyn.closedloop.ttl.link_ttl.
+statistics on a seeded closed-loop time series passed through tqdyn.ttl.coupling.link_ttl.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from tqdyn.closedloop.missions import default_controllers, default_noise, defaul
 from tqdyn.closedloop.noise import AsdModel
 from tqdyn.closedloop.plant import PlantParameters, WorkingPoint
 from tqdyn.closedloop.simulate import simulate
-from tqdyn.closedloop.ttl import MOSAS, TTLCoefficients, link_ttl, mosa_angles
-from tqdyn.closedloop.ttl_budget import ANGLE_OUTPUTS, angle_map, link_ttl_asd, mosa_angles_from_outputs
+from tqdyn.ttl.coupling import MOSAS, TTLCoefficients, link_ttl, mosa_angles
+from tqdyn.ttl.budget import ANGLE_OUTPUTS, angle_map, link_ttl_asd, mosa_angles_from_outputs
 from tqdyn.constellation.spacecraft import Spacecraft
 
 
@@ -141,7 +141,7 @@ def test_single_link_budget_dataset_and_its_tm_term():
     (LISA's requirement shape, 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4) each, drag-free
     suppresses the rest) in quadrature over (2 pi f)^2 (within 10 %); the requirement is LISA's 15 pm
     sqrt(1 + (2 mHz/f)^4); total = power sum of TTL, TM and readout (round-off)."""
-    from tqdyn.analysis.closed_loop import ClosedLoopModel
+    from tqdyn.closedloop.model import ClosedLoopModel
     from tqdyn.analysis.ttl_budget import single_link_budget
 
     cl = _lisa_loop()
@@ -236,7 +236,7 @@ def test_link_budget_summary_against_an_analytic_budget():
 
 
 def test_summary_refuses_a_band_outside_the_grid_and_bad_frequencies_in_one_line():
-    from tqdyn.analysis.closed_loop import ClosedLoopModel
+    from tqdyn.closedloop.model import ClosedLoopModel
     from tqdyn.analysis.ttl_budget import link_budget_summary, single_link_budget, ttl_budget_values
 
     cl = _lisa_loop()

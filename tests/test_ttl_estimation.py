@@ -1,4 +1,4 @@
-"""Estimation of one link's TTL coefficients (tqdyn.closedloop.ttl_estimation).
+"""Estimation of one link's TTL coefficients (tqdyn.ttl.estimation).
 
 References: (a) the injected coefficients (noise-free data must return them to round-off);
 (b) the estimators' own predicted covariances against their scatter over seeds (chi-square
@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from tqdyn.closedloop import ttl
-from tqdyn.closedloop import ttl_estimation as te
+from tqdyn.ttl import coupling as ttl
+from tqdyn.ttl import estimation as te
 from tqdyn.closedloop.noise import AsdModel
 
 DT = 0.5  # s

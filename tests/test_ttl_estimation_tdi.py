@@ -1,5 +1,5 @@
 """Joint estimation of the six links' 24 TTL coefficients, from the links and in TDI
-(tqdyn.closedloop.ttl_estimation_tdi).
+(tqdyn.ttl.estimation_tdi).
 
 References: (a) PyTDI 2.2's second-generation Michelson X2, Y2, Z2 (``pytdi.michelson.X2_ETA``
 etc., an independent implementation of the nested delays) for the TDI operator; (b) the injected
@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from tqdyn.closedloop import ttl
-from tqdyn.closedloop import ttl_estimation_tdi as tt
+from tqdyn.ttl import coupling as ttl
+from tqdyn.ttl import estimation_tdi as tt
 from tqdyn.closedloop.noise import AsdModel
 
 DT = 0.5  # s

@@ -1,4 +1,4 @@
-"""Time-varying TTL coefficients (tqdyn.closedloop.ttl), LISA Instrument's TTL coefficient file
+"""Time-varying TTL coefficients (tqdyn.ttl.coupling), LISA Instrument's TTL coefficient file
 (tqdyn.formats.ttl) and ``tqdyn export CL.h5 --format ttl OUT.h5`` (docs/tilt-to-length.md).
 
 References: LISA Instrument 2.3's own reader and writer (``lisainstrument.ttl``); analytic sines with
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from cli_support import run_cli
-from tqdyn.closedloop.ttl import (LINEAR_FIELDS, LPF_DRIFT_M_PER_RAD_PER_S, MOSAS, TimeVaryingTTLCoefficients,
+from tqdyn.ttl.coupling import (LINEAR_FIELDS, LPF_DRIFT_M_PER_RAD_PER_S, MOSAS, TimeVaryingTTLCoefficients,
                                   TTLCoefficients, distant_mosa, ttl_terms)
 
 C_SI = 299792458.0
@@ -222,7 +222,7 @@ def test_lisa_instrument_applies_tqdyns_file_as_tqdyn_does(tmp_path, record_numb
     local, distant = ttl_terms(phidot, etadot, c, dt, tau, t0=0.0)
     # the wrong convention, for contrast: the distant coefficient taken at the reception time
     t = dt * np.arange(n)
-    from tqdyn.closedloop.ttl import _delay
+    from tqdyn.ttl.coupling import _delay
     wrong = {m: c.coefficient("distant_phi", distant_mosa(m), t) * _delay(phidot[distant_mosa(m)], dt, tau[m])
              + c.coefficient("distant_eta", distant_mosa(m), t) * _delay(etadot[distant_mosa(m)], dt, tau[m])
              for m in MOSAS}

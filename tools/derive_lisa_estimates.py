@@ -13,7 +13,7 @@
    print its first order in OA_l.
 4. G and A of the LISA drag-free scheme (Cramer's rule) from g at first
    order with the zeroth-order geometry; their Fourier coefficients, printed
-   as exact fractions (and compared with tqdyn.analysis.lisa_estimates.kepler_control).
+   as exact fractions (and compared with tqdyn.constellation.estimates.kepler_control).
 5. Numerical check: the exact identity on the exact two-body orbits of the
    design (Kepler's equation solved to round-off) for alpha = 1e-3 .. 1e-1:
    max |G| / (alpha n^2 d) -> 4.1204 with an O(alpha) difference.
@@ -193,7 +193,7 @@ def cw_part():
         assert all(sp.simplify(sp.expand_trig(e)) == 0 for e in eqs)
         assert all(sp.simplify(x.subs(t, 0)) == 0 and sp.simplify(sp.diff(x, t).subs(t, 0)) == 0 for x in disp)
         print(f"  push along {lab}_S, per unit f: x, y, z =", [sp.simplify(x) for x in disp])
-        from tqdyn.analysis.lisa_estimates import cartwheel_sg_displacement
+        from tqdyn.constellation.estimates import cartwheel_sg_displacement
 
         fn = sp.lambdify((t, n, ph), disp, "numpy")
         tt = np.linspace(0.0, 4e7, 101)
@@ -201,7 +201,7 @@ def cw_part():
             ref = np.stack(np.broadcast_arrays(*fn(tt, 2e-7, phase)), -1)
             got = cartwheel_sg_displacement(lab, 1.0, 2e-7, tt, phase)[0]
             assert np.allclose(got, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max()), lab
-    print("  each solves the CW equations from a zero state; tqdyn.analysis.lisa_estimates.cartwheel_sg_displacement "
+    print("  each solves the CW equations from a zero state; tqdyn.constellation.estimates.cartwheel_sg_displacement "
           "agrees")
 
 
@@ -220,7 +220,7 @@ def main():
     for name, arr in (("G_S", GS), ("A_1 (OA_1)", A1), ("A_2 (OA_2)", A2), ("g_1 (OA_1)", g1o), ("g_2 (OA_2)", g2o)):
         for q, comp in enumerate("xyz"):
             print(f"  {name} {comp}: {fourier(arr[:, q], ts)}")
-    from tqdyn.analysis.lisa_estimates import kepler_control
+    from tqdyn.constellation.estimates import kepler_control
 
     g_m, G_m, A_m = kepler_control(ts)
     assert np.allclose(G_m, GS, atol=1e-12) and np.allclose(A_m[:, 0], A1, atol=1e-12) \
@@ -228,9 +228,9 @@ def main():
     fine = np.linspace(0, 2 * np.pi, 400001)
     _, Gf, Af = kepler_control(fine)
     print(f"  max |G| = {np.linalg.norm(Gf, axis=-1).max():.9f}, max |A component| = {np.abs(Af).max():.9f} "
-          "(alpha n^2 d); tqdyn.analysis.lisa_estimates.kepler_control agrees to 1e-12")
+          "(alpha n^2 d); tqdyn.constellation.estimates.kepler_control agrees to 1e-12")
     print("5. the exact identity on the exact two-body design: max |G| / (alpha n^2 d)")
-    from tqdyn.analysis.lisa_estimates import arm_identity_control
+    from tqdyn.constellation.estimates import arm_identity_control
 
     for alpha in (1e-3, 3e-3, 8.3557e-3, 1e-2, 3e-2, 1e-1):
         t = np.linspace(0, 2 * np.pi, 2001)

@@ -185,8 +185,8 @@ def breathing_angles(trajectory: Trajectory) -> np.ndarray:
 
 def closed_loop_model(trajectory: Trajectory, config=None, validate: bool = True):
     """The closed loops of a coupled run (docs/closed-loop.md):
-    :func:`tqdyn.analysis.closed_loop.closed_loop_model` (imported on first use)."""
-    from .analysis.closed_loop import closed_loop_model as f
+    :func:`tqdyn.closedloop.model.closed_loop_model` (imported on first use)."""
+    from .closedloop.model import closed_loop_model as f
 
     return f(trajectory, config, validate)
 

@@ -19,16 +19,10 @@ the spectra module).
 Orbit deviations: |r_run(t) - r_ref(t)| per satellite on the rows both runs
 share, and its components along the reference's along-track direction
 t_hat = h_hat x r_hat (h_hat = r x v / |r x v|).  The secular along-track
-drift that a small acceleration f (radial f_r, along-track f_t) causes on a
-near-circular orbit of mean motion n is, from the averaged Hill
-(Clohessy-Wiltshire) equations with zero initial relative state,
-
-    delta_t(T) = -3 int_0^T (T - s) f_t(s) ds - (2 / n) int_0^T f_r(s) ds,
-
-(:func:`secular_along_track_drift`); for a constant f_t it is -3/2 f_t T^2
-(a forward push makes the satellite fall behind).  The report evaluates it
-with the stored drag-free acceleration G_i to explain the drag-free orbit's
-deviation from the gravity orbit.
+drift that a small acceleration causes on a near-circular orbit (the Hill
+equations' model, :func:`tqdyn.constellation.estimates.secular_along_track_drift`,
+re-exported here) explains, with the stored drag-free acceleration G_i, the
+drag-free orbit's deviation from the gravity orbit in the report.
 """
 
 from __future__ import annotations
@@ -37,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..astro.constants import GM_EARTH_EGM2008
 from ..constellation import geometry
+from ..constellation.estimates import secular_along_track_drift
 from ..constellation.indices import Link
 from ..lightpath import light_travel_times
 from . import spectra
@@ -213,34 +207,6 @@ def orbit_deviation(run, ref) -> Deviation | None:
 
     return Deviation(t=t, d=d, norm=np.linalg.norm(d, axis=-1), radial=dot(d, rh), along=dot(d, th),
                      cross=dot(d, hh))
-
-
-def secular_along_track_drift(t, r, v, f) -> np.ndarray:
-    """Secular along-track drift [m] caused by a small acceleration f on a near-circular orbit.
-
-    t : (N,) [s] increasing; r, v : (N, n_sat, 3) [m, m/s] GCRS (the
-    perturbed orbit is fine: f is small); f : (N, n_sat, 3) [m/s^2] GCRS.
-    Returns (N, n_sat): -3 int_0^t (t - s) f_t ds - (2/n) int_0^t f_r ds
-    (module docstring), f_t = f . t_hat, f_r = f . r_hat, n = sqrt(GM / a^3)
-    with a the mean |r| (GM: EGM2008), integrals by the trapezoidal rule.
-    """
-    from scipy.integrate import cumulative_trapezoid
-
-    t = np.asarray(t, np.float64)
-    r = np.asarray(r, np.float64)
-    v = np.asarray(v, np.float64)
-    f = np.asarray(f, np.float64)
-    rn = np.linalg.norm(r, axis=-1, keepdims=True)
-    rh = r / rn
-    h = np.cross(r, v)
-    th = np.cross(h / np.linalg.norm(h, axis=-1, keepdims=True), rh)
-    ft = np.einsum("...k,...k->...", f, th)
-    fr = np.einsum("...k,...k->...", f, rh)
-    n = np.sqrt(float(GM_EARTH_EGM2008) / np.mean(rn[..., 0], axis=0) ** 3)  # (n_sat,)
-    Ft = cumulative_trapezoid(ft, t, axis=0, initial=0.0)
-    FFt = cumulative_trapezoid(Ft, t, axis=0, initial=0.0)
-    Fr = cumulative_trapezoid(fr, t, axis=0, initial=0.0)
-    return -3.0 * FFt - 2.0 / n * Fr
 
 
 def flight_axis_check(traj) -> np.ndarray:

@@ -2,7 +2,7 @@
 from the closed loop's angle jitter, the interferometer readout noise and the TM acceleration noise as
 displacement, against each mission's single-link requirement, as an ``xarray.Dataset``.
 
-Units: m/Hz^1/2 (one-sided ASDs), Hz.  Links in LISA Instrument's order (``tqdyn.closedloop.ttl.MOSAS``).
+Units: m/Hz^1/2 (one-sided ASDs), Hz.  Links in LISA Instrument's order (``tqdyn.ttl.coupling.MOSAS``).
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import numpy as np
 
 from ..closedloop.budget import dominant_sources, noise_budget
 from ..closedloop.noise import AsdModel
-from ..closedloop.ttl import MOSAS, RANDOM_HALF_WIDTH_M_PER_RAD, TTLCoefficients
-from ..closedloop.ttl_budget import link_ttl_asd, tm_displacement_asd
+from ..ttl.coupling import MOSAS, RANDOM_HALF_WIDTH_M_PER_RAD, TTLCoefficients
+from ..ttl.budget import link_ttl_asd, tm_displacement_asd
 
 __all__ = ["READOUT", "SINGLE_LINK_REQUIREMENT", "SUMMARY_BANDS_HZ", "SUMMARY_BAND_HZ", "SUMMARY_FREQUENCIES_HZ",
            "TTL_ALLOCATION", "link_budget_summary", "single_link_budget", "ttl_budget_values",
@@ -62,8 +62,8 @@ def worst_case_coefficients() -> TTLCoefficients:
 def single_link_budget(model, coeffs: TTLCoefficients | None = None, f=None, segment: int = 0,
                        readout: AsdModel | None = None, dt: float | None = None):
     """The single-link displacement budget of segment ``segment`` of a closed-loop model
-    (:func:`tqdyn.analysis.closed_loop.closed_loop_model`) as an ``xarray.Dataset`` over (link, source,
-    frequency): ``ttl`` the TTL ASD per source (:func:`tqdyn.closedloop.ttl_budget.link_ttl_asd`),
+    (:func:`tqdyn.closedloop.model.closed_loop_model`) as an ``xarray.Dataset`` over (link, source,
+    frequency): ``ttl`` the TTL ASD per source (:func:`tqdyn.ttl.budget.link_ttl_asd`),
     ``ttl_total``; ``tm_acceleration`` the two TMs' residual acceleration over (2 pi f)^2 per source
     and its total; ``readout`` the science interferometer's readout noise; ``total`` their power sum;
     ``requirement`` :data:`SINGLE_LINK_REQUIREMENT`; ``margin`` requirement / total.  ``coeffs``

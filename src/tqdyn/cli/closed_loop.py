@@ -47,8 +47,8 @@ class _Bars:
 @click.option("--output", "-o", required=True, help="Output closed-loop HDF5 file (replaced only by a complete one).")
 @click.option("--duration", help="Length of the time series: seconds, or with a unit: 3d, 6h, 30min, 3600s "
                                  "[default: closed_loop.duration, else the run's span].")
-@click.option("--fs", help="Sample rate of the time series [Hz; default: closed_loop.fs, 4].")
-@click.option("--seed", type=int, help="Root seed of the noise realisations [default: closed_loop.seed, 0].")
+@click.option("--fs", help="Sample rate of the time series [Hz; default: closed_loop.fs, docs/scenarios.md].")
+@click.option("--seed", type=int, help="Root seed of the noise realisations [default: closed_loop.seed].")
 @click.option("--set", "sets", multiple=True, metavar="closed_loop.KEY=VALUE",
               help="Override a closed-loop key of the run's scenario, e.g. --set closed_loop.n_freq=100 or "
                    "--set closed_loop.noise.thruster_force.level=1e-7 (repeatable; docs/scenarios.md).")

@@ -28,7 +28,7 @@ _LISA_OPTIONS = ("shapiro", "frame", "axes", "time_origin")
 _TTL_OPTIONS = ("coefficients", "seed", "drift", "step")
 _INJECTION_OPTIONS = ("run", "tm_acceleration")
 #: LISA Pathfinder's measured drift of its TTL coefficients, 1 um/rad in 100 days, in m/rad per day
-#: (:data:`tqdyn.closedloop.ttl.LPF_DRIFT_M_PER_RAD_PER_S`).
+#: (:data:`tqdyn.ttl.coupling.LPF_DRIFT_M_PER_RAD_PER_S`).
 _LPF_DRIFT_PER_DAY = 1e-8
 
 

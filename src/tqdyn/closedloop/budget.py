@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from .controllers import LOOPS
 from .loop import SOURCES, ClosedLoop, output_names, source_inputs
 
 __all__ = ["DesignError", "LoopMargins", "check_stable", "closed_loop_response", "frequency_response", "loop_gains",
@@ -223,6 +222,3 @@ def check_stable(cl: ClosedLoop, tol: float = 1e-9) -> None:
                       f"the closed loop is unstable (pole at Re = {np.max(ev.real):.3g} 1/s; channel {worst.channel}: "
                       f"phase margin {worst.phase_margin:.3g} deg, gain margin {worst.gain_margin:.3g}); "
                       "allowed: a stabilising design (docs/closed-loop.md)")
-
-
-_ = LOOPS

@@ -27,24 +27,10 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..scenario.closed_loop import LOOP_NAMES, check_controller
+from ..scenario.closed_loop import LOOPS, check_controller
 from ..scenario.values import ScenarioError
 
 __all__ = ["Controller", "ControllerError", "LOOPS", "lead_lag_pid"]
-
-#: Loops: name -> (channels, what is sensed, sensor, actuator).
-LOOPS = {
-    "dragfree": (("tm1 sensitive axis", "tm2 sensitive axis", "mean z of the TMs"), "m",
-                 "interferometer (sensitive axes), capacitive (z)", "thrusters (force)"),
-    "suspension": (("tm1 p axis (Z x e_1)", "tm2 p axis (Z x e_2)", "half the z difference"), "m",
-                   "capacitive", "electrostatic force"),
-    "attitude": (("x", "y"), "rad", "DWS (the pitches of both MOSAs)", "thrusters (torque)"),
-    "attitude_z": (("z",), "rad", "mean DWS yaw minus mean MOSA encoder angle (or the star tracker)",
-                   "thrusters (torque)"),
-    "mosa": (("MOSA 1", "MOSA 2"), "rad", "DWS yaw of the MOSA (spacecraft yaw + MOSA angle)", "MOSA actuator"),
-    "tm_rotation": (("tm1 x", "tm1 y", "tm1 z", "tm2 x", "tm2 y", "tm2 z"), "rad", "capacitive", "electrostatic torque"),
-}
-
 
 #: Invalid controllers raise the scenario's one-line error naming the key.
 ControllerError = ScenarioError
@@ -76,6 +62,3 @@ def lead_lag_pid(f_c: float, alpha: float = 10.0, integrator_ratio: float = 10.0
     s = 1j * wc
     mag = abs((s + wz) * (s + wi) / (s * (s + wp))) / wc ** 2
     return Controller(zeros=(-wz, -wi), poles=(0.0, -wp), gain=1.0 / mag, name=name)
-
-
-assert tuple(LOOPS) == LOOP_NAMES, "the scenario's loop names and LOOPS differ"

@@ -17,32 +17,13 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..scenario.closed_loop import SOURCE_UNITS
+from ..scenario.closed_loop import ATTITUDE_Z_SENSORS, SOURCES
 from .controllers import LOOPS, Controller
 from .plant import PlantParameters, WorkingPoint, linear_plant, sensitive_basis
 
 __all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "build_closed_loop", "output_names", "source_inputs"]
 
-#: Noise sources: name -> (components, unit of the ASD, where it enters).
-SOURCES = {
-    "thruster_force": (3, "N", "thrust, S axes"),
-    "thruster_gain": (3, "1", "fractional thrust noise times the DC thrust M |G| per S axis"),
-    "thruster_torque": (3, "N m", "thruster torque, S axes"),
-    "tm_force": (6, "m/s^2", "stray acceleration of TM 1, TM 2 (OA_l axes)"),
-    "tm_torque": (6, "rad/s^2", "stray angular acceleration of TM 1, TM 2 (OA_l)"),
-    "actuation_force": (6, "1", "fractional electrostatic force noise times the DC force m |A| per OA_l axis"),
-    "actuation_torque": (6, "1", "fractional electrostatic torque noise times the DC torque I |alpha| per OA_l axis"),
-    "capacitive_translation": (6, "m", "capacitive readout of x_1, x_2 (OA_l)"),
-    "capacitive_rotation": (6, "rad", "capacitive readout of eta_1, eta_2 (OA_l)"),
-    "interferometer": (2, "m", "TM interferometer along each sensitive axis"),
-    "dws": (4, "rad", "DWS pitch and yaw of MOSA 1, then MOSA 2"),
-    "star_tracker": (3, "rad", "star tracker, S axes"),
-    "mosa_encoder": (2, "rad", "MOSA angle encoder (the angle of the MOSA relative to the spacecraft)"),
-    "mosa_actuator": (2, "N m", "MOSA actuator torque"),
-}
-
 _AX = ("x", "y", "z")
-assert {k: v[1] for k, v in SOURCES.items()} == SOURCE_UNITS, "the scenario's source units and SOURCES differ"
 
 
 def _output_table() -> dict:
@@ -139,25 +120,9 @@ def _controllers_ss(controllers: dict) -> list:
     return out
 
 
-def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
-                      attitude_z_sensor: str = "dws") -> ClosedLoop:
-    """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
-    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
-    ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
-    "star_tracker" (as LISA Pathfinder, which had no DWS)."""
-    if attitude_z_sensor not in ("dws", "star_tracker"):
-        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
-                         "allowed: 'dws', 'star_tracker'")
-    P = linear_plant(p, wp)
-    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
-    from ..constellation.control import oa_rotation
-    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
-    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
-    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
-    m, Itm, Im, Msc = p.tm_mass, p.tm_inertia, p.mosa_inertia, p.sc_mass
-    J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
-
-    # ---- sensors: plant coordinates + sensor noise -> error signals e_<loop>[k]
+def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
+    """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static): ``basis`` (2, 3, 3)
+    of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3) Y_OA_l in S."""
     sin = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
            + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
            + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
@@ -213,10 +178,15 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
         for i in range(3):
             row({f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
             names.append(f"e_tm_rotation[{3 * (l - 1) + i}]")
-    sensors = _static(np.array(rows), sin, names, "sensors")
+    return _static(np.array(rows), sin, names, "sensors")
 
-    # ---- actuators: controller outputs c + loop breaks d + actuation noise -> plant inputs
-    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
+
+def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple[control.StateSpace, dict]:
+    """Controller outputs ``c`` + loop breaks ``d`` + actuation noise -> the plant inputs (static), and the
+    DC levels of the force-proportional sources (:attr:`ClosedLoop.dc_force`).  ``e_S`` (2, 3) the
+    sensitive axes in S; ``chans`` the controller channels ``<loop>[k]``."""
+    m, Itm, Im, Msc = p.tm_mass, p.tm_inertia, p.mosa_inertia, p.sc_mass
+    J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
     ain = ([f"c_{c}" for c in chans] + [f"d_{c}" for c in chans] + source_inputs("thruster_force")
            + source_inputs("thruster_gain") + source_inputs("thruster_torque") + source_inputs("actuation_force")
            + source_inputs("actuation_torque") + source_inputs("mosa_actuator") + source_inputs("tm_force")
@@ -267,9 +237,11 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
             Da[ao[f"b{l}[{i}]"], ai[f"tm_torque[{k}]"]] = 1.0
     for l in range(2):
         Da[ao[f"tm[{l}]"], ai[f"mosa_actuator[{l}]"]] = 1.0
-    actuators = _static(Da, ain, aout, "actuators")
+    return _static(Da, ain, aout, "actuators"), dc
 
-    # ---- observables: named outputs from plant outputs and actuator signals
+
+def _observables(p: PlantParameters, basis) -> control.StateSpace:
+    """The named outputs (:data:`OUTPUTS`) from the plant outputs and the actuator signals (static)."""
     oin = ([f"u[{i}]" for i in range(3)] + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
            + [f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
            + [f"acc{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"xdd{l}[{i}]" for l in (1, 2) for i in range(3)]
@@ -303,12 +275,32 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
             put(f"tm{l}_rotation_{a}", {f"eta{l}[{i}]": 1.0})
             put(f"tm{l}_es_force_{a}", {f"f{l}[{j}]": X[i, j] for j in range(3)})
             put(f"tm{l}_es_torque_{a}", {f"t{l}[{j}]": X[i, j] for j in range(3)})
-    observables = _static(Do, oin, onames, "observables")
+    return _static(Do, oin, onames, "observables")
 
+
+def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
+                      attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0]) -> ClosedLoop:
+    """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
+    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
+    ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
+    "star_tracker" (as LISA Pathfinder, which had no DWS).  The blocks are joined by signal name with
+    python-control's check of unused signals on (a misnamed signal would leave one unconnected)."""
+    if attitude_z_sensor not in ATTITUDE_Z_SENSORS:
+        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
+                         f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
+    P = linear_plant(p, wp)
+    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
+    from ..constellation.control import oa_rotation
+    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
+    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
+    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
+    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
+    actuators, dc = _actuators(p, wp, basis, e_S, chans)
     noise = [s for src in SOURCES for s in source_inputs(src)]
     inplist = noise + [f"d_{c}" for c in chans]
-    outlist = onames + [f"c_{c}" for c in chans]
-    syslist = [P, sensors, actuators, observables] + _controllers_ss(controllers)
+    outlist = output_names() + [f"c_{c}" for c in chans]
+    syslist = ([P, _sensors(basis, yoa, attitude_z_sensor), actuators, _observables(p, basis)]
+               + _controllers_ss(controllers))
     cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
-                              check_unused=False, name="closed_loop", warn_duplicate=False)
+                              name="closed_loop", warn_duplicate=False)
     return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=dc)

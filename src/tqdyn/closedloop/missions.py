@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import math
 
-from ..scenario.closed_loop import MISSIONS
+import numpy as np
+
+from ..scenario.closed_loop import MISSIONS, PLANT_KEYS
 from .controllers import Controller, lead_lag_pid
 from .noise import AsdModel
+from .plant import PlantParameters, WorkingPoint, plant_parameters
 
-__all__ = ["MISSIONS", "controller_from_keys", "default_controllers", "default_noise", "default_plant", "requirement",
-           "resolve"]
+__all__ = ["MISSIONS", "controller_from_keys", "default_controllers", "default_noise", "default_plant",
+           "representative_plant", "representative_working_point", "requirement", "resolve"]
 
 
 #: Plant defaults per mission (scenario keys of [closed_loop.plant]).
@@ -108,8 +111,6 @@ def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
     :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` over the mission's defaults (the mission:
     ``closed_loop.mission`` or the spacecraft ``architecture``); a given noise ``level`` or ``knees``
     replaces that part of the default."""
-    from ..scenario.closed_loop import PLANT_KEYS
-
     mission = config.mission(architecture)
     raw = config.raw or {}
     plant = default_plant(mission)
@@ -127,4 +128,31 @@ def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
     return mission, plant, ctl, noise
 
 
-_ = math
+def representative_working_point(mission: str, self_gravity=None) -> WorkingPoint:
+    """A working point of ``mission`` from first principles: the central body's tide at the orbit
+    (TianQin: GM_E/r^3 at r = 1e8 m; LISA/Taiji: GM_S/(1 au)^3) in a frame turning at the orbital rate
+    about Z_S, theta = 60 deg, DC suspension from the self-gravity (default Table IV; the nominal
+    scheme puts the differences dg_y, dg_z on the TMs: A_1 = -A_2 = (0, dg_y/(2 cos 30), dg_z/2)
+    along Y_OA, Z), no drag-free DC acceleration along the sensitive axes.  SI units, S / OA_l frames."""
+    from ..constellation.control import dragfree_general, oa_rotation
+    from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY
+
+    _check(mission)
+    gm, r = (3.986004415e14, 1e8) if mission == "tianqin" else (1.32712440041e20, 1.495978707e11)
+    n2 = gm / r ** 3
+    sg = TABLE_IV_SELF_GRAVITY if self_gravity is None else np.asarray(self_gravity)
+    T = oa_rotation(math.pi / 3)
+    g_S = np.einsum("lji,lj->li", T, sg)
+    G, A = dragfree_general(g_S, math.pi / 3)
+    return WorkingPoint(gamma=np.diag([2 * n2, -n2, -n2]), omega=np.array([0.0, 0.0, math.sqrt(n2)]),
+                        omega_dot=np.zeros(3), theta=math.pi / 3, theta_dot=0.0, a_suspension=A,
+                        alpha_suspension=np.zeros((2, 3)), a_dragfree=G, self_gravity=sg)
+
+
+def representative_plant(mission: str, **over) -> PlantParameters:
+    """The :class:`~tqdyn.closedloop.plant.PlantParameters` of ``mission``'s preset spacecraft at theta =
+    60 deg with the mission's default plant values, ``over`` replacing some of them (keys of
+    :func:`default_plant`, e.g. ``crosstalk=0.0``)."""
+    from ..constellation.spacecraft import Spacecraft
+
+    return plant_parameters({**default_plant(mission), **over}, Spacecraft.preset(mission), math.pi / 3)

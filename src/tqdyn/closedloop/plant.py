@@ -33,7 +33,7 @@ import numpy as np
 
 from ..constellation.control import oa_rotation
 
-__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "sensitive_basis"]
+__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "plant_parameters", "sensitive_basis"]
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -101,6 +101,19 @@ class WorkingPoint:
     t: float = 0.0
 
 
+def plant_parameters(plant: dict, craft, theta: float) -> PlantParameters:
+    """The :class:`PlantParameters` of a spacecraft from the ``[closed_loop.plant]`` values ``plant`` (the
+    keys of :data:`tqdyn.scenario.closed_loop.PLANT_KEYS`, e.g. :func:`tqdyn.closedloop.missions.default_plant`;
+    the per-axis stiffnesses the same for both TMs) and the geometry of ``craft``
+    (:class:`tqdyn.constellation.spacecraft.Spacecraft`) at the opening angle ``theta`` [rad]."""
+    return PlantParameters(sc_mass=plant["sc_mass"], sc_inertia=plant["sc_inertia"], tm_mass=plant["tm_mass"],
+                           tm_side=plant["tm_side"], mosa_inertia=plant["mosa_inertia"],
+                           mosa_stiffness=plant["mosa_stiffness"], stiffness=np.tile(plant["stiffness"], (2, 1)),
+                           rotational_stiffness=np.tile(plant["rotational_stiffness"], (2, 1)),
+                           crosstalk=plant["crosstalk"], housing_centers=craft.housing_centers(theta),
+                           lever_arms=craft.lever_arms(theta), sensitive_axes=craft.sensitive_axes_array)
+
+
 def dof_names() -> list[str]:
     """The 20 coordinates q in state order (module docstring)."""
     out = []
@@ -138,60 +151,74 @@ def _gg_torque_jacobian(gamma: np.ndarray, J: np.ndarray) -> np.ndarray:
     return np.linalg.solve(J, out)
 
 
-def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> control.StateSpace:
-    """The linearised plant (module docstring) as a named python-control StateSpace (continuous)."""
-    n = 20
-    iu, iphi, ix, ieta, ith = 0, 3, (6, 9), (12, 15), 18
-    M = np.eye(n)            # mass matrix: M q'' + D q' + K q = B w
-    D = np.zeros((n, n))
-    K = np.zeros((n, n))
-    G = np.asarray(wp.gamma, dtype=np.float64)
-    W = _skew(wp.omega)
-    Wd = _skew(wp.omega_dot)
-    W2 = W @ W
-    J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
-    m, Msc, Itm, Im = p.tm_mass, p.sc_mass, p.tm_inertia, p.mosa_inertia
-    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))          # (2, 3, 3): T_S_OA_l (OA_l -> S)
-    half = 0.5 * wp.theta_dot
-    rh = np.asarray(p.housing_centers, dtype=np.float64)
-    rho = np.asarray(p.lever_arms, dtype=np.float64)
-    rh_dot = np.array([np.cross(s * half * Z, rho[l]) for l, s in enumerate((1.0, -1.0))])   # w_oa x rho
-    inputs = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
-              + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
-              + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)]
-              + ["tm[0]", "tm[1]"])
-    col = {s: k for k, s in enumerate(inputs)}
-    B = np.zeros((n, len(inputs)))
-    F, T = col["F[0]"], col["T[0]"]
+#: First rows of x_l, eta_l (l = 1, 2) and dth_1 in q (:func:`dof_names` order); u is 0, phi 3.
+_IX, _IETA, _ITH = (6, 9), (12, 15), 18
 
-    # spacecraft translation u (S): u'' = (Gamma - W' - W^2) u - 2 W u' + F_S/M - [G x] phi + reactions / M
-    K[0:3, 0:3] = -(G - Wd - W2)
-    D[0:3, 0:3] = 2 * W
-    B[0:3, F:F + 3] = np.eye(3) / Msc
-    K[0:3, 3:6] = _skew(wp.a_dragfree)                      # + phi x G_S  ->  K = -[phi x G] coefficient
-    # spacecraft rotation: J phi'' + (J W - [(J w) x] + W J) phi' + (J W' - [(J w) x] W + W J W) phi = T
-    Jw = _skew(J @ wp.omega)
-    Jinv = np.linalg.inv(J)
-    D[3:6, 3:6] = Jinv @ (J @ W - Jw + W @ J)
-    K[3:6, 3:6] = Jinv @ (J @ Wd - Jw @ W + W @ J @ W) - _gg_torque_jacobian(G, J)
-    B[3:6, T:T + 3] = Jinv
-    for l in range(2):
+
+class _Equations:
+    """M q'' + D q' + K q = B w (module docstring) of :func:`linear_plant`, filled block by block: the
+    spacecraft's rows (:meth:`spacecraft`), then each TM's and MOSA's (:meth:`test_mass`)."""
+
+    def __init__(self, p: PlantParameters, wp: WorkingPoint):
+        n = 20
+        self.p, self.wp = p, wp
+        self.M, self.D, self.K = np.eye(n), np.zeros((n, n)), np.zeros((n, n))
+        self.inputs = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
+                       + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)]
+                       + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
+                       + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)]
+                       + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)] + ["tm[0]", "tm[1]"])
+        self.col = {s: k for k, s in enumerate(self.inputs)}
+        self.B = np.zeros((n, len(self.inputs)))
+        self.G = np.asarray(wp.gamma, dtype=np.float64)
+        self.W, self.Wd = _skew(wp.omega), _skew(wp.omega_dot)
+        self.W2 = self.W @ self.W
+        self.J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
+        self.Jinv = np.linalg.inv(self.J)
+        self.R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))          # (2, 3, 3): T_S_OA_l (OA_l -> S)
+        self.X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))  # cross-talk of the actuation
+
+    def spacecraft(self) -> None:
+        """The rows of u and phi (their own terms; the TMs' and MOSAs' reactions: :meth:`test_mass`)."""
+        D, K, B, G, W, Wd, J, Jinv = self.D, self.K, self.B, self.G, self.W, self.Wd, self.J, self.Jinv
+        F, T = self.col["F[0]"], self.col["T[0]"]
+        # spacecraft translation u (S): u'' = (Gamma - W' - W^2) u - 2 W u' + F_S/M - [G x] phi + reactions / M
+        K[0:3, 0:3] = -(G - Wd - self.W2)
+        D[0:3, 0:3] = 2 * W
+        B[0:3, F:F + 3] = np.eye(3) / self.p.sc_mass
+        K[0:3, 3:6] = _skew(self.wp.a_dragfree)                 # + phi x G_S  ->  K = -[phi x G] coefficient
+        # spacecraft rotation: J phi'' + (J W - [(J w) x] + W J) phi' + (J W' - [(J w) x] W + W J W) phi = T
+        Jw = _skew(J @ self.wp.omega)
+        D[3:6, 3:6] = Jinv @ (J @ W - Jw + W @ J)
+        K[3:6, 3:6] = Jinv @ (J @ Wd - Jw @ W + W @ J @ W) - _gg_torque_jacobian(G, J)
+        B[3:6, T:T + 3] = Jinv
+
+    def test_mass(self, l: int) -> None:
+        """The rows of x_l, eta_l and dth_l (TM l = ``l`` + 1, its MOSA) and their reactions on the spacecraft."""
+        p, wp, M, D, K, B, R, X = self.p, self.wp, self.M, self.D, self.K, self.B, self.R, self.X
+        G, W, Wd, W2, Jinv = self.G, self.W, self.Wd, self.W2, self.Jinv
+        m, Msc, Itm, Im = p.tm_mass, p.sc_mass, p.tm_inertia, p.mosa_inertia
+        half = 0.5 * wp.theta_dot
+        rh = np.asarray(p.housing_centers, dtype=np.float64)[l]
+        rho = np.asarray(p.lever_arms, dtype=np.float64)[l]
+        rh_dot = np.cross((1.0, -1.0)[l] * half * Z, rho)                 # w_oa x rho
         Rl, kx, kr = R[l], np.diag(p.stiffness[l]), np.diag(p.rotational_stiffness[l])
-        xs, es = slice(ix[l], ix[l] + 3), slice(ieta[l], ieta[l] + 3)
-        th = ith + l
-        c = np.cross(Z, rho[l])                               # d r_h / d dth_l (S)
+        xs, es = slice(_IX[l], _IX[l] + 3), slice(_IETA[l], _IETA[l] + 3)
+        th = _ITH + l
+        c = np.cross(Z, rho)                                  # d r_h / d dth_l (S)
+        col = self.col
+        F = col["F[0]"]
         fcol, tcol, acol, bcol = col[f"f{l + 1}[0]"], col[f"t{l + 1}[0]"], col[f"a{l + 1}[0]"], col[f"b{l + 1}[0]"]
-        X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))     # cross-talk of the actuation
         # --- TM translation, in OA_l: x = R^T x_S
         # x_S'' + 2 W x_S' + (W' + W^2 - Gamma) x_S = attitude + MOSA terms + f_S/m - F/M - R kx x
-        M[xs, 3:6] = -Rl.T @ _skew(rh[l])                    # - [r_h x] phi''  (moved to the left)
+        M[xs, 3:6] = -Rl.T @ _skew(rh)                       # - [r_h x] phi''  (moved to the left)
         M[xs, th] = Rl.T @ c                                  # + c dth''
         D[xs, xs] = Rl.T @ (2 * W) @ Rl
         K[xs, xs] = Rl.T @ (Wd + W2 - G) @ Rl + kx
-        rx, wrx = _skew(rh[l]), _skew(W @ rh[l])
-        D[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot[l]) + rx @ W + wrx + W @ rx)
-        K[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot[l]) @ W + rx @ Wd + wrx @ W + W @ rx @ W
-                              - G @ rx + _skew(G @ rh[l]))
+        rx, wrx = _skew(rh), _skew(W @ rh)
+        D[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot) + rx @ W + wrx + W @ rx)
+        K[xs, 3:6] = -Rl.T @ (2 * _skew(rh_dot) @ W + rx @ Wd + wrx @ W + W @ rx @ W
+                              - G @ rx + _skew(G @ rh))
         D[xs, th] = Rl.T @ (2 * W @ c)
         K[xs, th] = Rl.T @ ((Wd + W2 - G) @ c - np.cross(Z, Rl @ wp.a_suspension[l]))
         B[xs, fcol:fcol + 3] = X / m + X / Msc            # own force, and its reaction on the spacecraft
@@ -199,17 +226,17 @@ def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> c
         B[xs, F:F + 3] = -Rl.T / Msc
         # reactions on the spacecraft: -R f (force), -r_h x R f - R t (torque), stiffness likewise
         B[0:3, fcol:fcol + 3] = -Rl @ X / Msc
-        B[3:6, fcol:fcol + 3] = -Jinv @ _skew(rh[l]) @ Rl @ X
+        B[3:6, fcol:fcol + 3] = -Jinv @ _skew(rh) @ Rl @ X
         B[3:6, tcol:tcol + 3] = -Jinv @ Rl @ X
         K[0:3, xs] = -(m / Msc) * Rl @ kx
-        K[3:6, xs] = -(m * Jinv @ _skew(rh[l]) @ Rl @ kx)
+        K[3:6, xs] = -(m * Jinv @ _skew(rh) @ Rl @ kx)
         K[3:6, es] = -(Itm * Jinv @ Rl @ kr)
         # the reactions on the spacecraft move both housings: x_k'' contains -F_sc/M (k = 1, 2)
         other = 1 - l
-        ox = slice(ix[other], ix[other] + 3)
+        ox = slice(_IX[other], _IX[other] + 3)
         B[ox, fcol:fcol + 3] = R[other].T @ Rl @ X / Msc
         for k in range(2):
-            ks = slice(ix[k], ix[k] + 3)
+            ks = slice(_IX[k], _IX[k] + 3)
             K[ks, xs] += (m / Msc) * R[k].T @ Rl @ kx
         # --- TM rotation, in OA_l: eta'' = tau/I - R^T(phi'' + dth'' Z) - [Wt x](eta' + R^T(phi' + dth' Z))
         #                                  - [Wt' x](eta + R^T(phi + dth Z)) - kr eta
@@ -232,38 +259,52 @@ def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> c
         K[th, th] = p.mosa_stiffness / Im
         B[th, col[f"tm[{l}]"]] = 1.0 / Im
         B[3:6, col[f"tm[{l}]"]] = -Jinv @ Z
-    Minv = np.linalg.inv(M)
+
+    def outputs(self, A, Bs) -> tuple[list, list, list]:
+        """(C blocks, D blocks, names) of the outputs: q, the TMs' non-gravitational accelerations (OA_l)
+        and the relative accelerations x_l'', of the state space (``A``, ``Bs``)."""
+        p, wp, R, X, n = self.p, self.wp, self.R, self.X, self.M.shape[0]
+        C = [np.hstack([np.eye(n), np.zeros((n, n))])]
+        Dm = [np.zeros((n, self.B.shape[1]))]
+        outs = dof_names()
+        for l in range(2):
+            xs = slice(_IX[l], _IX[l] + 3)
+            Cacc = np.zeros((3, 2 * n))
+            Cacc[:, xs] = -np.diag(p.stiffness[l])
+            Dacc = np.zeros((3, self.B.shape[1]))
+            fcol, acol = self.col[f"f{l + 1}[0]"], self.col[f"a{l + 1}[0]"]
+            Dacc[:, fcol:fcol + 3] = X / p.tm_mass
+            Dacc[:, acol:acol + 3] = np.eye(3)
+            # the body-fixed DC forces (suspension + self-gravity) turn with the attitude, the suspension
+            # also with the MOSA: (phi + dth Z) x F_dc, seen along the nominal (inertial) OA_l axes
+            Rl = R[l]
+            dc = Rl @ (np.asarray(wp.a_suspension[l]) + np.asarray(wp.self_gravity[l]))
+            Cacc[:, 3:6] = -Rl.T @ _skew(dc)
+            Cacc[:, _ITH + l] = -Rl.T @ _skew(Rl @ np.asarray(wp.a_suspension[l])) @ Z
+            C.append(Cacc)
+            Dm.append(Dacc)
+            outs += [f"acc{l + 1}[{i}]" for i in range(3)]
+        for l in range(2):
+            xs = slice(n + _IX[l], n + _IX[l] + 3)
+            C.append(A[xs, :])
+            Dm.append(Bs[xs, :])
+            outs += [f"xdd{l + 1}[{i}]" for i in range(3)]
+        return C, Dm, outs
+
+
+def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> control.StateSpace:
+    """The linearised plant (module docstring) as a named python-control StateSpace (continuous)."""
+    eq = _Equations(p, wp)
+    eq.spacecraft()
+    for l in range(2):
+        eq.test_mass(l)
+    n = eq.M.shape[0]
+    Minv = np.linalg.inv(eq.M)
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
-    A[n:, :n] = -Minv @ K
-    A[n:, n:] = -Minv @ D
-    Bs = np.vstack([np.zeros((n, B.shape[1])), Minv @ B])
-    # outputs: q, the TMs' non-gravitational accelerations (OA_l) and the relative accelerations x_l''
-    C = [np.hstack([np.eye(n), np.zeros((n, n))])]
-    Dm = [np.zeros((n, B.shape[1]))]
-    outs = dof_names()
-    for l in range(2):
-        xs = slice(ix[l], ix[l] + 3)
-        Cacc = np.zeros((3, 2 * n))
-        Cacc[:, xs] = -np.diag(p.stiffness[l])
-        Dacc = np.zeros((3, B.shape[1]))
-        fcol, acol = col[f"f{l + 1}[0]"], col[f"a{l + 1}[0]"]
-        X = np.eye(3) + p.crosstalk * (np.ones((3, 3)) - np.eye(3))
-        Dacc[:, fcol:fcol + 3] = X / m
-        Dacc[:, acol:acol + 3] = np.eye(3)
-        # the body-fixed DC forces (suspension + self-gravity) turn with the attitude, the suspension
-        # also with the MOSA: (phi + dth Z) x F_dc, seen along the nominal (inertial) OA_l axes
-        Rl = R[l]
-        dc = Rl @ (np.asarray(wp.a_suspension[l]) + np.asarray(wp.self_gravity[l]))
-        Cacc[:, 3:6] = -Rl.T @ _skew(dc)
-        Cacc[:, ith + l] = -Rl.T @ _skew(Rl @ np.asarray(wp.a_suspension[l])) @ Z
-        C.append(Cacc)
-        Dm.append(Dacc)
-        outs += [f"acc{l + 1}[{i}]" for i in range(3)]
-    for l in range(2):
-        xs = slice(n + ix[l], n + ix[l] + 3)
-        C.append(A[xs, :])
-        Dm.append(Bs[xs, :])
-        outs += [f"xdd{l + 1}[{i}]" for i in range(3)]
+    A[n:, :n] = -Minv @ eq.K
+    A[n:, n:] = -Minv @ eq.D
+    Bs = np.vstack([np.zeros((n, eq.B.shape[1])), Minv @ eq.B])
+    C, Dm, outs = eq.outputs(A, Bs)
     states = dof_names() + [f"d{s}" for s in dof_names()]
-    return control.ss(A, Bs, np.vstack(C), np.vstack(Dm), inputs=inputs, outputs=outs, states=states, name=name)
+    return control.ss(A, Bs, np.vstack(C), np.vstack(Dm), inputs=eq.inputs, outputs=outs, states=states, name=name)

@@ -201,7 +201,7 @@ def centroid_directions(R) -> np.ndarray:
     so free of the cancellation of the absolute positions.  Same axes as R.
     The incenter's direction (:class:`Incenter`, X_S of the global law)
     differs from it by the first-order angle (L_ik - L_ij) / (2 sqrt(3) L)
-    (:func:`tqdyn.analysis.lisa_estimates.bisector_median_angle`).
+    (:func:`tqdyn.constellation.estimates.bisector_median_angle`).
     """
     a = arms(R)
     c = a.r[..., _IJ, :] + a.r[..., _IK, :]

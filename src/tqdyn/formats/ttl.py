@@ -8,7 +8,7 @@ The layout is exactly that of LISA Instrument 2.3's ``lisainstrument.ttl.ttl_fil
 * dataset ``t`` (n,) [s]: the sample times, strictly increasing (LISA Instrument evaluates the spline
   at its ``physics_t`` = its ``t0`` + k ``physics_dt``, the time axis of its orbit input);
 * datasets ``c_<mosa>_phi_rx``, ``c_<mosa>_phi_tx``, ``c_<mosa>_eta_rx``, ``c_<mosa>_eta_tx`` (n,)
-  [m/rad] for each MOSA of :data:`tqdyn.closedloop.ttl.MOSAS`: the local (rx) and distant (tx) yaw and
+  [m/rad] for each MOSA of :data:`tqdyn.ttl.coupling.MOSAS`: the local (rx) and distant (tx) yaw and
   pitch coefficients (tqdyn's ``local_phi``, ``distant_phi``, ``local_eta``, ``distant_eta``); LZF
   compressed, float64.
 
@@ -27,7 +27,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__ as _TQDYN_VERSION
-from ..closedloop.ttl import LINEAR_FIELDS, MOSAS
+from ..ttl.coupling import LINEAR_FIELDS, MOSAS
 from .atomic import replacing
 from .trajectory import check_writable
 
@@ -87,7 +87,7 @@ def write_ttl_file(path, t, coefficients: dict, order: int = 5, attrs: dict | No
     """Write LISA Instrument's TTL coefficient file (module docstring) at ``path``, atomically.
 
     t: (n,) sample times [s]; coefficients: {field: {mosa: (n,) array}} [m/rad], field in
-    :data:`tqdyn.closedloop.ttl.LINEAR_FIELDS`; order: ``interpolation_order`` (3 or 5); attrs: tqdyn's
+    :data:`tqdyn.ttl.coupling.LINEAR_FIELDS`; order: ``interpolation_order`` (3 or 5); attrs: tqdyn's
     root attributes (:data:`TQDYN_ATTRS`; ``tqdyn_version`` filled in), str values.  Bad input raises a
     one-line ValueError before anything is written; a failed write raises
     :class:`tqdyn.formats.trajectory.OutputError`.  Returns the absolute path."""

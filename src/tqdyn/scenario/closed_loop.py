@@ -2,23 +2,25 @@
 
 Every key is optional; what is not given takes the mission's default
 (:mod:`tqdyn.closedloop.missions`), the mission being ``closed_loop.mission`` or, by default, the
-run's ``spacecraft.architecture``.  Layout (SI units; ASDs one-sided)::
+run's ``spacecraft.architecture``, and the settings' defaults of :data:`CLOSED_LOOP_KEYS`.  Layout
+(SI units; ASDs one-sided)::
 
     [closed_loop]
-    mission = "lisa"              # "tianqin" | "lisa" | "taiji" (default: spacecraft.architecture)
-    fs = 4.0                      # Hz, time-domain sample rate
-    duration = "3d"               # time-domain length (default: the run's span)
-    seed = 0                      # root seed of the noise realisations
-    segment = "1d"                # frozen-coefficient segment length
-    f_min = 1e-5                  # Hz, budget grid
-    f_max = 1.0                   # Hz
-    n_freq = 300
-    attitude_z_sensor = "dws"     # "dws" | "star_tracker"
+    mission                       # "tianqin" | "lisa" | "taiji"
+    fs                            # Hz, time-domain sample rate
+    duration                      # time-domain length ("3d" or s; default: the run's span)
+    seed                          # root seed of the noise realisations
+    segment                       # frozen-coefficient segment length ("1d" or s)
+    f_min, f_max, n_freq          # the budget's log frequency grid [Hz]
+    attitude_z_sensor             # one of ATTITUDE_Z_SENSORS
     [closed_loop.plant]           # sc_mass [kg], sc_inertia [kg m^2] (3), tm_mass [kg], tm_side [m],
                                   # mosa_inertia [kg m^2], mosa_stiffness [N m/rad], stiffness [s^-2] (3),
                                   # rotational_stiffness [s^-2] (3), crosstalk [1]
-    [closed_loop.controllers.<loop>]   # zeros, poles [rad/s; [re, im] for a conjugate pair], gain
-    [closed_loop.noise.<source>]       # level [unit/Hz^1/2], knees [[f Hz, slope], ...]
+    [closed_loop.controllers.<loop>]   # zeros, poles [rad/s; [re, im] for a conjugate pair], gain (LOOPS)
+    [closed_loop.noise.<source>]       # level [unit/Hz^1/2], knees [[f Hz, slope], ...] (SOURCES)
+
+The loop and noise-source tables (:data:`LOOPS`, :data:`SOURCES`) live here, the lowest layer that
+names them; :mod:`tqdyn.closedloop` builds the loops from them.
 
 The configuration is kept as given (sparse): :meth:`ClosedLoopConfig.to_toml_lines` writes back only the
 keys that were set, so scenarios without the section resolve to the same text as before it existed.
@@ -33,25 +35,54 @@ from decimal import Decimal
 from typing import Any
 
 from .toml_text import toml_str, toml_value
-from .values import ScenarioError, _require
+from .values import ScenarioError, _one_of, _require
 
-__all__ = ["CLOSED_LOOP_KEYS", "LOOP_NAMES", "MISSIONS", "PLANT_KEYS", "SOURCE_UNITS", "ClosedLoopConfig",
-           "check_asd", "check_controller"]
+__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "LOOPS", "MISSIONS", "PLANT_KEYS", "SOURCES",
+           "ClosedLoopConfig", "check_asd", "check_controller"]
 
 #: Missions with a default closed-loop design (tqdyn.closedloop.missions).
 MISSIONS = ("tianqin", "lisa", "taiji")
-#: Control loops (tqdyn.closedloop.controllers.LOOPS describes their channels).
-LOOP_NAMES = ("dragfree", "suspension", "attitude", "attitude_z", "mosa", "tm_rotation")
-#: Noise sources and the unit of their ASD (tqdyn.closedloop.loop.SOURCES: components, where they enter).
-SOURCE_UNITS = {"thruster_force": "N", "thruster_gain": "1", "thruster_torque": "N m", "tm_force": "m/s^2",
-                "tm_torque": "rad/s^2", "actuation_force": "1", "actuation_torque": "1",
-                "capacitive_translation": "m", "capacitive_rotation": "rad", "interferometer": "m", "dws": "rad",
-                "star_tracker": "rad", "mosa_encoder": "rad", "mosa_actuator": "N m"}
+#: Control loops: name -> (channels, what is sensed, sensor, actuator).  Each channel's controller
+#: (tqdyn.closedloop.controllers) turns the sensed coordinate into an acceleration command.
+LOOPS = {
+    "dragfree": (("tm1 sensitive axis", "tm2 sensitive axis", "mean z of the TMs"), "m",
+                 "interferometer (sensitive axes), capacitive (z)", "thrusters (force)"),
+    "suspension": (("tm1 p axis (Z x e_1)", "tm2 p axis (Z x e_2)", "half the z difference"), "m",
+                   "capacitive", "electrostatic force"),
+    "attitude": (("x", "y"), "rad", "DWS (the pitches of both MOSAs)", "thrusters (torque)"),
+    "attitude_z": (("z",), "rad", "mean DWS yaw minus mean MOSA encoder angle (or the star tracker)",
+                   "thrusters (torque)"),
+    "mosa": (("MOSA 1", "MOSA 2"), "rad", "DWS yaw of the MOSA (spacecraft yaw + MOSA angle)", "MOSA actuator"),
+    "tm_rotation": (("tm1 x", "tm1 y", "tm1 z", "tm2 x", "tm2 y", "tm2 z"), "rad", "capacitive", "electrostatic torque"),
+}
+#: Noise sources: name -> (components, unit of the ASD, where it enters the loop, tqdyn.closedloop.loop).
+SOURCES = {
+    "thruster_force": (3, "N", "thrust, S axes"),
+    "thruster_gain": (3, "1", "fractional thrust noise times the DC thrust M |G| per S axis"),
+    "thruster_torque": (3, "N m", "thruster torque, S axes"),
+    "tm_force": (6, "m/s^2", "stray acceleration of TM 1, TM 2 (OA_l axes)"),
+    "tm_torque": (6, "rad/s^2", "stray angular acceleration of TM 1, TM 2 (OA_l)"),
+    "actuation_force": (6, "1", "fractional electrostatic force noise times the DC force m |A| per OA_l axis"),
+    "actuation_torque": (6, "1", "fractional electrostatic torque noise times the DC torque I |alpha| per OA_l axis"),
+    "capacitive_translation": (6, "m", "capacitive readout of x_1, x_2 (OA_l)"),
+    "capacitive_rotation": (6, "rad", "capacitive readout of eta_1, eta_2 (OA_l)"),
+    "interferometer": (2, "m", "TM interferometer along each sensitive axis"),
+    "dws": (4, "rad", "DWS pitch and yaw of MOSA 1, then MOSA 2"),
+    "star_tracker": (3, "rad", "star tracker, S axes"),
+    "mosa_encoder": (2, "rad", "MOSA angle encoder (the angle of the MOSA relative to the spacecraft)"),
+    "mosa_actuator": (2, "N m", "MOSA actuator torque"),
+}
+#: Sensors of the attitude about Z_S: the mean DWS yaw minus the mean MOSA encoder angle (default), or
+#: the star tracker (as LISA Pathfinder, which had no DWS).
+ATTITUDE_Z_SENSORS = ("dws", "star_tracker")
 
-#: Top-level keys of [closed_loop] and their kind.
-CLOSED_LOOP_KEYS = {"mission": "string", "fs": "number", "duration": "duration", "seed": "integer",
-                    "segment": "duration", "f_min": "number", "f_max": "number", "n_freq": "integer",
-                    "attitude_z_sensor": "string"}
+#: Top-level keys of [closed_loop]: name -> (kind, default).  Defaults: ``mission`` None = the spacecraft
+#: architecture; ``fs`` [Hz]; ``duration`` [s] None = the run's span; ``segment`` [s]; ``f_min``, ``f_max``
+#: [Hz] and ``n_freq`` the budget's log grid; ``attitude_z_sensor`` one of :data:`ATTITUDE_Z_SENSORS`.
+CLOSED_LOOP_KEYS = {"mission": ("string", None), "fs": ("number", 4.0), "duration": ("duration", None),
+                    "seed": ("integer", 0), "segment": ("duration", 86400.0), "f_min": ("number", 1e-5),
+                    "f_max": ("number", 1.0), "n_freq": ("integer", 300),
+                    "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0])}
 #: Keys of [closed_loop.plant]: name -> number of values (1: a number).
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1}
@@ -69,7 +100,6 @@ class ClosedLoopConfig:
     raw: Any = field(default_factory=dict)
 
     def __post_init__(self):
-        LOOPS, SOURCES = LOOP_NAMES, SOURCE_UNITS
         raw = self.raw if self.raw is not None else {}
         _require(isinstance(raw, dict), "closed_loop", raw, "is not a table", "a [closed_loop] table")
         allowed = tuple(CLOSED_LOOP_KEYS) + ("plant", "controllers", "noise")
@@ -79,7 +109,7 @@ class ClosedLoopConfig:
             if key == "mission":
                 _require(v in MISSIONS, name, v, "is not a mission", ", ".join(MISSIONS))
             elif key == "attitude_z_sensor":
-                _require(v in ("dws", "star_tracker"), name, v, "is not a sensor", "'dws', 'star_tracker'")
+                _require(v in ATTITUDE_Z_SENSORS, name, v, "is not a sensor", _one_of(ATTITUDE_Z_SENSORS))
             elif key in ("fs", "f_min", "f_max"):
                 _require(_num(v) and float(v) > 0, name, v, "is not a positive number", "a frequency > 0 Hz")
             elif key in ("seed", "n_freq"):
@@ -143,6 +173,18 @@ class ClosedLoopConfig:
         if isinstance(v, (Decimal, float)):
             return float(v)
         return v
+
+    def settings(self) -> dict:
+        """The top-level settings but ``mission`` with the defaults of :data:`CLOSED_LOOP_KEYS` filled in:
+        fs [Hz], duration [s] (None: the run's span), seed, segment [s], f_min, f_max [Hz], n_freq,
+        attitude_z_sensor; numbers as float, integers as int."""
+        cast = {"number": float, "integer": int, "duration": float, "string": str}
+        out = {}
+        for key, (kind, default) in CLOSED_LOOP_KEYS.items():
+            if key != "mission":
+                v = self.value(key, default)
+                out[key] = None if v is None else cast[kind](v)
+        return out
 
     def to_toml_lines(self) -> list[str]:
         """The given keys as TOML lines (nothing when the section is empty)."""

@@ -89,7 +89,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     test masses or a pure-gravity run, an unknown loop or source, a bad ASD, an unstable design naming
     the loop and its margin) or OutputError (the output path) before anything is written.
     ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``."""
-    from ..analysis.closed_loop import closed_loop_model
+    from ..closedloop.model import closed_loop_model
     from ..scenario import loads_scenario
     from ..scenario.loader import parse_duration
 

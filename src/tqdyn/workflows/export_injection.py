@@ -3,10 +3,10 @@
 
 :func:`export_lisa_injection` reads the closed-loop file (:mod:`tqdyn.formats.closed_loop`) and the run
 it was made from (checked by SHA-256), forms the MOSA angles of the closed loop's attitude and MOSA
-outputs, each link's TTL s_ij (:func:`tqdyn.closedloop.ttl.link_ttl`, the distant term delayed by the
+outputs, each link's TTL s_ij (:func:`tqdyn.ttl.coupling.link_ttl`, the distant term delayed by the
 run's light travel times of :func:`tqdyn.lightpath.light_travel_times_of`, as ``--format lisa``) and
 its science-readout injection g_ij = -(nu0/c) ds_ij/dt
-(:mod:`tqdyn.closedloop.ttl_injection`), and writes them as a LISA Instrument glitch file
+(:mod:`tqdyn.ttl.injection`), and writes them as a LISA Instrument glitch file
 (:func:`tqdyn.formats.lisa_injection.write_lisa_injection`) at ``readout_isi_carrier_ij`` and
 ``readout_isi_usb_ij``; with ``tm=True`` also the TMs' residual velocity (the integral of the closed loop's
 ``tm{l}_acceleration``) at ``tm_ij``.  It prints nothing; the CLI reports.
@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..closedloop.ttl import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
-from ..closedloop.ttl_budget import ANGLE_OUTPUTS
-from ..closedloop.ttl_injection import CENTRAL_FREQ_HZ, readout_injections, tm_velocity_injections
+from ..ttl.coupling import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
+from ..ttl.budget import ANGLE_OUTPUTS
+from ..ttl.injection import CENTRAL_FREQ_HZ, readout_injections, tm_velocity_injections
 from ..formats import trajectory as _io
 from ..formats.closed_loop import read_closed_loop
 from ..formats.lisa_injection import write_lisa_injection
@@ -185,7 +185,7 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
         "ltt_note": lp.note,
         "test_masses": "tm_ij: TM residual velocity (m/s)" if tm else "not injected",
         "convention": "readout_isi_{carrier,usb}_ij = -(nu0/c) d s_ij/dt, s_ij = local TTL of MOSA ij + distant "
-                      "TTL of MOSA ji delayed by the light travel time (tqdyn.closedloop.ttl.link_ttl)",
+                      "TTL of MOSA ji delayed by the light travel time (tqdyn.ttl.coupling.link_ttl)",
     }
     path = write_lisa_injection(out, t[idx[0]], dt, series, attrs, desc)
     return LisaInjection(path=path, size=int(idx.size), t0=float(t[idx[0]]), dt=dt, coefficients=spec,

@@ -2,7 +2,7 @@
 ``tqdyn export CL.h5 --format ttl OUT.h5``.
 
 :func:`export_ttl` reads the closed-loop file's time grid (:mod:`tqdyn.formats.closed_loop`), builds
-the coefficients (:mod:`tqdyn.closedloop.ttl`: constant, optionally drifting linearly from the first
+the coefficients (:mod:`tqdyn.ttl.coupling`: constant, optionally drifting linearly from the first
 sample), samples them on that grid (or a coarser step over the same span) and writes the file
 (:func:`tqdyn.formats.ttl.write_ttl_file`).  It prints nothing; the CLI reports.
 
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.ttl_budget import worst_case_coefficients
-from ..closedloop.ttl import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
+from ..ttl.coupling import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
 from ..formats.closed_loop import read_closed_loop
 from ..formats.ttl import write_ttl_file
 from .closed_loop import file_sha256

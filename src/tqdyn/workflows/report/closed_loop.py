@@ -4,7 +4,7 @@ the link between the DC self-gravity of the paper's study and the in-band noise.
 
 :func:`report_closed_loop` runs (in memory) a short coupled run of each mission's built-in scenario
 (:data:`RUNS`: TianQin with the paper's Table IV self-gravity, LISA with ESA's self-gravity ramp,
-Taiji without self-gravity), builds its closed loops (:func:`tqdyn.analysis.closed_loop.closed_loop_model`,
+Taiji without self-gravity), builds its closed loops (:func:`tqdyn.closedloop.model.closed_loop_model`,
 the run's [closed_loop] defaults: the mission's default plant, noises and controllers) and evaluates
 satellite 1 in the first frozen-coefficient segment (the working point at its middle row).  Written
 into ``DIR/closed-loop/`` (PNG and PDF): ``<mission>-budget`` (budget stacks of :data:`BUDGET_OUTPUTS`),
@@ -28,7 +28,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...analysis.closed_loop import BANDS, closed_loop_model
+from ...analysis.closed_loop import BANDS
+from ...analysis.closed_loop_paths import DC_SUSPENSION_LIMIT, dc_paths
 from ...analysis.figures_closed_loop import (plot_budget_stack, plot_link_budget, plot_loop_gains,
                                              plot_residual_acceleration, plot_ttl_sources)
 from ...analysis.ttl_budget import ttl_budget_values
@@ -36,7 +37,7 @@ from ...closedloop.budget import dominant_sources, loop_gains, loop_margins, noi
 from ...closedloop.controllers import LOOPS
 from ...closedloop.loop import OUTPUTS, output_names
 from ...closedloop.missions import MISSIONS, requirement
-from ...closedloop.study import DC_SUSPENSION_LIMIT, dc_paths
+from ...closedloop.model import closed_loop_model
 from .summary import Report, SummaryRow, _e, _finish, check_out_dir
 
 __all__ = ["BUDGET_OUTPUTS", "FREQUENCIES_HZ", "LINK_FREQUENCIES_HZ", "LINK_REQUIREMENT_TEXT", "MISSION_BAND_HZ",
@@ -52,7 +53,7 @@ RUNS = {
 }
 #: Frequencies [Hz] at which the residual TM acceleration is quoted.
 FREQUENCIES_HZ = (1e-4, 1e-3, 1e-2, 1e-1)
-#: Frequencies [Hz] of the DC-to-in-band paths (:func:`tqdyn.closedloop.study.dc_paths`).
+#: Frequencies [Hz] of the DC-to-in-band paths (:func:`tqdyn.analysis.closed_loop_paths.dc_paths`).
 LINK_FREQUENCIES_HZ = (1e-3, 1e-2)
 #: The measurement band [Hz] in which the largest ratio to the requirement is taken (all three missions).
 MISSION_BAND_HZ = (1e-4, 1.0)
@@ -103,7 +104,7 @@ def _mission_values(mission: str, model, run_text: str) -> tuple[dict, dict]:
     ``margins`` per channel (``crossover_hz``, ``phase_margin_deg``, ``gain_margin``, ``gain_margin_hz``),
     ``dominant`` per output and band, ``residual`` (the TMs' residual acceleration and the requirement at
     :data:`FREQUENCIES_HZ`, their ratio, the largest ratio in :data:`MISSION_BAND_HZ` and its
-    frequency), ``link`` (:func:`tqdyn.closedloop.study.dc_paths` at :data:`LINK_FREQUENCIES_HZ`)."""
+    frequency), ``link`` (:func:`tqdyn.analysis.closed_loop_paths.dc_paths` at :data:`LINK_FREQUENCIES_HZ`)."""
     p, wp = model.parts[0][0]
     cl = model.loops[0][0][1]
     f = _grid(*_F_GRID)

@@ -3,7 +3,7 @@
 Each study of :data:`tqdyn.workflows.studies_lisa.STUDIES` is measured on
 its runs and set against a reference that does not come from the coupled
 code: the first-order analytic estimates of
-:mod:`tqdyn.analysis.lisa_estimates` (derived in ``docs/lisa-coupled.md``),
+:mod:`tqdyn.constellation.estimates` (derived in ``docs/lisa-coupled.md``),
 ESA's orbit files, or a first-order bound.  The table of ``summary.md`` is
 "quantity | reference | tqdyn | notes" (rows of
 :class:`~tqdyn.workflows.report.summary.SummaryRow`, whose ``paper`` field
@@ -25,7 +25,6 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ...analysis import lisa_estimates as le
 from ...analysis.esa_orbits import esa_records, esa_states_on_grid
 from ...analysis.figures import SAT_COLORS, plot_control, plot_pointing
 from ...analysis.figures_lisa import plot_arm_response, plot_deviation, plot_esa_ramp, plot_estimate
@@ -35,6 +34,7 @@ from ...analysis.pointing_study import pointing_study_of
 from ...astro.constants import C_LIGHT
 from ...astro.ephemeris import planetary_gm
 from ...constellation import geometry
+from ...constellation import estimates as le
 from ...constellation.indices import Sat
 from ...constellation.pointing import beam_directions, pointing_frames
 from ..studies_lisa import SG_DIRECTIONS, STUDIES
@@ -60,7 +60,7 @@ def report_lisa_studies(run_paths: Mapping[str, str | os.PathLike | None], out_d
     (``values``: the measured and reference numbers by key, SI units).
     """
     rep, runs, used = evaluate_studies(STUDIES, _STUDY_FUNCS, run_paths, out_dir, studies, progress)
-    notes = ["reference: a first-order analytic estimate (docs/lisa-coupled.md, tqdyn.analysis.lisa_estimates), "
+    notes = ["reference: a first-order analytic estimate (docs/lisa-coupled.md, tqdyn.constellation.estimates), "
              "ESA's orbit files or a first-order bound, as each row says; spans are the runs' own"]
     notes += list(rep.notes) + [f"run {r}: {runs.paths[r]}" for r in used]
     text = format_summary(rep.rows, title, notes).replace("| quantity | paper | tqdyn | agreement / notes |",
@@ -389,11 +389,7 @@ def _study_esa_ramp(rep, runs, coupled="ramp-1y", pm="esa-1y", stem="lisa-esa-ra
     T = c["sat/T_S_I"][ia]
     X, Y = T[:, :, 0, :], T[:, :, 1, :]
     Xi = pointing_frames(beam_directions("global", r_dd).n).X_S  # the beams' bisectors, toward the incentre
-    G = c["sat/a_dragfree"][ia]
-    gm = planetary_gm()["sun"]
-    parts = {"geometric": g[:, None, None] * (Xi - ch), "aberration": g[:, None, None] * (X - Xi),
-             "nominal": G - g[:, None, None] * X}
-    resp = {k: le.cw_response(t[ia], r, v, f, gm=gm) for k, f in parts.items()}
+    resp = le.ramp_difference_response(t[ia], r, v, c["sat/a_dragfree"][ia], g, X, Xi, ch, gm=planetary_gm()["sun"])
     total = sum(resp.values())
     ang = np.degrees(np.arctan2(np.einsum("nsk,nsk->ns", ch, Y), np.einsum("nsk,nsk->ns", ch, X)))
     L_arm, (ij, ik) = geometry.arms(r_dd).length, geometry.link_pairs()

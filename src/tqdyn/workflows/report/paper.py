@@ -36,10 +36,10 @@ from ...analysis.metrics import (
     flight_axis_check,
     orbit_deviation,
     range_asd_in_band,
-    secular_along_track_drift,
 )
 from ...analysis.pointing_study import pointing_study_of
 from ...astro.constants import C_LIGHT, GM_EARTH_EGM2008
+from ...constellation.estimates import secular_along_track_drift
 from ...constellation.indices import Link, Sat
 from ...constellation.pointing import angle_between
 from ...lightpath import instantaneous_ranges, light_travel_times_of

@@ -13,7 +13,7 @@ distant - local + nu0 OMS + ``glitch_readout_sci_carriers``, Hz) is
     -(nu0 + O_ji(t - tau)) [ local_ttl_ij(t) + (1 - d_ppr_ij) distant_ttl_ji(t - tau) ] / c
         = -(nu0 / c) ds_ij/dt  (1 + O(O_ji / nu0) + O(d_ppr))
 
-with s_ij the link's TTL path length of :func:`tqdyn.closedloop.ttl.link_ttl` (m; with constant
+with s_ij the link's TTL path length of :func:`tqdyn.ttl.coupling.link_ttl` (m; with constant
 coefficients ds/dt is exactly LISA Instrument's velocity sum).  The glitch injection point
 ``readout_isi_carrier_ij`` (``readout_sci_carrier``) is added to that same beatnote, in Hz, with a
 plus sign; so the injection
@@ -50,8 +50,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..astro.constants import C_LIGHT
-from .ttl import MOSAS, link_ttl
-from .ttl_budget import MOSA_NAMES, mosa_angles_from_outputs
+from .coupling import MOSAS, link_ttl
+from .budget import MOSA_NAMES, mosa_angles_from_outputs
 
 __all__ = ["CENTRAL_FREQ_HZ", "central_derivative", "readout_injections", "tm_velocity_injections",
            "ttl_to_readout_hz"]
@@ -87,9 +87,9 @@ def readout_injections(outputs: dict, theta, coeffs, dt: float, delays: dict,
                        central_freq: float = CENTRAL_FREQ_HZ, t0: float = 0.0) -> tuple[dict, dict]:
     """The links' TTL s_ij (m) and their readout injections g_ij (Hz), dicts keyed by link (:data:`MOSAS`).
 
-    outputs: the closed loop's angle outputs (:data:`tqdyn.closedloop.ttl_budget.ANGLE_OUTPUTS`, rad),
+    outputs: the closed loop's angle outputs (:data:`tqdyn.ttl.budget.ANGLE_OUTPUTS`, rad),
     arrays (n, 3) over the spacecraft, sampled at t0 + k dt (s); theta: opening angle(s) (rad); coeffs:
-    constant or time-varying coefficients (:func:`tqdyn.closedloop.ttl.ttl_terms`); dt: step (s); delays:
+    constant or time-varying coefficients (:func:`tqdyn.ttl.coupling.ttl_terms`); dt: step (s); delays:
     light travel time per link (s, float or (n,)).  NaN where the derivative's or the delay's stencil leaves the series."""
     phi, eta = mosa_angles_from_outputs(outputs, theta)
     s = link_ttl(phi, eta, coeffs, dt, delays, t0)
@@ -101,7 +101,7 @@ def tm_velocity_injections(tm1_acceleration: np.ndarray, tm2_acceleration: np.nd
     """The ``tm_ij`` injections (m/s), dict keyed by MOSA: the trapezoidal time integral (mean removed) of
     the residual acceleration of TM l of spacecraft i (``tm{l}_acceleration``, m/s^2, arrays (n, 3) over the
     spacecraft) times ``axis_sign[l - 1]`` (e_l . X_OA_l), at LISA Instrument's MOSA of TM l
-    (:data:`tqdyn.closedloop.ttl_budget.MOSA_NAMES`); dt (s)."""
+    (:data:`tqdyn.ttl.budget.MOSA_NAMES`); dt (s)."""
     out = {}
     for l, acc in enumerate((tm1_acceleration, tm2_acceleration)):
         a = np.asarray(acc, dtype=np.float64)

@@ -1,9 +1,13 @@
 """Numbers for the docs: the default designs' margins and the paths from the DC working point to in-band noise.
 
+The closed loops are evaluated here, not built: :func:`tqdyn.closedloop.loop.build_closed_loop` builds them
+(with and without a part of the working point or the plant), :mod:`tqdyn.closedloop.budget` evaluates them.
+
 :func:`dc_paths` splits the residual TM acceleration at a working point into the paths from the DC
 forces, the cross-talk, the stiffness and the gravity gradient (``tqdyn report --closed-loop`` writes
 them for the working points of coupled runs; docs/closed-loop.md renders them).
-:func:`design_numbers` returns a JSON-ready dict of the same kind at first-principles working points:
+:func:`design_numbers` returns a JSON-ready dict of the same kind at first-principles working points
+(:func:`tqdyn.closedloop.missions.representative_working_point`):
 per mission, the loop-at-a-time margins of the default design at a representative working point, and
 the residual TM acceleration along the sensitive axis at 1 and 10 mHz split into
 
@@ -21,52 +25,18 @@ Units: m/s^2/Hz^1/2 (one-sided), Hz, deg.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from .budget import closed_loop_response, loop_margins, noise_budget
-from .loop import build_closed_loop, output_names
-from .missions import MISSIONS, default_controllers, default_noise, default_plant
-from .plant import PlantParameters, WorkingPoint
+from ..closedloop.budget import closed_loop_response, loop_margins, noise_budget
+from ..closedloop.loop import SOURCES, build_closed_loop, output_names, source_inputs
+from ..closedloop.missions import (MISSIONS, default_controllers, default_noise, default_plant, representative_plant,
+                                   representative_working_point)
+from ..closedloop.plant import PlantParameters, WorkingPoint, sensitive_basis
 
-__all__ = ["DC_SUSPENSION_LIMIT", "dc_paths", "design_numbers", "representative_working_point"]
+__all__ = ["DC_SUSPENSION_LIMIT", "dc_paths", "design_numbers"]
 
 #: The paper's DC limit on the TM suspension acceleration [m/s^2] (TianQin's self-gravity requirement).
 DC_SUSPENSION_LIMIT = 1e-10
-
-
-def representative_working_point(mission: str, self_gravity=None) -> WorkingPoint:
-    """A working point of ``mission`` from first principles: the central body's tide at the orbit
-    (TianQin: GM_E/r^3 at r = 1e8 m; LISA/Taiji: GM_S/(1 au)^3) in a frame turning at the orbital rate
-    about Z_S, theta = 60 deg, DC suspension from the self-gravity (default Table IV; the nominal
-    scheme puts the differences dg_y, dg_z on the TMs: A_1 = -A_2 = (0, dg_y/(2 cos 30), dg_z/2)
-    along Y_OA, Z), no drag-free DC acceleration along the sensitive axes.  SI units, S / OA_l frames."""
-    from ..constellation.control import dragfree_general, oa_rotation
-    from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY
-
-    gm, r = (3.986004415e14, 1e8) if mission == "tianqin" else (1.32712440041e20, 1.495978707e11)
-    n2 = gm / r ** 3
-    sg = TABLE_IV_SELF_GRAVITY if self_gravity is None else np.asarray(self_gravity)
-    T = oa_rotation(math.pi / 3)
-    g_S = np.einsum("lji,lj->li", T, sg)
-    G, A = dragfree_general(g_S, math.pi / 3)
-    return WorkingPoint(gamma=np.diag([2 * n2, -n2, -n2]), omega=np.array([0.0, 0.0, math.sqrt(n2)]),
-                        omega_dot=np.zeros(3), theta=math.pi / 3, theta_dot=0.0, a_suspension=A,
-                        alpha_suspension=np.zeros((2, 3)), a_dragfree=G, self_gravity=sg)
-
-
-def _plant(mission: str, **over) -> PlantParameters:
-    from ..constellation.spacecraft import Spacecraft
-
-    sc = Spacecraft.preset(mission)
-    d = {**default_plant(mission), **over}
-    return PlantParameters(sc_mass=d["sc_mass"], sc_inertia=d["sc_inertia"], tm_mass=d["tm_mass"],
-                           tm_side=d["tm_side"], mosa_inertia=d["mosa_inertia"], mosa_stiffness=d["mosa_stiffness"],
-                           stiffness=np.tile(d["stiffness"], (2, 1)),
-                           rotational_stiffness=np.tile(d["rotational_stiffness"], (2, 1)), crosstalk=d["crosstalk"],
-                           housing_centers=sc.housing_centers(math.pi / 3), lever_arms=sc.lever_arms(math.pi / 3),
-                           sensitive_axes=sc.sensitive_axes_array)
 
 
 def design_numbers(freqs=(1e-3, 1e-2)) -> dict:
@@ -81,12 +51,13 @@ def design_numbers(freqs=(1e-3, 1e-2)) -> dict:
         wp = representative_working_point(mission)
         ctl = default_controllers(mission)
         noise = default_noise(mission)
-        p = _plant(mission)
+        p = representative_plant(mission)
         cl = build_closed_loop(p, wp, ctl)
         b, sources = noise_budget(cl, noise, f)
         total = np.sqrt(np.sum(b ** 2, axis=1))
-        no_xt = noise_budget(build_closed_loop(_plant(mission, crosstalk=0.0), wp, ctl), noise, f)[0]
-        no_k = noise_budget(build_closed_loop(_plant(mission, stiffness=(0.0, 0.0, 0.0)), wp, ctl), noise, f)[0]
+        no_xt = noise_budget(build_closed_loop(representative_plant(mission, crosstalk=0.0), wp, ctl), noise, f)[0]
+        no_k = noise_budget(build_closed_loop(representative_plant(mission, stiffness=(0.0, 0.0, 0.0)), wp, ctl),
+                            noise, f)[0]
         tot_xt = np.sqrt(np.sum(no_xt ** 2, axis=1))
         tot_k = np.sqrt(np.sum(no_k ** 2, axis=1))
         jitter = total[i_x]
@@ -115,8 +86,6 @@ def _path(cl, p, wp, ctl, noise, f, azs, output):
     """ASD [output unit/Hz^1/2] of the part of ``output`` that the closed loop ``cl`` has and the loop of
     (``p``, ``wp``) has not: per source input the difference of the two transfer functions (coherent, so
     that a path is measured alone, not through the cross terms of a power difference), summed in power."""
-    from .loop import SOURCES, source_inputs
-
     other = build_closed_loop(p, wp, ctl, azs)
     sources = [s for s in SOURCES if s in noise]
     inputs = [x for s in sources for x in source_inputs(s)]
@@ -147,7 +116,6 @@ def dc_paths(p: PlantParameters, wp: WorkingPoint, controllers: dict, noise: dic
     from dataclasses import replace
 
     from ..constellation.control import oa_rotation
-    from .plant import sensitive_basis
 
     f = np.asarray(f, dtype=np.float64)
     names = output_names()
@@ -195,6 +163,3 @@ def dc_paths(p: PlantParameters, wp: WorkingPoint, controllers: dict, noise: dic
         "stiffness_sensitive": k_e,
         "limit": float(limit),
     }
-
-
-_ = closed_loop_response

@@ -1,6 +1,6 @@
 """Estimation of the linear TTL coefficients of one link from its readout and the measured (DWS) angles.
 
-Model of link ``ij`` (:mod:`tqdyn.closedloop.ttl`, linear part), readout y (m)::
+Model of link ``ij`` (:mod:`tqdyn.ttl.coupling`, linear part), readout y (m)::
 
     y(t) = c_lp phi_ij(t) + c_le eta_ij(t) + c_dp phi_ji(t - tau) + c_de eta_ji(t - tau) + n_y(t)
          = X_true(t) b + n_y(t),        b = (c_lp, c_le, c_dp, c_de)   [m/rad]  (:data:`REGRESSORS`)
@@ -51,8 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate
 
-from .noise import AsdModel
-from .ttl import _delay
+from ..closedloop.noise import AsdModel
+from .coupling import _delay
 
 __all__ = ["REGRESSORS", "LinkFit", "LinkSimulation", "band_bins", "band_variance", "iv_fit",
            "manoeuvre_instruments", "ols_attenuation", "ols_fit", "simulate_link_fit"]
@@ -242,7 +242,7 @@ def simulate_link_fit(coefficients, *, dt: float, n: int, seed: int, band, jitte
     dws_asd: ASDs [rad/Hz^1/2] (a float = white, or an :class:`AsdModel`) of the true angle jitter and
     of the DWS noise, the same for the four angles, independent; readout_asd [m/Hz^1/2] of the
     readout noise; tau [s]: the link's light travel time (the distant angles and their DWS noise are
-    delayed by it with :mod:`tqdyn.closedloop.ttl`'s order-7 Lagrange delay); manoeuvres: dict
+    delayed by it with :mod:`tqdyn.ttl.coupling`'s order-7 Lagrange delay); manoeuvres: dict
     regressor name -> (amplitude [rad], frequency [Hz]), a sinusoid added to that true angle (a distant
     one at the emitting MOSA, so it arrives delayed), each frequency moved to the nearest DFT bin;
     angles: optional dict regressor name -> (n + margin,) true jitter series [rad] (e.g. a closed-loop

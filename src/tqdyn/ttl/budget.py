@@ -46,9 +46,9 @@ import math
 import numpy as np
 
 from ..constellation.control import oa_rotation
-from .budget import closed_loop_response
-from .loop import SOURCES, ClosedLoop, source_inputs
-from .ttl import MOSAS, TTLCoefficients, distant_mosa
+from ..closedloop.budget import closed_loop_response
+from ..closedloop.loop import SOURCES, ClosedLoop, source_inputs
+from .coupling import MOSAS, TTLCoefficients, distant_mosa
 
 __all__ = ["ANGLE_OUTPUTS", "MOSA_NAMES", "angle_map", "link_ttl_asd", "mosa_angles_from_outputs",
            "tm_displacement_asd"]
@@ -121,7 +121,7 @@ def _check_loops(loops, thetas) -> tuple:
 
 def link_ttl_asd(loops, noise: dict, f, coeffs: TTLCoefficients, theta, dt: float | None = None
                  ) -> tuple[np.ndarray, list]:
-    """TTL ASD (6, n_source, n_f) [m/Hz^1/2] of the links (:data:`tqdyn.closedloop.ttl.MOSAS` order) from each
+    """TTL ASD (6, n_source, n_f) [m/Hz^1/2] of the links (:data:`tqdyn.ttl.coupling.MOSAS` order) from each
     noise source (module docstring), and the source names.  ``loops``: the three spacecraft's
     :class:`ClosedLoop` (i = 1, 2, 3); ``noise`` {source: AsdModel}; ``f`` [Hz]; ``theta`` opening angle
     [rad] (float or one per spacecraft); ``dt`` [s]: the zero-order-hold discretised loops (as the time

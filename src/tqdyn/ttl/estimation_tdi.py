@@ -1,10 +1,10 @@
 """Joint estimation of the 24 linear TTL coefficients of the six links, from the links or in TDI.
 
-Unknowns b (24,) (:data:`COEFFICIENTS`): for each MOSA m of :data:`tqdyn.closedloop.ttl.MOSAS` its
-local_phi, local_eta, distant_phi, distant_eta (m/rad), in :mod:`tqdyn.closedloop.ttl`'s convention:
+Unknowns b (24,) (:data:`COEFFICIENTS`): for each MOSA m of :data:`tqdyn.ttl.coupling.MOSAS` its
+local_phi, local_eta, distant_phi, distant_eta (m/rad), in :mod:`tqdyn.ttl.coupling`'s convention:
 link ``ij`` carries c^local_ij of the receiving MOSA ij's angles at t and c^distant_ji of the
 emitting MOSA ji's angles at t - tau_ij.  Regressors: the DWS-measured angles (true + DWS noise),
-the distant ones delayed by the link's light time with :mod:`tqdyn.closedloop.ttl`'s order-7
+the distant ones delayed by the link's light time with :mod:`tqdyn.ttl.coupling`'s order-7
 Lagrange delay (:func:`link_regressors`).
 
 (a) Six links, :func:`fit_links`: the six readouts y_ij = s_ij + n_ij are the data; each
@@ -30,7 +30,7 @@ links (identity for the links; for constant delays the Michelsons' sums of +/- e
 :func:`michelson_transfer`) and g the readout noise's PSD shape (1 = white).  Each bin is whitened
 (L_k^-1 with C_k = L_k L_k^H) and real and imaginary parts stacked: 2 m c real equations with white
 noise of variance s^2 each.  OLS: b = (A^T A)^-1 A^T Y, covariance s^2 (A^T A)^-1 (generalised least
-squares in the un-whitened variables).  IV (two-stage least squares, :mod:`.ttl_estimation`): the
+squares in the un-whitened variables).  IV (two-stage least squares, :mod:`.estimation`): the
 instruments are the cos and sin of the calibration manoeuvres, each at a DFT bin and distinct per
 angle; their in-band span in every channel is the span of the manoeuvre bins, so P_Z A keeps those
 rows, A_hat^T A = A_s^T A_s and b = (A_s^T A_s)^-1 A_s^T Y_s, covariance s^2 (A_s^T A_s)^-1 with s^2
@@ -42,7 +42,7 @@ Errors in variables: E[A^T A] = G_true + G_N for any design built by the same li
 the true angles and their DWS noises; with independent angles and jitter and DWS PSDs proportional
 (S_j = r S_N at every frequency) G_true = r G_N and E[b_OLS] -> r / (1 + r) b for every coefficient,
 in the links and in TDI alike (:func:`predicted_attenuation`, the one-link lambda of
-:mod:`.ttl_estimation`).
+:mod:`.estimation`).
 
 Degeneracies in TDI: the whitened TDI information is the six links' projected onto the complement
 of the laser-noise signatures y_ij = D_ij p_j - p_i (three dimensions per frequency), so a TTL
@@ -68,9 +68,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from .noise import AsdModel
-from .ttl import MOSAS, SPACECRAFT, TTLCoefficients, _delay, distant_mosa, mosa_angles
-from .ttl_estimation import REGRESSORS, _as_asd, _band_asd, _coloured, band_bins, band_variance
+from ..closedloop.noise import AsdModel
+from .coupling import MOSAS, SPACECRAFT, TTLCoefficients, _delay, distant_mosa, mosa_angles
+from .estimation import REGRESSORS, _as_asd, _band_asd, _coloured, band_bins, band_variance
 
 __all__ = ["ANGLES", "CHANNELS", "COEFFICIENTS", "NULL_RCOND", "JointFit", "SixLinkSimulation", "chain_shift",
            "coefficient_vector", "default_manoeuvres", "fit_links", "fit_tdi", "link_regressors",
@@ -132,7 +132,7 @@ def _weights(dt: float, shift: float) -> tuple[int, tuple]:
 
 
 def _delayed(x: np.ndarray, dt: float, shift) -> np.ndarray:
-    """x(t - shift) along axis 0 (x (n,) or (n, q)) by :mod:`tqdyn.closedloop.ttl`'s order-7 Lagrange
+    """x(t - shift) along axis 0 (x (n,) or (n, q)) by :mod:`tqdyn.ttl.coupling`'s order-7 Lagrange
     delay (NaN where its stencil leaves the series).  A constant shift uses that delay's eight weights,
     read off by delaying unit impulses, as one FIR filter (the same interpolant, ~10x faster than
     evaluating the weights per sample); a series shift calls it directly."""
@@ -408,7 +408,7 @@ def simulate_six_link_fit(coeffs: TTLCoefficients, *, dt: float, n: int, seed: i
     moved to the nearest DFT bin; :func:`default_manoeuvres`); laser_asd (m/Hz^1/2): laser noise p_i of
     the three spacecraft added as D_ij p_j - p_i to link ij of the TDI data only (the link fits see
     readouts without it); spacecraft_jitter_asd (rad/Hz^1/2): optional yaw, pitch and roll jitter of
-    each spacecraft, added to its two MOSAs' angles by :func:`tqdyn.closedloop.ttl.mosa_angles`
+    each spacecraft, added to its two MOSAs' angles by :func:`tqdyn.ttl.coupling.mosa_angles`
     (jitter_asd is then the MOSAs' own jitter); tdi: False skips the TDI fits.  predicted_attenuation
     is exact for the links; in TDI for independent MOSA angles (no spacecraft jitter) and jitter and
     DWS PSDs proportional."""
