@@ -33,10 +33,7 @@ __all__ = [
 
 _PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), ("corrected", "published")
 _RTOL_MAX = 1e-3
-#: ``integrator.method`` of a fixed-step run that does not name one.  An adaptive run
-#: (``integrator.mode = "adaptive"``) that names none is ``"dp87"``: the multistep method has a
-#: fixed step only.
-DEFAULT_METHOD = "multistep"
+DEFAULT_METHOD = "multistep"  #: ``integrator.method`` of a fixed-step run naming none (adaptive: ``"dp87"``, the only one)
 #: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive mode) a run
 #: may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at ``tqdyn bench``'s rates
 #: (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (full TianQin model) and write ~1e11 bytes per
@@ -54,9 +51,8 @@ from .values import (_EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one
 class IntegratorConfig:
     """Integrator choice.
 
-    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"``
-    (fixed step; :mod:`tqdyn.numerics.multistep`); None (not given): :data:`DEFAULT_METHOD`
-    in fixed mode, ``"dp87"`` in adaptive mode; ``mode``: ``"fixed"`` or
+    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"`` (fixed step; :mod:`tqdyn.numerics.multistep`);
+    None (not given): :data:`DEFAULT_METHOD` in fixed mode, ``"dp87"`` in adaptive mode; ``mode``: ``"fixed"`` or
     ``"adaptive"`` (DP87 only); ``step_s`` [s] (> 0): the fixed step, or in adaptive mode
     the output interval; ``tableau``: ``"corrected"`` or ``"published"``
     coefficients (also of the multistep start-up); ``rtol``: adaptive-mode relative local error tolerance
@@ -73,8 +69,7 @@ class IntegratorConfig:
 
     def __post_init__(self) -> None:
         _require_choice(self.mode, "integrator.mode", _MODES)
-        if self.method is None:  # the one place the default method is chosen
-            _set(self, "method", DEFAULT_METHOD if self.mode == "fixed" else "dp87")
+        _set(self, "method", (DEFAULT_METHOD if self.mode == "fixed" else "dp87") if self.method is None else self.method)
         _require_choice(self.method, "integrator.method", _METHODS)
         _require(self.method != "multistep" or self.mode == "fixed", "integrator.mode", self.mode,
                  'has no multistep form (integrator.method = "multistep")', '"fixed", or method = "dp87"')
