@@ -1,4 +1,4 @@
-"""The measured numbers of README.md and docs/*.md against their JSON records (docs/numbers.md).
+"""The measured numbers of README.md, CHANGELOG.md and docs/*.md against their JSON records (docs/numbers.md).
 
 Every page is rendered in memory by ``tools/render_docs.py`` from ``docs/data/*.json`` (the records that
 ``tqdyn bench --json``, ``tqdyn report --studies`` and ``pytest --record-numbers`` write); a page whose

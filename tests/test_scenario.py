@@ -72,7 +72,7 @@ def test_builtins_equal_table_i(name):
     assert s.name == name
     _check_table_i(s)
     assert s.run.duration_s == 864000  # "10d"
-    assert s.integrator == IntegratorConfig()  # dp87, fixed, 50 s, corrected, 1e-22
+    assert s.integrator == IntegratorConfig()  # the default method, fixed, 50 s, corrected, 1e-22
     assert s.spacecraft.d_tm_m == Decimal("0.40") and s.spacecraft.d_p_m == 0
     assert s.n_steps == 17280  # 864000 s / 50 s
     assert s.description

@@ -28,11 +28,12 @@ __all__ = [
     "SatelliteConfig", "IntegratorConfig", "RunConfig", "ForcesConfig", "SpacecraftConfig",
     "ConstellationConfig", "POINTING_LAWS", "Scenario", "ScenarioError", "CONTROL_MODES", "LIBRATION_MODELS",
     "MAX_EARTH_DEGREE", "MAX_MOON_DEGREE", "MAX_OCEAN_TIDE_DEGREE", "SELF_GRAVITY_MODELS", "THIRD_BODIES",
-    "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig",
+    "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig", "DEFAULT_METHOD",
 ]
 
 _PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), ("corrected", "published")
 _RTOL_MAX = 1e-3
+DEFAULT_METHOD = "multistep"  #: ``integrator.method`` of a fixed-step run naming none (adaptive: ``"dp87"``, the only one)
 #: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive mode) a run
 #: may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at ``tqdyn bench``'s rates
 #: (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (full TianQin model) and write ~1e11 bytes per
@@ -50,15 +51,15 @@ from .values import (_EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one
 class IntegratorConfig:
     """Integrator choice.
 
-    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"``
-    (fixed step; :mod:`tqdyn.numerics.multistep`); ``mode``: ``"fixed"`` or
+    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"`` (fixed step; :mod:`tqdyn.numerics.multistep`);
+    None (not given): :data:`DEFAULT_METHOD` in fixed mode, ``"dp87"`` in adaptive mode; ``mode``: ``"fixed"`` or
     ``"adaptive"`` (DP87 only); ``step_s`` [s] (> 0): the fixed step, or in adaptive mode
     the output interval; ``tableau``: ``"corrected"`` or ``"published"``
     coefficients (also of the multistep start-up); ``rtol``: adaptive-mode relative local error tolerance
     (0 < rtol < 1e-3).  Multistep: ``order`` and ``corrector`` (:mod:`tqdyn.numerics.multistep`).
     """
 
-    method: str = "dp87"
+    method: str | None = None
     mode: str = "fixed"
     step_s: Decimal = Decimal(50)
     tableau: str = "corrected"
@@ -67,8 +68,9 @@ class IntegratorConfig:
     corrector: str = _ms.DEFAULT_CORRECTOR
 
     def __post_init__(self) -> None:
-        _require_choice(self.method, "integrator.method", _METHODS)
         _require_choice(self.mode, "integrator.mode", _MODES)
+        _set(self, "method", (DEFAULT_METHOD if self.mode == "fixed" else "dp87") if self.method is None else self.method)
+        _require_choice(self.method, "integrator.method", _METHODS)
         _require(self.method != "multistep" or self.mode == "fixed", "integrator.mode", self.mode,
                  'has no multistep form (integrator.method = "multistep")', '"fixed", or method = "dp87"')
         o = self.order

@@ -28,6 +28,12 @@ Y_S . v / |v| on a run and the report prints it from every coupled run.
 The "+flight" common self-gravity of 1e-9 m/s^2 is therefore
 ``[0, -1e-9, 0]`` in S.
 
+Every run integrates with DP87 at the scenario's step (:data:`STUDY_INTEGRATOR`, applied before the
+run's own overrides): the paper's section V was computed with it, so the studies reproduce it with
+the paper's method rather than the default of ``tqdyn run`` (the multistep method, which agrees with
+DP87 to DP87's own reproducibility: docs/precision.md), and the runs' files (their digests) and
+records are those measured before that default changed.
+
 Runs live in a runs directory as ``<run name>-<digest>.h5``, the digest a
 short SHA-256 of the resolved scenario (with ``run.output`` normalised), so a
 scaled ("quick") set and the full set can coexist.  A run whose file is a
@@ -54,6 +60,7 @@ from pathlib import Path
 __all__ = [
     "BASE_SCENARIO",
     "COARSE_EVERY",
+    "STUDY_INTEGRATOR",
     "FLIGHT_DIRECTION_S",
     "QUICK_SCALE",
     "RUNS",
@@ -72,6 +79,8 @@ __all__ = [
 
 #: Base scenario of every study run (full force model, Table I elements).
 BASE_SCENARIO = "tianqin"
+#: Overrides of every study run, before its own: the paper's integrator, DP87 (the module docstring).
+STUDY_INTEGRATOR = ("integrator.method=dp87",)
 #: Output decimation of the 90-day runs (rows every 12 x 50 s = 600 s).
 COARSE_EVERY = 12
 #: Duration scale of ``tqdyn report --studies --quick``: 90 days -> 1 day, 30 days -> 8 h.
@@ -88,7 +97,7 @@ _DIGEST_CHARS = 12
 @dataclass(frozen=True)
 class RunSpec:
     """One study run: ``scenario`` (built-in name) + ``overrides`` (as for
-    ``tqdyn run --set``), ``days`` nominal duration [days],
+    ``tqdyn run --set``; after :data:`STUDY_INTEGRATOR`), ``days`` nominal duration [days],
     ``output_every`` (output row every N integrator steps), ``description``."""
 
     name: str
@@ -109,10 +118,11 @@ class RunSpec:
         """
         from ..scenario import load_scenario
 
-        base = load_scenario(self.scenario, [*self.overrides, *extra])
+        own = [*STUDY_INTEGRATOR, *self.overrides, *extra]
+        base = load_scenario(self.scenario, own)
         step = float(base.integrator.step_s)
         dur = scaled_duration_s(self.days, duration_scale, step * self.output_every)
-        return load_scenario(self.scenario, [*self.overrides, *extra, f"run.duration={dur}",
+        return load_scenario(self.scenario, [*own, f"run.duration={dur}",
                                              f"run.output_every={self.output_every}",
                                              f"run.output={output or _PLACEHOLDER}"])
 
