@@ -27,6 +27,7 @@ from ..closedloop.missions import requirement
 from ..closedloop.plant import PlantParameters
 from ..closedloop.simulate import MemorySink, Sink, simulate
 from ..closedloop.working_point import segment_rows, third_body_positions, working_points
+from ..scenario.closed_loop import FREQUENCY_GRID
 
 __all__ = ["ClosedLoopError", "ClosedLoopModel", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
            "BANDS"]
@@ -152,8 +153,9 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
             loops[i].append((float(t[a]), cl))
             parts[i].append((p, wp))
     settings = {"fs": float(cfg.value("fs", 4.0)), "duration": cfg.value("duration", None),
-                "seed": int(cfg.value("seed", 0)), "segment": segment, "f_min": float(cfg.value("f_min", 1e-5)),
-                "f_max": float(cfg.value("f_max", 1.0)), "n_freq": int(cfg.value("n_freq", 300)),
+                "seed": int(cfg.value("seed", 0)), "segment": segment, "f_min": float(cfg.value("f_min", FREQUENCY_GRID["f_min"])),
+                "f_max": float(cfg.value("f_max", FREQUENCY_GRID["f_max"])),
+                "n_freq": int(cfg.value("n_freq", FREQUENCY_GRID["n_freq"])),
                 "attitude_z_sensor": azs}
     names = tuple(getattr(traj, "satellite_names", ())) or tuple(f"Sat{i + 1}" for i in range(n_sat))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,

@@ -27,15 +27,15 @@ Errors are :class:`~tqdyn.scenario.values.ScenarioError` naming the key.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from decimal import Decimal
 from typing import Any
 
+from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _require
 
-__all__ = ["CLOSED_LOOP_KEYS", "LOOP_NAMES", "MISSIONS", "PLANT_KEYS", "SOURCE_UNITS", "ClosedLoopConfig",
+__all__ = ["CLOSED_LOOP_KEYS", "FREQUENCY_GRID", "LOOP_NAMES", "MISSIONS", "PLANT_KEYS", "SOURCE_UNITS", "ClosedLoopConfig",
            "check_asd", "check_controller"]
 
 #: Missions with a default closed-loop design (tqdyn.closedloop.missions).
@@ -52,6 +52,8 @@ SOURCE_UNITS = {"thruster_force": "N", "thruster_gain": "1", "thruster_torque": 
 CLOSED_LOOP_KEYS = {"mission": "string", "fs": "number", "duration": "duration", "seed": "integer",
                     "segment": "duration", "f_min": "number", "f_max": "number", "n_freq": "integer",
                     "attitude_z_sensor": "string"}
+#: Defaults of the budget's log frequency grid: f_min, f_max [Hz], n_freq (f_min < f_max).
+FREQUENCY_GRID = {"f_min": 1e-5, "f_max": 1.0, "n_freq": 300}
 #: Keys of [closed_loop.plant]: name -> number of values (1: a number).
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1}
@@ -59,7 +61,7 @@ _POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia")
 
 
 def _num(v) -> bool:
-    return isinstance(v, (int, float, Decimal)) and not isinstance(v, bool) and math.isfinite(float(v))
+    return finite_number(v) is not None
 
 
 @dataclass(frozen=True)
@@ -116,6 +118,13 @@ class ClosedLoopConfig:
                     _require(isinstance(spec, dict) and set(spec) <= {"level", "knees"}, sname, spec,
                              "is not a noise table", "level, knees")
                     self._asd(src, spec)
+        lo, hi = (float(raw.get(k, FREQUENCY_GRID[k])) for k in ("f_min", "f_max"))
+        if not lo < hi:
+            given = "f_min" if "f_min" in raw else "f_max"
+            _require(False, f"closed_loop.{given}", raw[given],
+                     f"leaves no band: f_min = {lo:g} Hz, f_max = {hi:g} Hz" + ("" if {"f_min", "f_max"} <= set(raw)
+                                                                               else " (the other one's default)"),
+                     "f_min < f_max [Hz]")
 
     @staticmethod
     def _controller(loop: str, spec: dict):
