@@ -192,6 +192,8 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     except (ValueError, io.OutputError) as exc:
         if state["bar"] is not None:
             state["bar"].close()
+        if isinstance(exc, dynamics.NonFiniteStateError):
+            _fail(f"{exc}; no output file written")
         if hasattr(exc, "tqdyn_checkpoint") and not isinstance(exc, io.OutputError):
             raise  # a failure inside the propagation, not bad input
         _fail(str(exc))

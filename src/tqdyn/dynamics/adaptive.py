@@ -18,7 +18,7 @@ from ..numerics import dp87
 from ..numerics import hermite
 from . import layout as _lay
 from .fixed import DEFAULT_CHUNK, _one_step, _scale_tableau, _workspace
-from .results import RunResult, select_rows, to_dd
+from .results import NonFiniteStateError, RunResult, check_finite_states, select_rows, to_dd
 from .rhs import evaluate_rhs
 
 __all__ = ["propagate_adaptive"]
@@ -122,6 +122,10 @@ def propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, prog
                   tdat, model.params, model.layout, cpar, aux, aux, gw, fw)
         n_rhs += 13
         norm = dp87.error_norm(y_try, err, rtol)
+        if not (np.isfinite(norm) and np.isfinite(y_try).all()):  # no step size makes it finite: stop here
+            t_try = _dd_of(t + h_exact)
+            check_finite_states(n_acc + 1, np.array([t_try]), y_try[None])
+            raise NonFiniteStateError(n_acc + 1, t_try[0] + t_try[1], int(np.argmax(~np.isfinite(err).all(axis=1))))
         if norm <= 1.0:
             t_new = t + h_exact
             a0 = K[0][:, 3:6].copy()

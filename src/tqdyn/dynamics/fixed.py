@@ -26,7 +26,7 @@ from ..forces.model import ForceModel
 from ..numerics import dp87
 from ..numerics.dd import add, ld, mul, st
 from . import layout as _lay
-from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
+from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_mass_system, system_rhs
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_plan", "deliver_rows", "input_pipeline", "propagate_fixed", "warm_up"]
@@ -172,7 +172,9 @@ class CheckpointClock:
 def deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t, y, a, aux) -> None:
     """Hand the rows of the steps n0, n0 + 1, ... (dd times ``t``, states ``y``, accelerations ``a``,
     diagnostics ``aux``) to ``sink`` (every ``every``-th step: :func:`select_rows`) and fold the
-    diagnostics into ``extremes`` (when the run forms them, ``n_aux``)."""
+    diagnostics into ``extremes`` (when the run forms them, ``n_aux``).  A state that is not finite
+    stops the run here (:func:`~tqdyn.dynamics.results.check_finite_states`), before its rows go out."""
+    check_finite_states(n0, t, y)
     if sink is not None:
         sink(select_rows(t, y, a, precision, every, n0, aux, system))
     if n_aux:
@@ -299,6 +301,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
                 else np.zeros(0))
     k_end, aux_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model, cpar, with_aux=True)
     wall = _time.perf_counter() - t_start
+    check_finite_states(n_total, t_end, y[None])
     if sink is not None:
         sink(select_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
     return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,

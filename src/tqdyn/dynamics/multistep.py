@@ -39,7 +39,7 @@ from ..numerics import multistep as _ms
 from . import layout as _lay
 from .fixed import (CheckpointClock, _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, deliver_rows,
                     input_pipeline)
-from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
+from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import evaluate_rhs, point_mass_system, system_rhs
 
 __all__ = ["INPUT_BLOCK", "propagate_multistep", "warm_up_multistep", "corrector_stages"]
@@ -187,6 +187,7 @@ def _start_up(st, mc, scenario, precision, model, epoch, tab, y0_dd, sink, syste
                  tdat, model.params, model.layout, cpar, aux, gw, fw, n_s, out_y, out_a, out_aux)
     k_end, aux_end = evaluate_rhs(y, tdat_end, model, cpar, with_aux=True)
     cpu["loop"] += _time.thread_time() - t_cpu
+    check_finite_states(0, t_out[:n_s], out_y)
     if sink is not None:
         sink(select_rows(t_out[:n_s], out_y, out_a, precision, scenario.run.output_every, 0, out_aux, system))
     st.y[...] = y

@@ -29,11 +29,11 @@ Errors are :class:`~tqdyn.scenario.values.ScenarioError` naming the key.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from decimal import Decimal
 from typing import Any
 
+from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _one_of, _require
 
@@ -90,7 +90,7 @@ _POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia")
 
 
 def _num(v) -> bool:
-    return isinstance(v, (int, float, Decimal)) and not isinstance(v, bool) and math.isfinite(float(v))
+    return finite_number(v) is not None
 
 
 @dataclass(frozen=True)
@@ -146,6 +146,13 @@ class ClosedLoopConfig:
                     _require(isinstance(spec, dict) and set(spec) <= {"level", "knees"}, sname, spec,
                              "is not a noise table", "level, knees")
                     self._asd(src, spec)
+        lo, hi = (float(raw.get(k, CLOSED_LOOP_KEYS[k][1])) for k in ("f_min", "f_max"))
+        if not lo < hi:
+            given = "f_min" if "f_min" in raw else "f_max"
+            _require(False, f"closed_loop.{given}", raw[given],
+                     f"leaves no band: f_min = {lo:g} Hz, f_max = {hi:g} Hz" + ("" if {"f_min", "f_max"} <= set(raw)
+                                                                               else " (the other one's default)"),
+                     "f_min < f_max [Hz]")
 
     @staticmethod
     def _controller(loop: str, spec: dict):

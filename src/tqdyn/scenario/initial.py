@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
 
+from ..astro.constants import C_LIGHT
 from ..astro.timescales import Epoch
 from .values import _EXACT, ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
 
@@ -54,6 +55,13 @@ class SatelliteConfig:
                 _require(getattr(self, f) is not None, f"satellite.{f}", None, "is missing",
                          f"3 finite numbers [{unit}] (a Cartesian state needs both r and v)")
                 _set(self, f, _num_array(getattr(self, f), f"satellite.{f}", ((3,),), unit))
+            with localcontext() as ctx:
+                ctx.prec = _EXACT
+                r, v = (sum(x * x for x in getattr(self, f)).sqrt() for f in ("r_m", "v_mps"))
+            _require(r > 0, "satellite.r_m", list(self.r_m), "is the centre of the central body",
+                     "|r| > 0 (the point-mass gravity is singular there)")
+            _require(v < _C_LIGHT, "satellite.v_mps", list(self.v_mps), f"has |v| = {float(v):.4g} m/s, not below "
+                     "the speed of light", f"|v| < c = {_C_LIGHT} m/s")
             return
         _require(self.a_m is not None, "satellite.a_m", None, "is missing", "a > 0 m (or a Cartesian state r, v)")
         for f in elements:
@@ -76,6 +84,7 @@ ROTATIONS = ("clockwise", "counterclockwise")
 #: standard), or taken as ICRF axes already (ESA's CReMA 2.0 LISA files, docs/lisa-orbits.md).
 OEM_EME2000 = ("frame-bias", "icrf")
 AU_M = Decimal(149597870700)
+_C_LIGHT = Decimal(repr(C_LIGHT))
 
 
 def epoch_from_label(text: str, name: str) -> Epoch:

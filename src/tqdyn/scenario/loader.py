@@ -224,8 +224,14 @@ def _build_satellite(raw: Any, k: int, derived: bool) -> SatelliteConfig | str:
         for key in ("r_km", "v_kmps"):
             _require(key in raw, f"{prefix}.{key}", _NOVALUE, "is missing", "r_km and v_kmps, 3 numbers each")
         name = _typed(raw.get("name", f"Sat{k}"), _STR, f"{prefix}.name")
-        return SatelliteConfig(name=name, r_m=_km_vector(raw["r_km"], f"{prefix}.r_km"),
-                               v_mps=_km_vector(raw["v_kmps"], f"{prefix}.v_kmps"))
+        try:
+            return SatelliteConfig(name=name, r_m=_km_vector(raw["r_km"], f"{prefix}.r_km"),
+                                   v_mps=_km_vector(raw["v_kmps"], f"{prefix}.v_kmps"))
+        except ScenarioError as err:
+            key = {"r_m": "r_km", "v_mps": "v_kmps"}.get(err.field.rsplit(".", 1)[-1])
+            if key is None:
+                raise
+            raise ScenarioError(f"{prefix}.{key}", raw[key], err.problem, err.allowed) from None
     _require("a_km" in raw, f"{prefix}.a_km", _NOVALUE, "is missing",
              "a semi-major axis in km (> 0), or a Cartesian state r_km, v_kmps")
     vals = {key: _typed(raw[key], kind, f"{prefix}.{key}") for key, kind in _SAT_SCHEMA.items() if key in raw}

@@ -10,7 +10,16 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any, Sequence
 
-__all__ = ["ScenarioError"]
+__all__ = ["MAX_ACCELERATION", "ScenarioError"]
+
+#: Largest component [m/s^2] of an acceleration a scenario gives (``[accelerations]``,
+#: ``spacecraft.self_gravity*``).  These keys model small forces on the satellites: solar radiation
+#: pressure (~1e-7 m/s^2 on these missions' spacecraft), the spacecraft's self-gravity at its test
+#: masses (~1e-9 m/s^2), empirical accelerations estimated by orbit determination (the same sizes);
+#: even an electric-propulsion thruster (~0.1 N on a ~500 kg spacecraft) gives 2e-4 m/s^2.  A value
+#: above 1e-3 m/s^2 is a unit or typing mistake (km/s^2, a missing exponent): it is refused at load
+#: rather than driving the orbit out of range (1e300 m/s^2 overflows the state to inf, then NaN).
+MAX_ACCELERATION = Decimal("1e-3")
 
 _EXACT = 200  # Decimal working precision for exact unit conversions
 
@@ -20,10 +29,14 @@ _NOVALUE = object()
 # --------------------------------------------------------------------------- errors
 
 
+def _has_decimal(value: Any) -> bool:
+    return isinstance(value, Decimal) or (isinstance(value, (list, tuple)) and any(_has_decimal(x) for x in value))
+
+
 def _fmt(value: Any) -> str:
     if isinstance(value, Decimal):
         return str(value)
-    if isinstance(value, list) and any(isinstance(x, Decimal) for x in value):
+    if isinstance(value, (list, tuple)) and _has_decimal(value):
         return "[" + ", ".join(_fmt(x) for x in value) + "]"
     if isinstance(value, Path):
         return repr(str(value))
@@ -122,8 +135,10 @@ def _toml_type(value: Any) -> str:
 
 
 
-def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: str) -> tuple:
-    """Nested tuples of Decimal with one of ``shapes`` (ScenarioError otherwise)."""
+def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: str,
+               max_abs: Decimal | None = None) -> tuple:
+    """Nested tuples of Decimal with one of ``shapes`` (ScenarioError otherwise); with ``max_abs``,
+    every |element| <= max_abs (in ``unit``; :data:`MAX_ACCELERATION` for accelerations)."""
     allowed = " or ".join(str(tuple(s)) for s in shapes)
     allowed = f"an array of shape {allowed} of finite numbers [{unit}]"
 
@@ -146,4 +161,12 @@ def _num_array(value: Any, name: str, shapes: Sequence[tuple[int, ...]], unit: s
 
     _require(isinstance(arr, tuple) and shape(arr) in [tuple(s) for s in shapes], name,
              value, "has the wrong shape", allowed)
+    if max_abs is not None:
+        def flat(x):
+            return [e for y in x for e in flat(y)] if isinstance(x, tuple) else [x]
+
+        big = max(flat(arr), key=abs)
+        u = unit.split(",")[0].split(" ")[0]
+        _require(abs(big) <= max_abs, name, value, f"has {big} {u}, too large for the small force this key models",
+                 f"|each value| <= {max_abs} {u} (docs/scenarios.md)")
     return arr

@@ -53,6 +53,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..numerics import lagrange
+from ..numerics.finite import finite_number
 from ..numerics.lagrange import MARGIN, POINTS
 
 __all__ = ["LINEAR_FIELDS", "LPF_DRIFT_M_PER_RAD_PER_S", "LPF_TEMPERATURE_COEFFICIENT_M_PER_RAD_PER_K", "MOSAS",
@@ -99,12 +100,9 @@ def _check_keys(field: str, d, allowed: tuple) -> None:
 
 
 def _finite_float(field: str, v, unit: str) -> float:
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not math.isfinite(x):
-        raise ValueError(f"{field} = {v!r}: must be a finite number ({unit})")
+    x = finite_number(v)
+    if x is None:
+        raise ValueError(f"{field} = {v!r}: must be a finite number ({unit}), not a boolean or a string")
     return x
 
 

@@ -197,6 +197,37 @@ def _check_arc(scen, arc_s: float, source: str) -> None:
                          f"0 < arc <= {span:g} s (or --set run.duration=...)")
 
 
+def _check_rows(scen, fields, arc_s: float, tdm) -> None:
+    """Every measurement row against the run, before any propagation: its satellite is one of the
+    scenario's, its epoch t [s] lies in [0, arc] (the header's ``tqdyn arc_s``, at most the run's
+    span) and on the run's step grid (``integrator.step``).  One line naming the file's line."""
+    from ..od.variational import off_grid
+
+    t, sat, line = fields["t"], fields["sat"], fields["line"]
+    n_sat, span, step = len(scen.satellites), float(scen.run.duration_s), float(scen.integrator.step_s)
+    end = min(arc_s, span)
+
+    def first(mask):
+        i = np.flatnonzero(mask)
+        return int(i[np.argmin(line[i])]) if i.size else None
+
+    i = first(sat >= n_sat)
+    if i is not None:
+        raise ValueError(f"{tdm}, line {line[i]}: tqdyn sat = {sat[i]}; allowed: 0..{n_sat - 1} (the scenario's "
+                         f"{n_sat} satellites)")
+    i = first(~((t >= 0) & (t <= end + 1e-9 * max(1.0, end))))
+    if i is not None:
+        what = (f"the arc 0..{end:g} s (header tqdyn arc_s; the run spans {span:g} s)" if arc_s <= span
+                else f"the run, 0..{span:g} s")
+        raise ValueError(f"{tdm}, line {line[i]}: epoch at t = {t[i]:.12g} s (from the scenario epoch) is outside "
+                         f"{what}; allowed: epochs in it")
+    i = first(off_grid(t, step))
+    if i is not None:
+        d = t[i] - round(t[i] / step) * step
+        raise ValueError(f"{tdm}, line {line[i]}: epoch at t = {t[i]:.12g} s (from the scenario epoch) is {d:+.3g} s "
+                         f"off the step grid (integrator.step = {step:g} s); allowed: multiples of {step:g} s")
+
+
 def _scenario(scenario, overrides):
     """(scenario, notes, label) of a name, TOML path or run file (as ``tqdyn run``)."""
     scen, notes = load_run_scenario(scenario, list(overrides))
@@ -389,13 +420,15 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
                 raise ValueError(f"--figure: {str(figure)!r} is the input {label}; allowed: another file")
     scen, notes, label = _scenario(scenario, overrides)
     say("reading")
-    fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale)
+    fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale,
+                                         with_lines=True)
     kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
         tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
     parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
     sp3_paths = _sp3_paths(sp3, kinds)
     sp3_record = _check_sp3_against(info, sp3_paths, tdm)
     arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
+    _check_rows(scen, fields, arc_s, tdm)
     _check_arc(scen, arc_s, label)
     interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,

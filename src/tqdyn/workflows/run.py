@@ -13,6 +13,8 @@ another run) raises ``ValueError`` /
 Any exception during the propagation (including ``KeyboardInterrupt``) is
 re-raised after clean-up; its attribute ``tqdyn_checkpoint`` is the
 checkpoint path if the run can be resumed (``--resume``), else None.  A
+state that stops being finite (:class:`tqdyn.dynamics.NonFiniteStateError`) leaves no file and no
+checkpoint (resuming would meet it again).  A
 failed write (disk full, file-size limit) is an
 :class:`tqdyn.formats.trajectory.OutputIOError`; the last checkpoint (if
 any) and its partial trajectory stay valid for ``--resume``.
@@ -335,7 +337,10 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         rows = writer.rows_written
         writer.close()
     except BaseException as exc:
-        # keep the partial trajectory while a checkpoint refers to it; else discard it
+        # keep the partial trajectory while a checkpoint refers to it; else discard it.  A state that is
+        # not finite would come back on resuming: nothing is kept (no file, no checkpoint).
+        if isinstance(exc, dynamics.NonFiniteStateError):
+            ckpt.unlink(missing_ok=True)
         resumable = ckpt.exists()
         writer.keep_partial() if resumable else writer.abort()
         try:
