@@ -260,6 +260,11 @@ def test_checkpoint_resume_bit_identical(tmp_path, capsys, monkeypatch, extra):
     status, _, err = _run(args + ["-o", str(ref)], capsys)
     assert status == 0, err
     assert not (tmp_path / "ref.h5.checkpoint").exists()
+    if extra:
+        # the free TMs stay at their EH centres (full model, global pointing, 1 day): measured 2.4e-16 m, bounds
+        # ~5x either side (tests/test_coupled.py::test_free_tms_ten_days_full_model, slow: 2.0e-15 m in 10 days)
+        off = np.linalg.norm(io.read_trajectory(ref)["tm/housing_offset"], axis=-1).max()
+        assert 5e-17 < off < 1e-15, off
 
     out = tmp_path / "run.h5"
     # Ctrl-C after the third chunk of rows, i.e. after the checkpoints at steps 500 and 1000
