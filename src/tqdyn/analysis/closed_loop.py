@@ -27,9 +27,10 @@ from ..closedloop.loop import OUTPUTS, SOURCES, output_names
 from ..closedloop.missions import requirement
 from ..closedloop.model import ClosedLoopError, ClosedLoopModel, closed_loop_model
 from ..closedloop.simulate import MemorySink, Sink, simulate
+from ..scenario.closed_loop import DEFAULT_SERIES_S
 
 __all__ = ["ClosedLoopError", "ClosedLoopModel", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
-           "BANDS", "MARGIN_GRID"]
+           "BANDS", "MARGIN_GRID", "default_series_s"]
 
 #: Bands [Hz] of the dominant-source summary.
 BANDS = ((1e-4, 1e-3), (1e-3, 1e-2), (1e-2, 1e-1), (1e-1, 1.0))
@@ -133,15 +134,22 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, 
     return ds
 
 
+def default_series_s(model: ClosedLoopModel) -> float:
+    """The time series' length [s] when none is asked for: the run's first day
+    (:data:`tqdyn.scenario.closed_loop.DEFAULT_SERIES_S`), its span if shorter."""
+    span = model.t_span[1] - model.t_span[0]
+    return min(DEFAULT_SERIES_S, span) if span > 0 else DEFAULT_SERIES_S
+
+
 def closed_loop_timeseries(model: ClosedLoopModel, duration_s: float | None = None, fs: float | None = None,
                            seed: int | None = None, sink: Sink | None = None, block_size: int = 65536):
     """Seeded time series of every output (:func:`tqdyn.closedloop.simulate.simulate`) from the run's first
     time on.  With ``sink`` None: an ``xarray.Dataset`` ``values`` (time, sat, output) [output units];
     with a sink (e.g. a file writer): the sink, after ``close``.  ``duration_s`` [s] (default: the
-    settings' duration, else the run's span), ``fs`` [Hz] and ``seed`` override the settings."""
+    settings' duration, else :func:`default_series_s`), ``fs`` [Hz] and ``seed`` override the settings."""
     s = model.settings
     fs = float(fs if fs is not None else s["fs"])
-    dur = duration_s if duration_s is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
+    dur = duration_s if duration_s is not None else (s["duration"] or default_series_s(model))
     if not (isinstance(dur, (int, float)) and math.isfinite(dur) and dur > 0):
         raise ClosedLoopError(f"closed_loop.duration: {dur!r} is not a positive duration; allowed: > 0 s")
     n = int(round(float(dur) * fs))
