@@ -260,8 +260,9 @@ def grid_margins(L, f) -> dict:
     gm = np.exp(-(lmag[r, i] + t * (lmag[r, i + 1] - lmag[r, i])))
     with np.errstate(divide="ignore"):
         k = _first_min_per_row(r, np.abs(np.log(gm)), R)
-    out["gain_margin"] = np.where(k >= 0, gm[k], math.inf)
-    out["f_gain_margin"] = np.where(k >= 0, np.exp(x180[k]), math.nan)
+    gm_, x180_ = np.r_[gm, math.inf], np.r_[x180, math.nan]     # index -1: none
+    out["gain_margin"] = gm_[k]
+    out["f_gain_margin"] = np.exp(x180_[k])
     low = np.zeros(R)
     up = np.full(R, math.inf)
     np.maximum.at(low, r[gm < 1], gm[gm < 1])
@@ -275,6 +276,6 @@ def grid_margins(L, f) -> dict:
     dph = np.angle(L2[r, i + 1] / L2[r, i])                     # the phase step, unwrapped
     pm = np.remainder(np.degrees(ph0 + t * dph), 360.0) - 180.0
     k = _first_min_per_row(r, np.abs(pm), R)
-    out["phase_margin"] = np.where(k >= 0, pm[k], math.inf)
-    out["crossover"] = np.where(k >= 0, np.exp(xc[k]), math.nan)
+    out["phase_margin"] = np.r_[pm, math.inf][k]
+    out["crossover"] = np.exp(np.r_[xc, math.nan][k])
     return {key: v.reshape(shape) for key, v in out.items()}

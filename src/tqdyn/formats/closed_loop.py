@@ -104,8 +104,16 @@ def _put(group, name: str, value, dims=(), attrs=None):
         arr = text_array(arr)                      # fixed-length UTF-8 bytes, stored with the UTF-8 character set
     ch = _chunks(arr.shape, arr.dtype.itemsize)
     extra = {"compression": "gzip", "compression_opts": _GZIP_LEVEL, "shuffle": True} if ch is not None else {}
-    ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None,
-                              dtype=h5py.string_dtype("utf-8", arr.dtype.itemsize) if text else None, **extra)
+    if text:                                       # HDF5 converts no ASCII to UTF-8: the UTF-8 type in file and memory
+        tid = h5py.h5t.C_S1.copy()
+        tid.set_size(arr.dtype.itemsize)
+        tid.set_cset(h5py.h5t.CSET_UTF8)
+        ds = group.create_dataset(name, shape=arr.shape, dtype=h5py.Datatype(tid), chunks=ch,
+                                  fletcher32=ch is not None, **extra)
+        if arr.size:
+            ds.id.write(h5py.h5s.ALL, h5py.h5s.ALL, np.ascontiguousarray(arr), mtype=tid)
+    else:
+        ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None, **extra)
     ds.attrs["dims"] = ",".join(dims)
     ds.attrs["kind"] = "text" if arr.dtype.kind == "S" else "number"
     for k, v in (attrs or {}).items():
