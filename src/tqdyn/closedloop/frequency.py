@@ -53,7 +53,7 @@ class LoopStack:
     Sy (n, 17, 32), Sw (n, 17, 58); Ac, Ad (n, 32, 17), Aw (n, 32, 58); Oy, Ou (n, 46, 32).
     derivative : ((plant output j, coordinate k), ...): y_j = q_k''.
     controllers : per channel the realisation (A, B, C, D); zpk : per channel (zeros, poles, gain) [rad/s].
-    dc_force : per loop :attr:`tqdyn.closedloop.loop.ClosedLoop.dc_force`.
+    dc_force : per loop the ``dc_force`` of :class:`~tqdyn.closedloop.loop.ClosedLoop`.
     plant_names : (inputs, outputs, states) of the plant; channels : :func:`~tqdyn.closedloop.loop.channel_names`.
     """
 
