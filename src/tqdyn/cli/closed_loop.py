@@ -1,4 +1,5 @@
-"""Command line: ``tqdyn closed-loop RUN.h5 --output CL.h5 [--duration D] [--fs HZ] [--seed N] [--set ...]``.
+"""Command line: ``tqdyn closed-loop RUN.h5 --output CL.h5 [--duration D] [--fs HZ] [--seed N] [--set ...]
+[--per-source]``.
 
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.closed_loop`: the inputs are
 resolved and checked first (bad input: status 2, one line, nothing written), then the budget and the
@@ -46,14 +47,16 @@ class _Bars:
 @click.argument("run_file", metavar="RUN.h5")
 @click.option("--output", "-o", required=True, help="Output closed-loop HDF5 file (replaced only by a complete one).")
 @click.option("--duration", help="Length of the time series: seconds, or with a unit: 3d, 6h, 30min, 3600s "
-                                 "[default: closed_loop.duration, else the run's span].")
+                                 "[default: closed_loop.duration, else the run's first day (its span if shorter)].")
 @click.option("--fs", help="Sample rate of the time series [Hz; default: closed_loop.fs, docs/scenarios.md].")
 @click.option("--seed", type=int, help="Root seed of the noise realisations [default: closed_loop.seed].")
 @click.option("--set", "sets", multiple=True, metavar="closed_loop.KEY=VALUE",
               help="Override a closed-loop key of the run's scenario, e.g. --set closed_loop.n_freq=100 or "
                    "--set closed_loop.noise.thruster_force.level=1e-7 (repeatable; docs/scenarios.md).")
+@click.option("--per-source", is_flag=True, help="Also write the ASD of every output from every noise source "
+                                                "(/budget/asd; the totals and dominant sources are always written).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bars.")
-def closed_loop(run_file, output, duration, fs, seed, sets, quiet):
+def closed_loop(run_file, output, duration, fs, seed, sets, per_source, quiet):
     """The closed loop of the coupled run RUN.h5 (any mission): the drag-free, suspension, attitude
     and MOSA loops linearised around the run's working point (docs/closed-loop.md), their noise
     budget, margins and dominant sources, and seeded time series of every output per spacecraft,
@@ -64,7 +67,8 @@ def closed_loop(run_file, output, duration, fs, seed, sets, quiet):
     from ..workflows import closed_loop as wf
 
     try:
-        job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets)
+        job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets,
+                                          per_source=per_source)
     except (ValueError, FileNotFoundError, io.OutputError) as exc:
         _fail(" ".join(str(exc).split()))
     n = job.attrs["n_samples"]

@@ -19,9 +19,10 @@ import numpy as np
 
 from ..scenario.closed_loop import ATTITUDE_Z_SENSORS, SOURCES
 from .controllers import LOOPS, Controller
-from .plant import PlantParameters, WorkingPoint, linear_plant, sensitive_basis
+from .plant import PlantParameters, WorkingPoint, plant_matrices, sensitive_basis
 
-__all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "build_closed_loop", "output_names", "source_inputs"]
+__all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "build_closed_loop", "channel_names", "controller_realisations",
+           "loop_blocks", "output_names", "source_inputs"]
 
 _AX = ("x", "y", "z")
 
@@ -107,22 +108,34 @@ class ClosedLoop:
         return output_names(time_domain=True) if not self.outputs else list(self.outputs)
 
 
-def _controllers_ss(controllers: dict) -> list:
+def channel_names() -> list[str]:
+    """The controller channels ``<loop>[k]`` in :data:`LOOPS` order."""
+    return [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
+
+
+def controller_realisations(controllers: dict) -> list[tuple]:
+    """One state-space realisation (A, B, C, D) of each channel's controller (python-control's of the
+    controller's transfer function), in :func:`channel_names` order."""
     out = []
     for loop, (channels, *_rest) in LOOPS.items():
         ctl = controllers[loop]
         if not isinstance(ctl, Controller):
             raise TypeError(f"controllers[{loop!r}] is not a Controller")
         tf = control.ss(ctl.tf())
-        for k in range(len(channels)):
-            out.append(control.ss(tf.A, tf.B, tf.C, tf.D, inputs=[f"e_{loop}[{k}]"], outputs=[f"c_{loop}[{k}]"],
-                                  name=f"C_{loop}_{k}"))
+        out += [(np.asarray(tf.A), np.asarray(tf.B), np.asarray(tf.C), np.asarray(tf.D))] * len(channels)
     return out
 
 
-def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
-    """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static): ``basis`` (2, 3, 3)
-    of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3) Y_OA_l in S."""
+def _controllers_ss(controllers: dict) -> list:
+    chans = channel_names()
+    return [control.ss(*abcd, inputs=[f"e_{c}"], outputs=[f"c_{c}"], name=f"C_{c.replace('[', '_').rstrip(']')}")
+            for c, abcd in zip(chans, controller_realisations(controllers))]
+
+
+def _sensors(basis, yoa, attitude_z_sensor: str) -> tuple:
+    """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static): (D, input names,
+    output names); ``basis`` (2, 3, 3) of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3)
+    Y_OA_l in S."""
     sin = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
            + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
            + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
@@ -178,12 +191,12 @@ def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
         for i in range(3):
             row({f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
             names.append(f"e_tm_rotation[{3 * (l - 1) + i}]")
-    return _static(np.array(rows), sin, names, "sensors")
+    return np.array(rows), sin, names
 
 
-def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple[control.StateSpace, dict]:
-    """Controller outputs ``c`` + loop breaks ``d`` + actuation noise -> the plant inputs (static), and the
-    DC levels of the force-proportional sources (:attr:`ClosedLoop.dc_force`).  ``e_S`` (2, 3) the
+def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple[tuple, dict]:
+    """Controller outputs ``c`` + loop breaks ``d`` + actuation noise -> the plant inputs (static: D, input
+    names, output names), and the DC levels of the force-proportional sources (:attr:`ClosedLoop.dc_force`).  ``e_S`` (2, 3) the
     sensitive axes in S; ``chans`` the controller channels ``<loop>[k]``."""
     m, Itm, Im, Msc = p.tm_mass, p.tm_inertia, p.mosa_inertia, p.sc_mass
     J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
@@ -237,11 +250,12 @@ def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple
             Da[ao[f"b{l}[{i}]"], ai[f"tm_torque[{k}]"]] = 1.0
     for l in range(2):
         Da[ao[f"tm[{l}]"], ai[f"mosa_actuator[{l}]"]] = 1.0
-    return _static(Da, ain, aout, "actuators"), dc
+    return (Da, ain, aout), dc
 
 
-def _observables(p: PlantParameters, basis) -> control.StateSpace:
-    """The named outputs (:data:`OUTPUTS`) from the plant outputs and the actuator signals (static)."""
+def _observables(p: PlantParameters, basis) -> tuple:
+    """The named outputs (:data:`OUTPUTS`) from the plant outputs and the actuator signals (static: D,
+    input names, output names)."""
     oin = ([f"u[{i}]" for i in range(3)] + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
            + [f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
            + [f"acc{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"xdd{l}[{i}]" for l in (1, 2) for i in range(3)]
@@ -275,7 +289,31 @@ def _observables(p: PlantParameters, basis) -> control.StateSpace:
             put(f"tm{l}_rotation_{a}", {f"eta{l}[{i}]": 1.0})
             put(f"tm{l}_es_force_{a}", {f"f{l}[{j}]": X[i, j] for j in range(3)})
             put(f"tm{l}_es_torque_{a}", {f"t{l}[{j}]": X[i, j] for j in range(3)})
-    return _static(Do, oin, onames, "observables")
+    return Do, oin, onames
+
+
+def _check_sensor(attitude_z_sensor: str) -> None:
+    if attitude_z_sensor not in ATTITUDE_Z_SENSORS:
+        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
+                         f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
+
+
+def loop_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0]) -> dict:
+    """The blocks of the closed loop of a spacecraft with parameters ``p`` at working point ``wp`` as plain
+    matrices with their signal names (what :func:`build_closed_loop` joins): ``plant`` (A, B, C, D, inputs,
+    outputs, states) of :func:`~tqdyn.closedloop.plant.plant_matrices`; ``sensors``, ``actuators`` and
+    ``observables`` (D, inputs, outputs) of the static blocks; ``dc_force`` (:attr:`ClosedLoop.dc_force`);
+    ``channels`` (:func:`channel_names`)."""
+    _check_sensor(attitude_z_sensor)
+    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
+    from ..constellation.control import oa_rotation
+    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
+    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
+    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
+    chans = channel_names()
+    actuators, dc = _actuators(p, wp, basis, e_S, chans)
+    return {"plant": plant_matrices(p, wp), "sensors": _sensors(basis, yoa, attitude_z_sensor),
+            "actuators": actuators, "observables": _observables(p, basis), "dc_force": dc, "channels": chans}
 
 
 def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
@@ -283,24 +321,19 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
     """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
     with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
     ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
-    "star_tracker" (as LISA Pathfinder, which had no DWS).  The blocks are joined by signal name with
-    python-control's check of unused signals on (a misnamed signal would leave one unconnected)."""
-    if attitude_z_sensor not in ATTITUDE_Z_SENSORS:
-        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
-                         f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
-    P = linear_plant(p, wp)
-    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
-    from ..constellation.control import oa_rotation
-    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
-    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
-    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
-    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
-    actuators, dc = _actuators(p, wp, basis, e_S, chans)
+    "star_tracker" (as LISA Pathfinder, which had no DWS).  The blocks (:func:`loop_blocks`) are joined
+    by signal name with python-control's check of unused signals on (a misnamed signal would leave one
+    unconnected).  :func:`tqdyn.closedloop.frequency.closed_loops` builds the same loops for many working
+    points at once."""
+    b = loop_blocks(p, wp, attitude_z_sensor)
+    A, B, C, D, pin, pout, pst = b["plant"]
+    P = control.ss(A, B, C, D, inputs=pin, outputs=pout, states=pst, name="plant")
+    chans = b["channels"]
     noise = [s for src in SOURCES for s in source_inputs(src)]
     inplist = noise + [f"d_{c}" for c in chans]
     outlist = output_names() + [f"c_{c}" for c in chans]
-    syslist = ([P, _sensors(basis, yoa, attitude_z_sensor), actuators, _observables(p, basis)]
-               + _controllers_ss(controllers))
+    syslist = ([P, _static(*b["sensors"], "sensors"), _static(*b["actuators"], "actuators"),
+                _static(*b["observables"], "observables")] + _controllers_ss(controllers))
     cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
                               name="closed_loop", warn_duplicate=False)
-    return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=dc)
+    return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=b["dc_force"])

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .budget import check_stable
-from .loop import build_closed_loop
+from .frequency import closed_loop_matrices, closed_loops, stack_loops, unstable_loops
 from .missions import resolve
 from .plant import plant_parameters
 from .working_point import segment_rows, third_body_positions, working_points
@@ -45,7 +45,9 @@ class ClosedLoopModel:
     segment [s], f_min, f_max [Hz], n_freq, attitude_z_sensor); satellite_names : tuple; t_span : (t0, t1) [s].
     parts : list over satellites of lists (one per segment, as ``loops``) of (PlantParameters,
     WorkingPoint) the loops were built from; controllers : {loop: Controller} (to rebuild a loop with
-    changed parameters, e.g. without cross-talk).
+    changed parameters, e.g. without cross-talk); stack : the loops' blocks
+    (:class:`tqdyn.closedloop.frequency.LoopStack`, satellite-major: loop ``loops[i][k]`` is entry
+    i n_segment + k) for the frequency domain, or None.
     """
 
     loops: list
@@ -56,6 +58,7 @@ class ClosedLoopModel:
     t_span: tuple
     parts: list = field(default_factory=list)
     controllers: dict = field(default_factory=dict)
+    stack: object = None
 
 
 def _where(traj) -> str:
@@ -108,23 +111,25 @@ def _craft(sc):
 
 
 def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_sensor: str, validate: bool):
-    """(loops, parts) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments ``rows``."""
-    n_sat = len(wps[0])
-    loops = [[] for _ in range(n_sat)]
+    """(loops, parts, stack) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments
+    ``rows``: every loop built at once (:mod:`tqdyn.closedloop.frequency`), the unstable ones refused."""
+    n_sat, n_seg = len(wps[0]), len(rows)
     parts = [[] for _ in range(n_sat)]
-    for k, (a, _b, _m) in enumerate(rows):
+    for k in range(n_seg):
         for i in range(n_sat):
             wp = wps[k][i]
-            p = plant_parameters(plant, craft, wp.theta)
-            try:
-                cl = build_closed_loop(p, wp, controllers, attitude_z_sensor)
-            except ValueError as exc:
-                raise ClosedLoopError(str(exc)) from None
-            if validate:
-                check_stable(cl)
-            loops[i].append((float(t[a]), cl))
-            parts[i].append((p, wp))
-    return loops, parts
+            parts[i].append((plant_parameters(plant, craft, wp.theta), wp))
+    try:
+        st = stack_loops([pw for per_sat in parts for pw in per_sat], controllers, attitude_z_sensor)
+    except ValueError as exc:
+        raise ClosedLoopError(str(exc)) from None
+    mats = closed_loop_matrices(st)
+    cls = closed_loops(st, mats)
+    if validate:
+        for j in unstable_loops(mats[0], cls[0].system.state_labels):
+            check_stable(cls[j])                   # DesignError naming the loop and its margins
+    loops = [[(float(t[rows[k][0]]), cls[i * n_seg + k]) for k in range(n_seg)] for i in range(n_sat)]
+    return loops, parts, st
 
 
 def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopModel:
@@ -156,8 +161,9 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
     wps = working_points(t[mids], traj["sat/r"][mids], traj["sat/T_S_I"][mids], traj["sat/omega"][mids],
                          traj["sat/omega_dot"][mids], traj["mosa/angle"][mids], traj["tm/a_suspension"][mids],
                          traj["tm/alpha_suspension"][mids], traj["sat/a_dragfree"][mids], sg, central_gm, pos, gms)
-    loops, parts = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl, settings["attitude_z_sensor"], validate)
+    loops, parts, stack = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl, settings["attitude_z_sensor"],
+                                 validate)
     names = tuple(getattr(traj, "satellite_names", ())) or tuple(f"Sat{i + 1}" for i in range(len(loops)))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,
                            satellite_names=names, t_span=(float(t[0]), float(t[-1])), parts=parts,
-                           controllers=dict(ctl))
+                           controllers=dict(ctl), stack=stack)

@@ -33,7 +33,8 @@ import numpy as np
 
 from ..constellation.control import oa_rotation
 
-__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "plant_parameters", "sensitive_basis"]
+__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "plant_matrices", "plant_parameters",
+           "sensitive_basis"]
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -294,6 +295,14 @@ class _Equations:
 
 def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> control.StateSpace:
     """The linearised plant (module docstring) as a named python-control StateSpace (continuous)."""
+    A, Bs, C, D, inputs, outs, states = plant_matrices(p, wp)
+    return control.ss(A, Bs, C, D, inputs=inputs, outputs=outs, states=states, name=name)
+
+
+def plant_matrices(p: PlantParameters, wp: WorkingPoint) -> tuple:
+    """The linearised plant's (A (40, 40), B (40, 32), C (32, 40), D (32, 32), input names, output names,
+    state names) of :func:`linear_plant`: A = [[0, I], [-M^-1 K, -M^-1 D]], B = [[0], [M^-1 B_q]] (the
+    states [q, q'], SI)."""
     eq = _Equations(p, wp)
     eq.spacecraft()
     for l in range(2):
@@ -307,4 +316,4 @@ def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> c
     Bs = np.vstack([np.zeros((n, eq.B.shape[1])), Minv @ eq.B])
     C, Dm, outs = eq.outputs(A, Bs)
     states = dof_names() + [f"d{s}" for s in dof_names()]
-    return control.ss(A, Bs, np.vstack(C), np.vstack(Dm), inputs=eq.inputs, outputs=outs, states=states, name=name)
+    return A, Bs, np.vstack(C), np.vstack(Dm), list(eq.inputs), outs, states

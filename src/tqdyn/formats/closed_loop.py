@@ -16,7 +16,8 @@ Every dataset is chunked and carries a Fletcher-32 checksum.  Writing is atomic:
 :class:`ClosedLoopWriter` writes to a hidden temporary file beside the output and renames it into
 place on :meth:`~ClosedLoopWriter.close`; a failure or an interrupt (with-block, :meth:`abort`)
 removes the temporary file and leaves the output path as it was.  Strings are stored as fixed-length
-UTF-8 bytes.  Units SI.
+UTF-8 strings (HDF5 character set UTF-8); the budget's datasets are compressed (byte shuffle + gzip).  Version 1
+files (ASCII strings, ``gain_margin`` python-control's choice) are read into version 2's layout.  Units SI.
 """
 
 from __future__ import annotations
@@ -41,8 +42,8 @@ __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError"
 
 FORMAT = "tqdyn-closed-loop"
 """Value of the root attribute ``format``."""
-FORMAT_VERSION = 1
-"""Format version written; readers accept any version <= this."""
+FORMAT_VERSION = 2
+"""Format version written; readers accept any version <= this (docs/closed-loop-file.md#older-versions)."""
 
 #: Root attributes and their meaning (docs/closed-loop-file.md).
 ROOT_ATTRS = {
@@ -76,16 +77,43 @@ class ClosedLoopFormatError(ValueError):
     """A file that is not a readable closed-loop file: one line naming the file and what was found."""
 
 
-def _chunks(shape) -> tuple | None:
-    return tuple(max(1, min(int(n), 65536)) for n in shape) if all(int(n) > 0 for n in shape) and shape else None
+#: Largest chunk of a budget dataset [bytes] (the leading axes, e.g. the segments, are split first).
+_BUDGET_CHUNK_BYTES = 1 << 21
+#: Compression of the budget's datasets (h5py: byte shuffle, then gzip at this level).
+_GZIP_LEVEL = 4
+
+
+def _chunks(shape, itemsize: int = 8) -> tuple | None:
+    """Chunks of at most :data:`_BUDGET_CHUNK_BYTES` (and 65,536 per axis): whole trailing axes, the leading
+    ones cut first."""
+    if not shape or not all(int(n) > 0 for n in shape):
+        return None
+    ch = [max(1, min(int(n), 65536)) for n in shape]
+    for k in range(len(ch)):
+        rest = itemsize * int(np.prod(ch[k + 1:], dtype=np.int64))
+        if rest * ch[k] <= _BUDGET_CHUNK_BYTES:
+            break
+        ch[k] = max(1, _BUDGET_CHUNK_BYTES // max(1, rest))
+    return tuple(ch)
 
 
 def _put(group, name: str, value, dims=(), attrs=None):
     arr = np.asarray(value)
-    if arr.dtype.kind in "USO":
-        arr = text_array(arr)
-    ch = _chunks(arr.shape)
-    ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None)
+    text = arr.dtype.kind in "USO"
+    if text:
+        arr = text_array(arr)                      # fixed-length UTF-8 bytes, stored with the UTF-8 character set
+    ch = _chunks(arr.shape, arr.dtype.itemsize)
+    extra = {"compression": "gzip", "compression_opts": _GZIP_LEVEL, "shuffle": True} if ch is not None else {}
+    if text:                                       # HDF5 converts no ASCII to UTF-8: the UTF-8 type in file and memory
+        tid = h5py.h5t.C_S1.copy()
+        tid.set_size(arr.dtype.itemsize)
+        tid.set_cset(h5py.h5t.CSET_UTF8)
+        ds = group.create_dataset(name, shape=arr.shape, dtype=h5py.Datatype(tid), chunks=ch,
+                                  fletcher32=ch is not None, **extra)
+        if arr.size:
+            ds.id.write(h5py.h5s.ALL, h5py.h5s.ALL, np.ascontiguousarray(arr), mtype=tid)
+    else:
+        ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None, **extra)
     ds.attrs["dims"] = ",".join(dims)
     ds.attrs["kind"] = "text" if arr.dtype.kind == "S" else "number"
     for k, v in (attrs or {}).items():
@@ -303,7 +331,26 @@ class ClosedLoopFile:
                                  "time_unit": "s on the run's time axis since the epoch"})
 
 
-def _read_budget(h5, fname: str):
+def _upgrade_v1(data: dict) -> None:
+    """A version-1 budget in version 2's layout: version 1's ``gain_margin`` is python-control's choice (the
+    margin closest to 1 in dB, the upper one when a loop has both); ``gain_margin_lower`` and
+    ``gain_margin_upper`` are what it tells (inf: no phase crossover, so none of either; NaN: not recorded) and
+    ``gain_margin`` becomes the lower one."""
+    import xarray as xr
+
+    gm = data.get("gain_margin")
+    if gm is None or "gain_margin_lower" in data:
+        return
+    v = np.asarray(gm.values, dtype=np.float64)
+    lower = np.where(np.isinf(v), 0.0, np.where(v < 1, v, np.nan))
+    upper = np.where(np.isinf(v), np.inf, np.where(v > 1, v, np.nan))
+    attrs = dict(gm.attrs, units="1")
+    data["gain_margin"] = xr.Variable(gm.dims, lower, attrs=attrs)
+    data["gain_margin_lower"] = xr.Variable(gm.dims, lower, attrs=attrs)
+    data["gain_margin_upper"] = xr.Variable(gm.dims, upper, attrs=attrs)
+
+
+def _read_budget(h5, fname: str, version: int = FORMAT_VERSION):
     import xarray as xr
 
     g = h5["budget"]
@@ -316,6 +363,8 @@ def _read_budget(h5, fname: str):
         attrs = {k: native_attr(v) for k, v in ds.attrs.items() if k not in ("dims", "kind", "role")}
         var = xr.Variable(dims, _values(ds, fname), attrs=attrs)
         (coords if native_attr(ds.attrs.get("role")) == "coord" else data)[name] = var
+    if version < 2:
+        _upgrade_v1(data)
     return xr.Dataset(data, coords=coords, attrs={k: native_attr(v) for k, v in g.attrs.items()
                                                   if k not in ("variables", "coordinates")})
 
@@ -344,7 +393,7 @@ def read_closed_loop(path) -> ClosedLoopFile:
             if "budget" not in h5 or "timeseries" not in h5:
                 raise ClosedLoopFormatError(f"{fname}: the group '/budget' or '/timeseries' is missing; re-create "
                                             "it (tqdyn closed-loop)")
-            budget = _read_budget(h5, fname)
+            budget = _read_budget(h5, fname, ver)
     except DAMAGED as exc:
         raise ClosedLoopFormatError(damaged_message(fname, exc, "tqdyn closed-loop")) from None
     return ClosedLoopFile(p, attrs, budget)

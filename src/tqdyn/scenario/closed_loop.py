@@ -8,7 +8,7 @@ run's ``spacecraft.architecture``, and the settings' defaults of :data:`CLOSED_L
     [closed_loop]
     mission                       # "tianqin" | "lisa" | "taiji"
     fs                            # Hz, time-domain sample rate
-    duration                      # time-domain length ("3d" or s; default: the run's span)
+    duration                      # time-domain length ("3d" or s; default: the first day, or the run's span)
     seed                          # root seed of the noise realisations
     segment                       # frozen-coefficient segment length ("1d" or s)
     f_min, f_max, n_freq          # the budget's log frequency grid [Hz]
@@ -37,7 +37,7 @@ from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _one_of, _require
 
-__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "LOOPS", "MISSIONS", "PLANT_KEYS", "SOURCES",
+__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "DEFAULT_SERIES_S", "LOOPS", "MISSIONS", "PLANT_KEYS", "SOURCES",
            "ClosedLoopConfig", "check_asd", "check_controller"]
 
 #: Missions with a default closed-loop design (tqdyn.closedloop.missions).
@@ -76,8 +76,10 @@ SOURCES = {
 #: the star tracker (as LISA Pathfinder, which had no DWS).
 ATTITUDE_Z_SENSORS = ("dws", "star_tracker")
 
+#: Length [s] of the time series when ``duration`` is not given: the run's first day (its span if shorter).
+DEFAULT_SERIES_S = 86400.0
 #: Top-level keys of [closed_loop]: name -> (kind, default).  Defaults: ``mission`` None = the spacecraft
-#: architecture; ``fs`` [Hz]; ``duration`` [s] None = the run's span; ``segment`` [s]; ``f_min``, ``f_max``
+#: architecture; ``fs`` [Hz]; ``duration`` [s] None = :data:`DEFAULT_SERIES_S` or the run's span if shorter; ``segment`` [s]; ``f_min``, ``f_max``
 #: [Hz] and ``n_freq`` the budget's log grid; ``attitude_z_sensor`` one of :data:`ATTITUDE_Z_SENSORS`.
 CLOSED_LOOP_KEYS = {"mission": ("string", None), "fs": ("number", 4.0), "duration": ("duration", None),
                     "seed": ("integer", 0), "segment": ("duration", 86400.0), "f_min": ("number", 1e-5),

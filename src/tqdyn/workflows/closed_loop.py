@@ -34,6 +34,7 @@ class ClosedLoopJob:
     fs: float
     seed: int
     attrs: dict
+    per_source: bool = False
 
 
 @dataclass(frozen=True)
@@ -83,12 +84,15 @@ def file_sha256(path) -> str:
     return h.hexdigest()
 
 
-def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=()) -> ClosedLoopJob:
+def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=(),
+                             per_source: bool = False) -> ClosedLoopJob:
     """Resolve a ``tqdyn closed-loop`` job; raise (one line) FileNotFoundError, ValueError
     (TrajectoryFormatError, ScenarioError, ClosedLoopError, DesignError: a bad option, a run without
     test masses or a pure-gravity run, an unknown loop or source, a bad ASD, an unstable design naming
     the loop and its margin) or OutputError (the output path) before anything is written.
-    ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``."""
+    ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``; ``per_source``: also write
+    the ASD of every output from every source (``/budget/asd``, n_segment x n_sat x 46 x n_source x n_freq)."""
+    from ..analysis.closed_loop import default_series_s
     from ..closedloop.model import closed_loop_model
     from ..scenario import loads_scenario
     from ..scenario.loader import parse_duration
@@ -111,7 +115,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     scen = loads_scenario(traj.scenario_toml, list(overrides), source=f"{src} (attribute scenario) and --set")
     model = closed_loop_model(traj, scen.closed_loop, validate=True)
     s = model.settings
-    dur = dur if dur is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
+    dur = dur if dur is not None else (s["duration"] or default_series_s(model))
     rate = rate if rate is not None else s["fs"]
     seed = seed if seed is not None else s["seed"]
     n = int(round(float(dur) * rate))
@@ -130,7 +134,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
              "seed": int(seed), "fs": float(rate), "duration_s": n / rate, "n_samples": n,
              "t0": float(model.t_span[0]), "satellite_names": json.dumps(list(model.satellite_names))}
     return ClosedLoopJob(traj=traj, model=model, output=out, duration_s=n / rate, fs=float(rate), seed=int(seed),
-                         attrs=attrs)
+                         attrs=attrs, per_source=bool(per_source))
 
 
 class _Counting:
@@ -154,7 +158,8 @@ class _Counting:
 def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 65536, budget=None,
                         wrap=None, budget_progress=None) -> ClosedLoopSummary:
     """Write the closed-loop file of ``job`` (:func:`check_closed_loop_inputs`): the budget
-    (:func:`~tqdyn.analysis.closed_loop.closed_loop_budget`, or ``budget`` if given), then the time
+    (:func:`~tqdyn.analysis.closed_loop.closed_loop_budget`, per source when the job asks; or ``budget`` if
+    given), then the time
     series streamed block by block (``progress(n)`` after each block of n samples; ``budget_progress(1)``
     after each of the budget's segment x spacecraft loops).  ``wrap``: a
     function of the writer returning the sink the simulation writes to (tests inject failures).
@@ -163,7 +168,8 @@ def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 655
     from ..closedloop.loop import OUTPUTS
 
     t0 = time.perf_counter()
-    ds = closed_loop_budget(job.model, progress=budget_progress) if budget is None else budget
+    ds = closed_loop_budget(job.model, progress=budget_progress, per_source=job.per_source) if budget is None \
+        else budget
     t1 = time.perf_counter()
     try:
         with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
