@@ -115,7 +115,7 @@ def test_output_may_not_be_the_run_and_an_existing_output_is_replaced_only_when_
                                                                                          capsys):
     """As tqdyn run: the output replaces an existing file on success (atomically), never the input."""
     status, _o, err = run_cli(["closed-loop", str(runs / "tq.h5"), "--output", str(runs / "tq.h5")], capsys)
-    assert status == 2 and "the run file itself" in err and err.count("\n") == 1
+    assert status == 2 and "is the input RUN.h5" in err and err.count("\n") == 1
     out = tmp_path / "cl.h5"
     out.write_bytes(b"old")
     status, stdout, err = run_cli(["closed-loop", str(runs / "tq.h5"), "-o", str(out), "--seed", "5", "--per-source",

@@ -147,19 +147,14 @@ def _open_temporary(path: Path) -> tuple[int, Path]:
 
 
 def _savefig_atomic(fig, path: Path, fmt: str, **kwargs) -> None:
-    """``fig.savefig`` to a temporary file next to ``path``, then rename it over ``path``;
-    on any failure the temporary file is removed and ``path`` left as it was."""
-    fd, tmp = _open_temporary(path)
-    os.close(fd)
-    try:
+    """``fig.savefig`` to a temporary file next to ``path``, then rename it over ``path``
+    (:func:`tqdyn.formats.atomic.replacing`); on any failure the temporary file is removed and
+    ``path`` left as it was; a failed write (a full disk) raises
+    :class:`tqdyn.formats.trajectory.OutputIOError` (one line)."""
+    from ..formats.atomic import replacing
+
+    with replacing(Path(path), "the figure") as tmp:
         fig.savefig(tmp, format=fmt, **kwargs)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def _save(fig, out_dir: Path, stem: str) -> list[Path]:

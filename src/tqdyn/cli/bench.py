@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from ._common import fail as _fail
+from ._common import fail as _fail, guarded
 
 __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
@@ -125,19 +125,28 @@ def bench(duration, step, no_heyoka, which, json_path):
     runners["startup"] = lambda: (_mission.startup_benchmark(duration), _mission.format_startup_report)
     for name in _mission.MISSION_RUNS:
         runners[name] = lambda name=name: (_mission.mission_benchmark(name, duration), _mission.format_mission_report)
+    done: list[str] = []
+
+    def note(exc) -> str:
+        if path is None:
+            return "no output file written"
+        return (f"the record {path} holds the models that finished ({', '.join(done)})" if done else
+                f"the record {path} is as it was")
+
     for model in models:
         prov = _numbers.provenance("tqdyn bench", command(model))
-        try:
-            result, fmt = runners[model]()
-        except (ScenarioError, ValueError) as exc:
-            _fail(str(exc))
-        except RuntimeError as exc:
-            _fail(str(exc), 1)
-        click.echo(fmt(result))
-        if path is not None:
-            entry = {**prov, "model": model, "result": result}
-            entry.pop("written_by")
-            _numbers.merge_section(path, "models", {model: entry},
-                                   {"written_by": "tqdyn bench",
-                                    "description": "results of tqdyn bench --json, one entry per model, each with "
-                                                   "the command, date, machine and library versions of its run"})
+        with guarded(note, bad_input=(ScenarioError, ValueError)):
+            try:
+                result, fmt = runners[model]()
+            except RuntimeError as exc:
+                _fail(str(exc), 1)
+            click.echo(fmt(result))
+            if path is not None:
+                entry = {**prov, "model": model, "result": result}
+                entry.pop("written_by")
+                _numbers.merge_section(path, "models", {model: entry},
+                                       {"written_by": "tqdyn bench",
+                                        "description": "results of tqdyn bench --json, one entry per model, each "
+                                                       "with the command, date, machine and library versions of its "
+                                                       "run"})
+        done.append(model)

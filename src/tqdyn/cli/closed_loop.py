@@ -4,9 +4,9 @@
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.closed_loop`: the inputs are
 resolved and checked first (bad input: status 2, one line, nothing written), then the budget and the
 time series are written to the closed-loop file (docs/closed-loop-file.md) with progress bars (the
-budget's loops, then the samples); a failed write exits with status 3, Ctrl-C with 130, and neither
-leaves a file at the output path (an existing file there is replaced only by a complete one, as
-``tqdyn run`` does).
+budget's loops, then the samples); a failed write exits with status 3, Ctrl-C with 130, SIGTERM with
+143 (:func:`._common.guarded`), and none leaves a file at the output path (an existing file there is
+replaced only by a complete one, as ``tqdyn run`` does).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import sys
 
 import click
 
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, fail as _fail
+from ._common import guarded
 
 __all__ = ["closed_loop"]
 
@@ -66,11 +66,9 @@ def closed_loop(run_file, output, duration, fs, seed, sets, per_source, quiet):
     from ..formats import trajectory as io
     from ..workflows import closed_loop as wf
 
-    try:
+    with guarded(bad_input=(ValueError, FileNotFoundError, io.OutputError)):
         job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets,
                                           per_source=per_source)
-    except (ValueError, FileNotFoundError, io.OutputError) as exc:
-        _fail(" ".join(str(exc).split()))
     n = job.attrs["n_samples"]
     click.echo(f"tqdyn closed-loop: {job.attrs['source_file']}, mission {job.model.mission}, "
                f"{len(job.model.loops)} spacecraft x {len(job.model.loops[0])} segment(s); time series "
@@ -79,17 +77,8 @@ def closed_loop(run_file, output, duration, fs, seed, sets, per_source, quiet):
     bars = _Bars(lambda total, unit, desc: tqdm(total=total, disable=True if quiet else None, unit=unit,
                                                 unit_scale=unit == "sample", file=sys.stderr, dynamic_ncols=True,
                                                 desc=desc), n_loops, n)
-    try:
+    with guarded(bad_input=(ValueError, io.OutputError), cleanup=bars.close):
         summary = wf.closed_loop_to_file(job, progress=bars.samples, budget_progress=bars.loops)
-    except io.OutputIOError as exc:
-        bars.close()
-        _fail(f"{exc}; no output file written", _EXIT_IO)
-    except (ValueError, io.OutputError) as exc:
-        bars.close()
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        bars.close()
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     bars.close()
     click.echo(f"budget: {summary.budget_s:.2f} s; time series: {summary.n_samples} samples x {summary.n_sat} "
                f"spacecraft in {summary.timeseries_s:.2f} s")

@@ -6,8 +6,9 @@ A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
 It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`,
 :func:`tqdyn.workflows.export_oem.export_oem`, :func:`tqdyn.workflows.export_ttl.export_ttl`,
 :func:`tqdyn.workflows.export_injection.export_lisa_injection`).  As
-everywhere in the CLI, bad input exits with status 2 and one line
-``tqdyn: error: ...`` on stderr, and no output file is left behind.
+everywhere in the CLI, bad input (an output that is one of the inputs among it) exits with status 2
+and one line ``tqdyn: error: ...`` on stderr, a failed write with 3, Ctrl-C / SIGTERM with 130 / 143
+(:func:`._common.guarded`), and no output file is left behind.
 
 Formats are registered in :data:`_EXPORTERS` (name -> function(run_file,
 out_file, options) returning the lines to print); a new format adds one
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 import click
 
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from ._common import fail as _fail, guarded
 
 __all__ = ["FORMATS", "export"]
 
@@ -200,10 +201,6 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficie
     opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin,
             "coefficients": coefficients, "seed": seed, "drift": drift, "step": step, "run": run,
             "tm_acceleration": tm_acceleration}
-    try:
+    with guarded(bad_input=(FileNotFoundError, ValueError, io.OutputError)):
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
-    except (FileNotFoundError, ValueError, io.OutputError) as exc:
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     click.echo("\n".join(lines))

@@ -34,7 +34,8 @@ import numpy as np
 from .._version import __version__ as _TQDYN_VERSION
 from ..closedloop.simulate import Block, Sink
 from .trajectory import OutputError, OutputIOError, check_writable
-from .trajectory._h5safe import _cleanup, _close_h5, _io_reason
+from .stop import check_stop
+from .trajectory._h5safe import _cleanup, _close_h5, _io_reason, _vfd
 from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError", "ClosedLoopWriter",
@@ -149,6 +150,7 @@ class ClosedLoopWriter(Sink):
         try:
             h5 = h5py.File(tmp, "w", rdcc_nbytes=_RDCC_NBYTES)
             self._state["h5"] = h5
+            self._state["fd"] = _vfd(h5)
             for k, v in {"format": FORMAT, "format_version": FORMAT_VERSION, "tqdyn_version": _TQDYN_VERSION,
                          **{k: v for k, v in attrs.items() if k not in ("format", "format_version")}}.items():
                 h5.attrs[k] = v
@@ -233,6 +235,7 @@ class ClosedLoopWriter(Sink):
             return self._path
         h5 = self._h5("close")
         try:
+            check_stop()  # a stop signal that arrived: no file is renamed into place
             if not self._meta or self._row != int(self._meta["n_samples"]) or not self._budget:
                 raise ValueError(f"close: the closed-loop file {str(self._path)!r} is incomplete ({self._row} of "
                                  f"{self._meta.get('n_samples', '?')} samples, budget "

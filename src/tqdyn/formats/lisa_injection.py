@@ -14,19 +14,18 @@ t0 + k dt per injection point and MOSA, named ``<point>_<ij>``:
 LISA Instrument interpolates each dataset by a degree-5 interpolating spline (exact at the samples) and
 takes it as zero outside [t0, t0 + (size - 1) dt].  Absent datasets are zero.  tqdyn adds its own root
 attributes (``generator``, ``tqdyn_version``, descriptions).  Written atomically
-(:func:`tqdyn.formats.atomic.replacing`).
+(:func:`tqdyn.formats.atomic.replacing_h5`).
 """
 
 from __future__ import annotations
 
 import math
 
-import h5py
 import numpy as np
 
 from .._version import __version__ as _TQDYN_VERSION
 from . import trajectory as _io
-from .atomic import replacing
+from .atomic import replacing_h5
 
 __all__ = ["GLITCH_FILE_VERSION", "POINTS", "write_lisa_injection"]
 
@@ -66,18 +65,17 @@ def write_lisa_injection(out_path, t0: float, dt: float, series: dict, attrs: di
         arrays[name] = a
     if size < 2:
         raise ValueError(f"series: {size} sample(s); need at least 2")
-    with replacing(out, "LISA injection file") as tmp:
-        with h5py.File(tmp, "w") as h5:
-            h5.attrs["version"] = GLITCH_FILE_VERSION
-            h5.attrs["size"] = int(size)
-            h5.attrs["dt"] = dt
-            h5.attrs["t0"] = t0
-            h5.attrs["tqdyn_version"] = _TQDYN_VERSION
-            for k, v in (attrs or {}).items():
-                h5.attrs[k] = v
-            for name, a in arrays.items():
-                ds = h5.create_dataset(name, data=a)
-                ds.attrs["units"] = POINTS[name.rpartition("_")[0]]
-                if descriptions and name in descriptions:
-                    ds.attrs["description"] = descriptions[name]
+    with replacing_h5(out, "LISA injection file") as h5:
+        h5.attrs["version"] = GLITCH_FILE_VERSION
+        h5.attrs["size"] = int(size)
+        h5.attrs["dt"] = dt
+        h5.attrs["t0"] = t0
+        h5.attrs["tqdyn_version"] = _TQDYN_VERSION
+        for k, v in (attrs or {}).items():
+            h5.attrs[k] = v
+        for name, a in arrays.items():
+            ds = h5.create_dataset(name, data=a)
+            ds.attrs["units"] = POINTS[name.rpartition("_")[0]]
+            if descriptions and name in descriptions:
+                ds.attrs["description"] = descriptions[name]
     return out

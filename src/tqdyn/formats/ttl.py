@@ -14,7 +14,7 @@ The layout is exactly that of LISA Instrument 2.3's ``lisainstrument.ttl.ttl_fil
 
 tqdyn adds root attributes that LISA Instrument ignores (:data:`TQDYN_ATTRS`).  The file is written to a
 hidden temporary file beside the output and renamed into place when complete
-(:func:`tqdyn.formats.atomic.replacing`): an error, a full disk or Ctrl-C leaves the output path as it
+(:func:`tqdyn.formats.atomic.replacing_h5`): an error, a full disk or Ctrl-C leaves the output path as it
 was.  Units SI.
 """
 
@@ -28,7 +28,7 @@ import numpy as np
 
 from .._version import __version__ as _TQDYN_VERSION
 from ..ttl.coupling import LINEAR_FIELDS, MOSAS
-from .atomic import replacing
+from .atomic import replacing_h5
 from .trajectory import check_writable
 
 __all__ = ["DATASET_SUFFIX", "ORDERS", "TQDYN_ATTRS", "TTLFile", "TTLFileError", "read_ttl_file", "write_ttl_file"]
@@ -97,7 +97,7 @@ def write_ttl_file(path, t, coefficients: dict, order: int = 5, attrs: dict | No
     if bad:
         raise ValueError(f"attrs: unknown attribute {bad[0]!r}; allowed: {', '.join(TQDYN_ATTRS)}")
     out = check_writable(path)
-    with replacing(out, "TTL coefficient file") as tmp, h5py.File(tmp, "x") as h5:
+    with replacing_h5(out, "TTL coefficient file") as h5:
         h5.attrs["interpolation_order"] = int(order)
         for k, v in extra.items():
             h5.attrs[k] = v

@@ -16,6 +16,7 @@ import time
 from dataclasses import dataclass
 
 from ..formats import trajectory as io
+from ..formats.atomic import check_output
 from ..formats.closed_loop import ClosedLoopWriter
 
 __all__ = ["ClosedLoopJob", "ClosedLoopSummary", "check_closed_loop_inputs", "closed_loop_to_file",
@@ -105,12 +106,10 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
         if not str(o).startswith("closed_loop."):
             raise ValueError(f"--set: {o!r} is not a closed-loop key; allowed: closed_loop.KEY=VALUE "
                              "(docs/scenarios.md#closed-loop)")
-    out = io.check_writable(output)
     src = os.path.abspath(os.path.expanduser(os.fspath(run_file)))
     if not os.path.isfile(src):
         raise FileNotFoundError(f"RUN.h5: trajectory file {src!r} does not exist or is not a file")
-    if out.exists() and os.path.samefile(out, src):
-        raise ValueError(f"--output: {str(out)!r} is the run file itself; allowed: another file")
+    out = check_output(output, "--output", {"RUN.h5": src})
     traj = io.read_trajectory(src)
     scen = loads_scenario(traj.scenario_toml, list(overrides), source=f"{src} (attribute scenario) and --set")
     model = closed_loop_model(traj, scen.closed_loop, validate=True)
@@ -121,6 +120,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     n = int(round(float(dur) * rate))
     if n < 1:
         raise ValueError(f"--duration: {dur!r} s at {rate!r} Hz is less than one sample; allowed: duration x fs >= 1")
+    _check_size(model, n, out)
     settings = {**s, "fs": rate, "duration": float(dur), "seed": int(seed)}
     conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings)
     ta = traj.attrs
@@ -135,6 +135,29 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
              "t0": float(model.t_span[0]), "satellite_names": json.dumps(list(model.satellite_names))}
     return ClosedLoopJob(traj=traj, model=model, output=out, duration_s=n / rate, fs=float(rate), seed=int(seed),
                          attrs=attrs, per_source=bool(per_source))
+
+
+#: Memory of the budget per (segment, spacecraft, output, source, frequency) [bytes]: 3.3 float64
+#: measured at the peak (the ASDs, the responses they come from); 4 with a margin.
+BUDGET_BYTES_PER_POINT = 4 * 8
+
+
+def _check_size(model, n_samples: int, out) -> None:
+    """Refuse, before any work, a closed loop whose budget needs more memory than the machine has
+    (ValueError naming closed_loop.n_freq) or whose time series -- streamed, so bounded by the disk,
+    not the memory -- is larger than the free space where it goes (OutputIOError naming --duration
+    and --fs; a lower bound: n_samples x (outputs x spacecraft + 1) float64)."""
+    from ..closedloop.loop import output_names
+    from .memory import check_memory, check_space, human_bytes
+
+    n_freq = int(model.settings["n_freq"])
+    per_freq = len(model.loops) * len(model.loops[0]) * len(output_names()) * max(len(model.noise), 1) \
+        * BUDGET_BYTES_PER_POINT
+    check_memory(n_freq * per_freq, f"closed_loop.n_freq = {n_freq}: the budget",
+                 lambda budget: f"closed_loop.n_freq <= {int(budget // per_freq)}")
+    row = (len(output_names(time_domain=True)) * len(model.loops) + 1) * 8
+    check_space(n_samples * row, out, "the closed-loop file",
+                f"a shorter --duration or a lower --fs (the file holds {human_bytes(row)} per sample)")
 
 
 class _Counting:
@@ -163,16 +186,17 @@ def closed_loop_to_file(job: ClosedLoopJob, progress=None, block_size: int = 655
     series streamed block by block (``progress(n)`` after each block of n samples; ``budget_progress(1)``
     after each of the budget's segment x spacecraft loops).  ``wrap``: a
     function of the writer returning the sink the simulation writes to (tests inject failures).
-    On any failure or interrupt no file is left at the output path."""
+    On any failure or interrupt no file is left at the output path (the writer's temporary file
+    exists from the start: an interrupt during the budget removes it too)."""
     from ..analysis.closed_loop import closed_loop_budget, closed_loop_timeseries
     from ..closedloop.loop import OUTPUTS
 
-    t0 = time.perf_counter()
-    ds = closed_loop_budget(job.model, progress=budget_progress, per_source=job.per_source) if budget is None \
-        else budget
-    t1 = time.perf_counter()
     try:
         with ClosedLoopWriter(job.output, job.attrs, units=OUTPUTS) as writer:
+            t0 = time.perf_counter()
+            ds = closed_loop_budget(job.model, progress=budget_progress, per_source=job.per_source) if budget is None \
+                else budget
+            t1 = time.perf_counter()
             writer.write_budget(ds)
             sink = _Counting(writer if wrap is None else wrap(writer), progress)
             closed_loop_timeseries(job.model, duration_s=job.duration_s, fs=job.fs, seed=job.seed, sink=sink,

@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from ..formats import trajectory as io
-from ..formats.atomic import replacing
+from ..formats.atomic import check_output, replacing, same_file
 from ..formats.od_estimate import estimate_contents, write_estimate_file
 from ..formats.od_tdm import read_measurements_tdm, write_measurements_tdm
 from .closed_loop import file_sha256
@@ -174,22 +174,6 @@ def parameter_unit(name: str) -> str:
     return "m/s^2" if last in PARAMETER_NAMES or last in COMMON_NAMES else ""
 
 
-def _same(a, b) -> bool:
-    pa, pb = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(a)))), \
-        pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(b))))
-    if pa.exists() and pb.exists():
-        return os.path.samefile(pa, pb)
-    return pa == pb
-
-
-def _check_output(output, option: str, inputs: dict) -> pathlib.Path:
-    out = io.check_writable(output)
-    for label, path in inputs.items():
-        if path is not None and os.path.exists(os.fspath(path)) and _same(out, path):
-            raise ValueError(f"{option}: {str(out)!r} is the input {label}; allowed: another file")
-    return out
-
-
 def _check_arc(scen, arc_s: float, source: str) -> None:
     span = float(scen.run.duration_s)
     if arc_s > span:
@@ -277,6 +261,12 @@ def _sp3_paths(sp3, kinds) -> list:
     return paths
 
 
+def _sp3_inputs(sp3) -> dict:
+    """{"--sp3 FILE": path} of the ``--sp3`` files (inputs an output must not be)."""
+    paths = [sp3] if isinstance(sp3, (str, os.PathLike)) else list(sp3 or ())
+    return {f"--sp3 {os.fspath(p)}": p for p in paths}
+
+
 def _sp3_orbits(paths, scen, arc_s: float) -> dict:
     """{"gnss_orbits": the SP3 constellations of ``paths`` on the scenario's epoch} (no files: {}),
     each checked to cover the arc (and the second before it: the signals' emission times)."""
@@ -343,7 +333,7 @@ def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=
         raise (FileNotFoundError(f"RUN.h5: trajectory file {str(run_file)!r} does not exist or is not a file")
                if not os.path.isfile(os.fspath(run_file)) else
                ValueError(f"RUN.h5: {str(run_file)!r} is not a trajectory file; allowed: a file written by tqdyn run"))
-    out = _check_output(output, "--output", {"RUN.h5": run_file})
+    out = check_output(output, "--output", {"RUN.h5": run_file, **_sp3_inputs(sp3_paths)})
     scen, notes, label = _scenario(run_file, overrides)
     _check_arc(scen, arc_s, label)
     p = _problem()
@@ -403,8 +393,9 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         raise ValueError(f"--edit-sigma: {edit_sigma!r} is not allowed; allowed: a number > 0")
     if not os.path.isfile(os.fspath(tdm)):
         raise FileNotFoundError(f"MEAS.tdm: measurement file {str(tdm)!r} does not exist or is not a file")
-    inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
-    out = _check_output(output, "--output", inputs) if output is not None else None
+    inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None,
+              **_sp3_inputs(sp3)}
+    out = check_output(output, "--output", inputs) if output is not None else None
     if figure is not None:
         from ..analysis.figures_od import check_residual_figure_path
 
@@ -413,11 +404,9 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         except ImportError as exc:
             raise ValueError(f"--figure: {str(figure)!r} cannot be drawn ({exc}); allowed: no --figure, or install "
                              "matplotlib") from None
-        if out is not None and _same(out, figure):
+        if out is not None and same_file(out, figure):
             raise ValueError(f"--figure: {str(figure)!r} is the output EST.h5; allowed: another file")
-        for label, path in inputs.items():
-            if path is not None and _same(figure, path):
-                raise ValueError(f"--figure: {str(figure)!r} is the input {label}; allowed: another file")
+        check_output(figure, "--figure", inputs)
     scen, notes, label = _scenario(scenario, overrides)
     say("reading")
     fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale,
@@ -457,7 +446,12 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         say("plotting")
         try:
             plot_od_residuals(estimate_contents(fit, meas, attrs=attrs, units=units, residual_rows=rows), figure)
-        except (OSError, RuntimeError) as exc:  # a full disk, a directory removed since the check
+        except io.OutputIOError as exc:  # a full disk: status 3, the estimate file stays
+            err = io.OutputIOError(f"--figure: {exc}")
+            err.tqdyn_note = ("the figure was not written" + (f", the estimate file {str(out)!r} was"
+                                                              if out is not None else ""))
+            raise err from None
+        except (OSError, RuntimeError) as exc:  # a directory removed since the check, a missing LaTeX
             raise ValueError(f"--figure: {str(figure)!r} could not be written ({exc}); nothing was written there"
                              + (f", the estimate file {str(out)!r} was" if out is not None else "")
                              + "; allowed: a writable file with space for the figure") from None
@@ -477,8 +471,8 @@ def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, cons
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
     sig = parse_a_priori(a_priori)
     _check_consider(con_names, sig)
-    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
-    out = _check_output(json_out, "--json", inputs) if json_out is not None else None
+    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None, **_sp3_inputs(sp3_paths)}
+    out = check_output(json_out, "--json", inputs) if json_out is not None else None
     scen, notes, label = _scenario(scenario, overrides)
     _check_arc(scen, arc_s, label)
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,

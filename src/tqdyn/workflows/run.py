@@ -24,6 +24,7 @@ work starts (the CLI calls it before its banner).
 
 from __future__ import annotations
 
+import os
 import time
 import traceback
 from dataclasses import dataclass
@@ -33,12 +34,13 @@ from typing import Callable
 from ..formats import trajectory as io
 from .. import dynamics
 from ..dynamics import Checkpoint, RunResult, row_names
+from ..formats.atomic import same_file
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 from .heap import bound_heap_retention
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
            "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning", "load_run_scenario",
-           "scenario_of_trajectory"]
+           "scenario_inputs", "scenario_of_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -186,8 +188,6 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
     ``writes``: the run will write ``run.output``, which must not be ``path``.
     Raises FileNotFoundError, ValueError (one line: not a trajectory, no
     scenario, the output would replace ``path``) or ScenarioError."""
-    import os
-
     from ..scenario import loads_scenario
     from ..scenario.record import compare_constants, run_constants
 
@@ -216,11 +216,24 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
             notes.append(f"{path}: this tqdyn will not reproduce the file's run: {diffs[0]}{more}")
     if overrides:
         scen = loads_scenario(text, [*legacy, *overrides], source=src)
-    out = os.path.abspath(os.path.expanduser(scen.run.output))
-    if writes and os.path.exists(out) and os.path.samefile(out, path):
+    if writes and os.path.exists(os.path.expanduser(scen.run.output)) and same_file(scen.run.output, path):
         raise ValueError(f"run.output: {scen.run.output!r} is the trajectory the scenario is read from; allowed: "
                          "another file (-o OUT.h5, or --set run.output=OUT.h5)")
     return scen, notes
+
+
+def scenario_inputs(scenario, scen) -> dict:
+    """The files a run of ``scen`` reads, {label: path}: the scenario argument ``scenario`` when it is
+    a file (a TOML file or a run file), ``forces.ephemeris`` when it is a path, ``initial.oem.N``; an
+    output must be none of them (:func:`tqdyn.formats.atomic.check_output`)."""
+    files = {}
+    if scenario is not None and os.path.isfile(os.fspath(scenario)):
+        files["SCENARIO"] = scenario
+    if scen.forces.ephemeris != "de421":
+        files["forces.ephemeris"] = scen.forces.ephemeris
+    for k, path in enumerate(scen.initial.oem, start=1):
+        files[f"initial.oem.{k}"] = path
+    return files
 
 
 def load_run_scenario(scenario=None, overrides=(), *, writes: bool = False):
