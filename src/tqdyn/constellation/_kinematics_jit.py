@@ -128,6 +128,7 @@ __all__ = [
     "LAW_TAYLOR1",
     "LAW_TAYLOR2",
     "law_code",
+    "nominal_kinematics",
     "sat_kinematics",
 ]
 
@@ -333,6 +334,15 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
     iterative law does not converge (non-finite input).
     """
     _check(law, r_hi, r_lo, v, a, T_out, w_out, wd_out, th_out)
+    nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out)
+
+
+@njit(cache=True)
+def nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out):
+    """:func:`sat_kinematics` without its checks of the law code and the
+    shapes, for callers whose arrays and law are fixed by construction (the
+    right-hand side of the coupled system): the checks' error messages
+    would be compiled into every kernel that calls it."""
     z = (0.0, 0.0, 0.0)
     j0 = j1 = j2 = s0 = s1 = s2 = z
     if law != 0:

@@ -144,12 +144,16 @@ def empirical_of(cpar: np.ndarray, n_par: int) -> np.ndarray:
     return np.ascontiguousarray(cpar[CP_LEN:]).reshape(-1, n_par)
 
 
-def workspace(y: np.ndarray):
+def workspace(y: np.ndarray, cpar: np.ndarray | None = None):
     """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
     (15, 3[, 2]) accelerations in the working precision, fw a tuple of
-    float64 arrays, aux (AUX_LEN,)."""
-    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
-            np.zeros(AUX_LEN))
+    float64 arrays, aux (AUX_LEN,).  For the point-mass system (``cpar``
+    of MODE_POINT_MASS) fw is None: the compiled kernels choose the
+    point-mass right-hand side by that type, so a point-mass run never
+    compiles the coupled one and vice versa."""
+    point_mass = cpar is not None and cpar[CP_MODE] == MODE_POINT_MASS
+    return (np.zeros((15, 3) + y.shape[2:]),
+            None if point_mass else tuple(np.zeros(shape) for _, shape in _FW_SHAPES), np.zeros(AUX_LEN))
 
 
 def aux_views(aux: np.ndarray) -> dict:

@@ -33,14 +33,17 @@ __all__ = ["propagate", "check_inputs", "two_body_energy", "warm_up", "PRECISION
            "RunResult"]
 
 
-def warm_up(precision: str = "dd", method: str = "dp87") -> None:
+def warm_up(precision: str = "dd", method: str = "dp87", coupled: bool | None = None) -> None:
     """Compile the kernels of ``method`` ("dp87" | "multistep") for
     ``precision`` (numba JIT, a few seconds on first use, then cached on
     disk) so that later timings measure the propagation alone.  The DP87
-    kernels are always compiled (they also start the multistep method)."""
-    _warm_up_fixed(precision)
+    kernels are always compiled (they also start the multistep method).
+    ``coupled``: for the coupled constellation (True), independent point
+    masses (False) or both (None, the default); a run's system is
+    :attr:`tqdyn.dynamics.system.System.coupled`."""
+    _warm_up_fixed(precision, coupled)
     if method == "multistep":
-        warm_up_multistep(precision)
+        warm_up_multistep(precision, coupled)
 
 
 def two_body_energy(y_dd: np.ndarray, gm) -> list:
