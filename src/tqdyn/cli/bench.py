@@ -59,8 +59,8 @@ def _check_json_path(path) -> Path:
                    "lisa-esa scenario (ESA's orbits and force model, point masses); lisa-coupled: the coupled "
                    "lisa scenario (LISA architecture and drag-free scheme, one year); kernels: the time-only inputs "
                    "of one chunk, term by term, and the compiled kernels per evaluation; default-run: the command "
-                   "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with an empty kernel cache, then "
-                   "with it filled; tianqin-5y: `tqdyn run tianqin` for five years; tianqin-5y-multistep: the same "
+                   "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with each integrator (DP87, "
+                   "multistep), first with an empty kernel cache (compilation clocked), then with it filled; tianqin-5y: `tqdyn run tianqin` for five years; tianqin-5y-multistep: the same "
                    "with the multistep method; lisa-10y: `tqdyn run "
                    "lisa` for ten years; closed-loop: the closed-loop time series of 3 TianQin spacecraft, "
                    "3 days at 4 Hz, streamed to a file; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")

@@ -30,7 +30,7 @@ from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd,
 from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_kernel", "chunk_plan", "deliver_rows",
-           "input_pipeline", "propagate_fixed", "warm_up"]
+           "input_pipeline", "propagate_fixed", "warm_up", "warm_up_systems"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -130,25 +130,33 @@ def _scale_tableau(a, b, h, ha, hb):
             st(ha, mul(ld(a, i, j), h), i, j)
 
 
-def warm_up(precision: str = "dd", coupled: bool | None = None) -> None:
-    """Compile the fixed-step kernels for ``precision`` (numba JIT, a few
+def warm_up(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+    """Compile the fixed-step kernel for ``precision`` (numba JIT, a few
     seconds on first use in a process, then cached on disk) so that later
-    timings measure the propagation alone.  ``coupled``: compile the kernel
-    of the coupled constellation (True), of independent point masses
-    (False) or both (None); each is compiled only when a run needs it."""
+    timings measure the propagation alone.  ``cpar``: the run's system
+    (the ``cpar`` of its :class:`tqdyn.dynamics.system.System`), whose kernel is compiled
+    (each system has its own: independent point masses, the coupled
+    constellation with the global or with a local pointing law); None: the
+    point masses' and the coupled constellation's with the global law."""
     _lay.check_precision(precision)
-    for c in ((False, True) if coupled is None else (coupled,)):
+    for c in warm_up_systems(cpar):
         _compile_chunk(precision, c)
     _grid_times(0, 1, np.array((1.0, 0.0)), np.zeros(13), np.empty((1, 2)), np.empty((0, 13, 2)))
 
 
-def _compile_chunk(precision: str, coupled: bool) -> None:
-    """Compile the kernel of the system for the argument types of a run (zero steps run)."""
+def warm_up_systems(cpar: np.ndarray | None) -> tuple:
+    """The system parameters whose kernels :func:`warm_up` compiles for ``cpar``."""
+    if cpar is not None:
+        return (cpar,)
+    return _lay.make_cpar(_lay.MODE_POINT_MASS), _lay.make_cpar(_lay.MODE_COUPLED)
+
+
+def _compile_chunk(precision: str, cpar: np.ndarray) -> None:
+    """Compile the kernel of the system ``cpar`` for the argument types of a run (zero steps run)."""
     tail = (2,) if precision == "dd" else ()
     y = np.zeros((3, 6) + tail)
     coef = dp87.step_coefficients(dp87.load_tableau(), 1, precision)
     model = ForceModel([])
-    cpar = _lay.make_cpar(_lay.MODE_COUPLED if coupled else _lay.MODE_POINT_MASS)
     gw, fw, aux = _lay.workspace(y, cpar)
     chunk_kernel(fw)(y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros((3, 6)),
                      coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((0, 13, 0)),

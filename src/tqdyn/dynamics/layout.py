@@ -147,13 +147,18 @@ def empirical_of(cpar: np.ndarray, n_par: int) -> np.ndarray:
 def workspace(y: np.ndarray, cpar: np.ndarray | None = None):
     """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
     (15, 3[, 2]) accelerations in the working precision, fw a tuple of
-    float64 arrays, aux (AUX_LEN,).  For the point-mass system (``cpar``
-    of MODE_POINT_MASS) fw is None: the compiled kernels choose the
-    point-mass right-hand side by that type, so a point-mass run never
-    compiles the coupled one and vice versa."""
-    point_mass = cpar is not None and cpar[CP_MODE] == MODE_POINT_MASS
-    return (np.zeros((15, 3) + y.shape[2:]),
-            None if point_mass else tuple(np.zeros(shape) for _, shape in _FW_SHAPES), np.zeros(AUX_LEN))
+    float64 arrays, aux (AUX_LEN,).  Their types tell the compiled code
+    which system runs, so that a run compiles its own only: for the
+    point-mass system (``cpar`` of MODE_POINT_MASS) fw is None; for the
+    coupled one with the global pointing law (cpar[CP_LAW] = 0, the
+    default without cpar) its jerk array fw[19] is None (the local laws'
+    jerk model is left out)."""
+    if cpar is not None and cpar[CP_MODE] == MODE_POINT_MASS:
+        fw = None
+    else:
+        local = cpar is not None and cpar[CP_LAW] != 0
+        fw = tuple(None if name == "jp" and not local else np.zeros(shape) for name, shape in _FW_SHAPES)
+    return np.zeros((15, 3) + y.shape[2:]), fw, np.zeros(AUX_LEN)
 
 
 def aux_views(aux: np.ndarray) -> dict:

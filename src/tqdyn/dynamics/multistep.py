@@ -39,7 +39,7 @@ from ..numerics import multistep as _ms
 from ..numerics.dd import copy_columns
 from . import layout as _lay
 from .fixed import (CheckpointClock, _as_precision, _grid_times, _workspace, chunk_kernel, chunk_plan, deliver_rows,
-                    input_pipeline)
+                    input_pipeline, warm_up_systems)
 from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
@@ -151,9 +151,9 @@ class _State:
         self.head[0] = self.F.shape[0] - 1
 
 
-def warm_up_multistep(precision: str = "dd", coupled: bool | None = None) -> None:
-    """Compile the multistep kernels for ``precision`` (numba JIT, cached on
-    disk); ``coupled`` as for :func:`tqdyn.dynamics.fixed.warm_up`."""
+def warm_up_multistep(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+    """Compile the multistep kernel for ``precision`` (numba JIT, cached on
+    disk); ``cpar`` as for :func:`tqdyn.dynamics.fixed.warm_up`."""
     from ..forces.model import ForceModel
 
     _lay.check_precision(precision)
@@ -164,12 +164,11 @@ def warm_up_multistep(precision: str = "dd", coupled: bool | None = None) -> Non
     model = ForceModel([])
     st = _State(y, order)
     _ms.start(st.y, st.F, 0, mc.coef, mc.hh, st.S, st.cS, st.s, st.cs)
-    for c in ((False, True) if coupled is None else (coupled,)):
-        cpar = _lay.make_cpar(_lay.MODE_COUPLED if c else _lay.MODE_POINT_MASS)
-        gw, fw, _ = _lay.workspace(y, cpar)
+    for c in warm_up_systems(cpar):
+        gw, fw, _ = _lay.workspace(y, c)
         _kernel(fw)(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, np.zeros_like(y),
                     np.zeros_like(y), st.aux, np.zeros(2), 1, True, np.zeros((0, 0)), model.params, model.layout,
-                    cpar, gw, fw, 0, np.empty((0,) + y.shape), np.empty((0, 3, 3) + tail),
+                    c, gw, fw, 0, np.empty((0,) + y.shape), np.empty((0, 3, 3) + tail),
                     np.empty((0, _lay.AUX_LEN)))
 
 

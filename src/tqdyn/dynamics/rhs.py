@@ -136,8 +136,10 @@ def _breathing_angle(r_hi, r_lo, i):
 
 
 @njit(cache=True)
-def _jerk_perturbation(cpar, tdat, fw):
-    """Jerk of each satellite beyond the central monopole [m/s^3] into fw[19].
+def _jerk_perturbation(cpar, tdat, fw, jp):
+    """Jerk of each satellite beyond the central monopole [m/s^3] into jp
+    (fw[19]; None for the global law, which needs none: then nothing is
+    computed, nor compiled).
 
     The local pointing laws need the remote satellites' jerk for omega_dot
     (it enters as jerk / c).  Modelled: the tidal terms of the jerk bodies
@@ -158,7 +160,9 @@ def _jerk_perturbation(cpar, tdat, fw):
     1e-12 m of their EH centers over 10 days (tests/test_coupled.py; with the
     monopole jerk alone they do not).
     """
-    v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
+    if jp is None:
+        return
+    v, r_hi, r_lo = fw[2], fw[0], fw[1]
     o = int(cpar[CP_TD])
     k = cpar[CP_J2K]
     nb = int(cpar[CP_NJB])
@@ -267,7 +271,7 @@ def coupled_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
                                                                  v[i, 1], v[i, 2], tdat, params, layout)
     # 2. attitude and EH geometry
     if cpar[CP_LAW] != 0:
-        _jerk_perturbation(cpar, tdat, fw)
+        _jerk_perturbation(cpar, tdat, fw, fw[19])
     _control_pass(cpar, fw)
     # 3. differential gravity at the EH centers: term by term
     # (:mod:`tqdyn.forces.differential`) or, "direct", the full model there (dd)
