@@ -144,12 +144,21 @@ def empirical_of(cpar: np.ndarray, n_par: int) -> np.ndarray:
     return np.ascontiguousarray(cpar[CP_LEN:]).reshape(-1, n_par)
 
 
-def workspace(y: np.ndarray):
+def workspace(y: np.ndarray, cpar: np.ndarray | None = None):
     """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
     (15, 3[, 2]) accelerations in the working precision, fw a tuple of
-    float64 arrays, aux (AUX_LEN,)."""
-    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
-            np.zeros(AUX_LEN))
+    float64 arrays, aux (AUX_LEN,).  Their types tell the compiled code
+    which system runs, so that a run compiles its own only: for the
+    point-mass system (``cpar`` of MODE_POINT_MASS) fw is None; for the
+    coupled one with the global pointing law (cpar[CP_LAW] = 0, the
+    default without cpar) its jerk array fw[19] is None (the local laws'
+    jerk model is left out)."""
+    if cpar is not None and cpar[CP_MODE] == MODE_POINT_MASS:
+        fw = None
+    else:
+        local = cpar is not None and cpar[CP_LAW] != 0
+        fw = tuple(None if name == "jp" and not local else np.zeros(shape) for name, shape in _FW_SHAPES)
+    return np.zeros((15, 3) + y.shape[2:]), fw, np.zeros(AUX_LEN)
 
 
 def aux_views(aux: np.ndarray) -> dict:

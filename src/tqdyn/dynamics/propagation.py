@@ -33,14 +33,18 @@ __all__ = ["propagate", "check_inputs", "two_body_energy", "warm_up", "PRECISION
            "NonFiniteStateError", "Rows", "RunResult"]
 
 
-def warm_up(precision: str = "dd", method: str = "dp87") -> None:
+def warm_up(precision: str = "dd", method: str = "dp87", cpar: np.ndarray | None = None) -> None:
     """Compile the kernels of ``method`` ("dp87" | "multistep") for
     ``precision`` (numba JIT, a few seconds on first use, then cached on
     disk) so that later timings measure the propagation alone.  The DP87
-    kernels are always compiled (they also start the multistep method)."""
-    _warm_up_fixed(precision)
+    kernel is always compiled (it also starts the multistep method).
+    ``cpar``: the run's system (the ``cpar`` of its
+    :class:`tqdyn.dynamics.system.System`, ``build_system(scenario).cpar``), whose kernels alone are
+    compiled; None: those of independent point masses and of the coupled
+    constellation with the global pointing law."""
+    _warm_up_fixed(precision, cpar)
     if method == "multistep":
-        warm_up_multistep(precision)
+        warm_up_multistep(precision, cpar)
 
 
 def two_body_energy(y_dd: np.ndarray, gm) -> list:

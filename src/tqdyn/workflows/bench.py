@@ -98,7 +98,7 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
                                             f"integrator.step={scen.integrator.step_s / 2}", *DP87])
     for name, precision, sc in (("dd", "dd", scen), ("float64", "float64", scen), ("dd h/2", "dd", half)):
         t0 = time.perf_counter()
-        dynamics.warm_up(precision)
+        dynamics.warm_up(precision, cpar=dynamics.build_system(sc).cpar)
         compile_s = time.perf_counter() - t0
         rows = []
         res = dynamics.propagate(sc, precision=precision, sink=rows.append)
