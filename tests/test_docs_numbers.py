@@ -60,6 +60,7 @@ TYPED_ALLOWED = [
     ("docs/design.md", "1 MB per\ndataset", "HDF5's default chunk cache, a library setting"),
     ("docs/design.md", "1 MB per dataset", "HDF5's default chunk cache, a library setting"),
     ("docs/design.md", "~10 MB each", "n_tdat x 13 stages x 512 steps x 8 bytes: arithmetic"),
+    ("docs/closed-loop-file.md", "2 MiB", "the chunk-size bound of the closed-loop writer, a setting"),
     ("docs/reliability.md", "2.6 MB tmpfs", "the size of the test's file system, a test setting"),
     ("docs/reliability.md", "1 MiB", "the headroom constant of the writer"),
     ("docs/reliability.md", "1 kB", "the file-size limit of the fault-table test, a test setting"),
