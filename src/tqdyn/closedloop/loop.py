@@ -107,10 +107,13 @@ class ClosedLoop:
         return output_names(time_domain=True) if not self.outputs else list(self.outputs)
 
 
-def _controllers_ss(controllers: dict) -> list:
+def _controllers_ss(controllers: dict, loops: dict = LOOPS) -> list:
     out = []
-    for loop, (channels, *_rest) in LOOPS.items():
-        ctl = controllers[loop]
+    for loop, (channels, *_rest) in loops.items():
+        ctl = controllers.get(loop)
+        if ctl is None:
+            raise ValueError(f"closed_loop.controllers.{loop}: no controller for this loop; allowed: one for each "
+                             f"loop of the scheme ({', '.join(loops)})")
         if not isinstance(ctl, Controller):
             raise TypeError(f"controllers[{loop!r}] is not a Controller")
         tf = control.ss(ctl.tf())
@@ -120,22 +123,41 @@ def _controllers_ss(controllers: dict) -> list:
     return out
 
 
+class SensorRows:
+    """The rows of a static sensor block: plant coordinates + sensor noise (+ ``extra`` signals) -> the error
+    signals ``e_<loop>[k]``; :meth:`add` one error signal as {signal: coefficient}, :meth:`block` the
+    python-control system (every sensor-noise input listed, used or not)."""
+
+    def __init__(self, extra=()):
+        self.inputs = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)]
+                       + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
+                       + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
+                       + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
+                       + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker")
+                       + source_inputs("mosa_encoder") + list(extra))
+        self.index = {s: k for k, s in enumerate(self.inputs)}
+        self.rows, self.names = [], []
+
+    def add(self, name: str, coeffs: dict) -> None:
+        r = np.zeros(len(self.inputs))
+        for sig, c in coeffs.items():
+            r[self.index[sig]] += c
+        self.rows.append(r)
+        self.names.append(name)
+
+    def block(self) -> control.StateSpace:
+        return _static(np.array(self.rows), self.inputs, self.names, "sensors")
+
+
 def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
-    """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static): ``basis`` (2, 3, 3)
-    of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3) Y_OA_l in S."""
-    sin = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
-           + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
-           + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
-           + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker")
-           + source_inputs("mosa_encoder"))
-    ci = {s: k for k, s in enumerate(sin)}
-    rows, names = [], []
+    """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static), "constellation" scheme:
+    ``basis`` (2, 3, 3) of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3) Y_OA_l in S."""
+    sr = SensorRows()
+    names = sr.names
 
     def row(coeffs):
-        r = np.zeros(len(sin))
-        for s, c in coeffs.items():
-            r[ci[s]] += c
-        rows.append(r)
+        sr.add(f"_{len(sr.rows)}", coeffs)
+        sr.names.pop()
 
     for l in (1, 2):      # drag-free: IFO along e_l
         e = basis[l - 1, 0]
@@ -178,30 +200,18 @@ def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
         for i in range(3):
             row({f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
             names.append(f"e_tm_rotation[{3 * (l - 1) + i}]")
-    return _static(np.array(rows), sin, names, "sensors")
+    return sr.block()
 
 
-def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple[control.StateSpace, dict]:
-    """Controller outputs ``c`` + loop breaks ``d`` + actuation noise -> the plant inputs (static), and the
-    DC levels of the force-proportional sources (:attr:`ClosedLoop.dc_force`).  ``e_S`` (2, 3) the
-    sensitive axes in S; ``chans`` the controller channels ``<loop>[k]``."""
+def _constellation_commands(p: PlantParameters, basis, e_S) -> list:
+    """(channel, plant input, gain) of the "constellation" scheme's actuators: ``e_S`` (2, 3) the sensitive
+    axes in S.  Raises ValueError (one line) when the sensitive axes leave the drag-free loops undetermined."""
     m, Itm, Im, Msc = p.tm_mass, p.tm_inertia, p.mosa_inertia, p.sc_mass
     J = np.diag(np.asarray(p.sc_inertia, dtype=np.float64))
-    ain = ([f"c_{c}" for c in chans] + [f"d_{c}" for c in chans] + source_inputs("thruster_force")
-           + source_inputs("thruster_gain") + source_inputs("thruster_torque") + source_inputs("actuation_force")
-           + source_inputs("actuation_torque") + source_inputs("mosa_actuator") + source_inputs("tm_force")
-           + source_inputs("tm_torque"))
-    aout = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
-            + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
-            + ["tm[0]", "tm[1]"] + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)]
-            + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)])
-    ai = {s: k for k, s in enumerate(ain)}
-    ao = {s: k for k, s in enumerate(aout)}
-    Da = np.zeros((len(aout), len(ain)))
+    out = []
 
-    def cmd(chan, out, gain):
-        Da[ao[out], ai[f"c_{chan}"]] += gain
-        Da[ao[out], ai[f"d_{chan}"]] += gain
+    def cmd(chan, inp, gain):
+        out.append((chan, inp, gain))
 
     Ninv = np.linalg.inv(np.array([e_S[0], e_S[1], [0.0, 0.0, 1.0]]))   # F = M N^-1 c (drag-free)
     for k in range(3):
@@ -220,6 +230,29 @@ def _actuators(p: PlantParameters, wp: WorkingPoint, basis, e_S, chans) -> tuple
     for l in (1, 2):
         for i in range(3):
             cmd(f"tm_rotation[{3 * (l - 1) + i}]", f"t{l}[{i}]", -Itm)
+    return out
+
+
+def _actuators(p: PlantParameters, wp: WorkingPoint, chans, commands) -> tuple[control.StateSpace, dict]:
+    """Controller outputs ``c`` + loop breaks ``d`` + actuation noise -> the plant inputs (static), and the
+    DC levels of the force-proportional sources (:attr:`ClosedLoop.dc_force`).  ``chans`` the controller
+    channels ``<loop>[k]``; ``commands`` (channel, plant input, gain) triples (the scheme's)."""
+    m, Itm, Msc = p.tm_mass, p.tm_inertia, p.sc_mass
+    ain = ([f"c_{c}" for c in chans] + [f"d_{c}" for c in chans] + source_inputs("thruster_force")
+           + source_inputs("thruster_gain") + source_inputs("thruster_torque") + source_inputs("actuation_force")
+           + source_inputs("actuation_torque") + source_inputs("mosa_actuator") + source_inputs("tm_force")
+           + source_inputs("tm_torque"))
+    aout = ([f"F[{i}]" for i in range(3)] + [f"T[{i}]" for i in range(3)]
+            + [f"f{l}[{i}]" for l in (1, 2) for i in range(3)] + [f"t{l}[{i}]" for l in (1, 2) for i in range(3)]
+            + ["tm[0]", "tm[1]"] + [f"a{l}[{i}]" for l in (1, 2) for i in range(3)]
+            + [f"b{l}[{i}]" for l in (1, 2) for i in range(3)])
+    ai = {s: k for k, s in enumerate(ain)}
+    ao = {s: k for k, s in enumerate(aout)}
+    Da = np.zeros((len(aout), len(ain)))
+
+    for chan, out, gain in commands:
+        Da[ao[out], ai[f"c_{chan}"]] += gain
+        Da[ao[out], ai[f"d_{chan}"]] += gain
     G = np.asarray(wp.a_dragfree, dtype=np.float64)
     dc = {"thruster_gain": Msc * np.abs(G),
           "actuation_force": m * np.abs(np.asarray(wp.a_suspension, dtype=np.float64)).reshape(6),
@@ -278,29 +311,55 @@ def _observables(p: PlantParameters, basis) -> control.StateSpace:
     return _static(Do, oin, onames, "observables")
 
 
-def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
-                      attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0]) -> ClosedLoop:
-    """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
-    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of :data:`LOOPS`.
-    ``attitude_z_sensor``: "dws" (the mean DWS yaw minus the mean MOSA encoder angle, default) or
-    "star_tracker" (as LISA Pathfinder, which had no DWS).  The blocks are joined by signal name with
-    python-control's check of unused signals on (a misnamed signal would leave one unconnected)."""
-    if attitude_z_sensor not in ATTITUDE_Z_SENSORS:
-        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
-                         f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
-    P = linear_plant(p, wp)
-    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
+def _constellation_blocks(p: PlantParameters, wp: WorkingPoint, chans, attitude_z_sensor: str):
+    """(sensors, commands) of the "constellation" scheme; ValueError (one line) for sensitive axes that do
+    not span the plane (collinear test masses: the DWS pitches of the two MOSAs then measure one angle)."""
     from ..constellation.control import oa_rotation
+    from ..constellation.spacecraft import MIN_AXES_DETERMINANT
+
+    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
     R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
     e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
     yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
-    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in LOOPS.items() for k in range(len(ch))]
-    actuators, dc = _actuators(p, wp, basis, e_S, chans)
+    det = float(np.dot(e_S[0], np.cross(e_S[1], [0.0, 0.0, 1.0])))
+    if abs(det) < MIN_AXES_DETERMINANT or abs(np.linalg.det(yoa[:, :2])) < MIN_AXES_DETERMINANT:
+        raise ValueError(f"closed_loop.scheme: 'constellation' cannot control test masses whose sensitive axes "
+                         f"are parallel (|e_1 . (e_2 x Z_S)| = {abs(det):.3g}): the two DWS pitches then measure "
+                         "one angle, the rotation about the TM line is unobservable; allowed: 'collinear' "
+                         "(the TMs and the star tracker, LISA Pathfinder's modes)")
+    return _sensors(basis, yoa, attitude_z_sensor), _constellation_commands(p, basis, e_S)
+
+
+def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
+                      attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0], scheme: str = "constellation") -> ClosedLoop:
+    """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
+    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of the ``scheme``
+    (:data:`tqdyn.scenario.closed_loop.SCHEME_LOOPS`: "constellation" (default, :data:`LOOPS`), "collinear",
+    "single_tm"; :mod:`tqdyn.closedloop.schemes`).  ``attitude_z_sensor`` ("constellation" only): "dws" (the
+    mean DWS yaw minus the mean MOSA encoder angle, default) or "star_tracker".  The blocks are joined by
+    signal name with python-control's check of unused signals on (a misnamed signal would leave one
+    unconnected).  ValueError (one line naming the key) for a geometry the scheme cannot control."""
+    from ..scenario.closed_loop import SCHEME_LOOPS, SCHEMES
+
+    if attitude_z_sensor not in ATTITUDE_Z_SENSORS:
+        raise ValueError(f"closed_loop.attitude_z_sensor: {attitude_z_sensor!r} is not a sensor; "
+                         f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
+    if scheme not in SCHEMES:
+        raise ValueError(f"closed_loop.scheme: {scheme!r} is not a control scheme; allowed: {', '.join(SCHEMES)}")
+    loops = SCHEME_LOOPS[scheme]
+    chans = [f"{loop}[{k}]" for loop, (ch, *_r) in loops.items() for k in range(len(ch))]
+    if scheme == "constellation":
+        sensors, commands = _constellation_blocks(p, wp, chans, attitude_z_sensor)
+    else:
+        from .schemes import scheme_blocks
+
+        sensors, commands = scheme_blocks(scheme, p, wp)
+    P = linear_plant(p, wp)
+    actuators, dc = _actuators(p, wp, chans, commands)
     noise = [s for src in SOURCES for s in source_inputs(src)]
     inplist = noise + [f"d_{c}" for c in chans]
     outlist = output_names() + [f"c_{c}" for c in chans]
-    syslist = ([P, _sensors(basis, yoa, attitude_z_sensor), actuators, _observables(p, basis)]
-               + _controllers_ss(controllers))
+    syslist = [P, sensors, actuators, _observables(p, sensitive_basis(p))] + _controllers_ss(controllers, loops)
     cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
                               name="closed_loop", warn_duplicate=False)
     return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=dc)

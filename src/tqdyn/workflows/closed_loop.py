@@ -24,8 +24,9 @@ __all__ = ["ClosedLoopJob", "ClosedLoopSummary", "check_closed_loop_inputs", "cl
 
 @dataclass
 class ClosedLoopJob:
-    """What :func:`check_closed_loop_inputs` resolved: the trajectory, the model, the output path and
-    the time-domain settings (duration [s], fs [Hz], seed), the configuration and the root attributes."""
+    """What :func:`check_closed_loop_inputs` resolved: the trajectory (None for a mission's static working
+    point), the model, the output path and the time-domain settings (duration [s], fs [Hz], seed), the
+    configuration and the root attributes."""
 
     traj: object
     model: object
@@ -83,16 +84,51 @@ def file_sha256(path) -> str:
     return h.hexdigest()
 
 
-def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=()) -> ClosedLoopJob:
+def _static_job(mission, out, dur, rate, seed, overrides) -> ClosedLoopJob:
+    """The job of a mission's static working point (no run file): the source_* attributes are empty."""
+    from ..closedloop.model import static_closed_loop_model
+    from ..scenario.loader import closed_loop_config
+
+    cfg = closed_loop_config({"mission": mission}, overrides)
+    model = static_closed_loop_model(cfg, validate=True)
+    s = model.settings
+    dur = dur if dur is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
+    rate = rate if rate is not None else s["fs"]
+    seed = seed if seed is not None else s["seed"]
+    n = int(round(float(dur) * rate))
+    if n < 1:
+        raise ValueError(f"--duration: {dur!r} s at {rate!r} Hz is less than one sample; allowed: duration x fs >= 1")
+    conf = resolved_configuration(cfg, mission, {**s, "fs": rate, "duration": float(dur), "seed": int(seed)})
+    conf["working_point"] = "static"
+    attrs = {"mission": model.mission, "source_file": "", "source_path": "", "source_sha256": "",
+             "source_scenario_sha256": "", "source_format_version": 0, "source_tqdyn_version": "",
+             "source_epoch_utc": "", "source_time_scale": "", "configuration": json.dumps(conf),
+             "closed_loop_toml": "\n".join(cfg.to_toml_lines()), "seed": int(seed), "fs": float(rate),
+             "duration_s": n / rate, "n_samples": n, "t0": 0.0,
+             "satellite_names": json.dumps(list(model.satellite_names))}
+    return ClosedLoopJob(traj=None, model=model, output=out, duration_s=n / rate, fs=float(rate), seed=int(seed),
+                         attrs=attrs)
+
+
+def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=(),
+                             mission=None) -> ClosedLoopJob:
     """Resolve a ``tqdyn closed-loop`` job; raise (one line) FileNotFoundError, ValueError
     (TrajectoryFormatError, ScenarioError, ClosedLoopError, DesignError: a bad option, a run without
     test masses or a pure-gravity run, an unknown loop or source, a bad ASD, an unstable design naming
     the loop and its margin) or OutputError (the output path) before anything is written.
-    ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``."""
+    ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``.  ``mission`` (instead of
+    ``run_file``): the mission's static working point (:func:`tqdyn.closedloop.model.static_closed_loop_model`;
+    the file's source_* attributes are then empty, its configuration says ``"working_point": "static"``)."""
     from ..closedloop.model import closed_loop_model
     from ..scenario import loads_scenario
+    from ..scenario.closed_loop import MISSIONS
     from ..scenario.loader import parse_duration
 
+    if (run_file is None) == (mission is None):
+        raise ValueError("RUN.h5: give either a run file or --mission (not both, not neither); allowed: "
+                         "tqdyn closed-loop RUN.h5 --output CL.h5, or tqdyn closed-loop --mission NAME --output CL.h5")
+    if mission is not None and mission not in MISSIONS:
+        raise ValueError(f"--mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
     dur = None if duration is None else _positive("--duration", duration, parse_duration)
     rate = None if fs is None else _positive("--fs", fs, float)
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
@@ -102,6 +138,8 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
             raise ValueError(f"--set: {o!r} is not a closed-loop key; allowed: closed_loop.KEY=VALUE "
                              "(docs/scenarios.md#closed-loop)")
     out = io.check_writable(output)
+    if mission is not None:
+        return _static_job(mission, out, dur, rate, seed, overrides)
     src = os.path.abspath(os.path.expanduser(os.fspath(run_file)))
     if not os.path.isfile(src):
         raise FileNotFoundError(f"RUN.h5: trajectory file {src!r} does not exist or is not a file")
