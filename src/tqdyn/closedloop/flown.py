@@ -32,7 +32,8 @@ from .noise import AsdModel
 from .plant import PlantParameters, WorkingPoint, tm_stiffness
 
 __all__ = ["FLOWN_CROSSOVER_HZ", "LPF_BAND_LOW_HZ", "flown_controllers", "flown_noise", "flown_plant",
-           "flown_plant_parameters", "flown_requirement", "flown_working_point", "lpf_design", "rule_crossover"]
+           "flown_plant_parameters", "flown_requirement", "flown_working_point", "lpf_design", "published_delta_g",
+           "published_flight_results", "rule_crossover"]
 
 _GM_SUN, _GM_EARTH = 1.32712440041e20, 3.986004415e14      # m^3/s^2 (DE440 / EGM2008, as the force model)
 _AU = 1.495978707e11                                        # m
@@ -214,3 +215,21 @@ def flown_plant_parameters(mission: str, plant: dict | None = None) -> PlantPara
                            crosstalk=float(v["crosstalk"]), housing_centers=centres, lever_arms=np.zeros((2, 3)),
                            sensitive_axes=np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
                            n_tm=2 if mission == "lpf" else 1, mosa=False)
+
+
+def published_flight_results() -> dict:
+    """The published flight results typed from the papers (package data ``tqdyn/data/flight_results.toml``:
+    every value with its paper and how it was read), as nested dicts."""
+    import tomllib
+    from importlib import resources
+
+    return tomllib.loads((resources.files("tqdyn") / "data" / "flight_results.toml").read_text(encoding="utf-8"))
+
+
+def published_delta_g(f, results: dict | None = None) -> np.ndarray:
+    """LISA Pathfinder's published Delta g ASD [m s^-2/Hz^1/2] at ``f`` [Hz]: the quadrature sum of the
+    published terms (:func:`published_flight_results` ``lpf.delta_g``): the Brownian floor (2018), the sub-mHz
+    tail floor x (1 mHz/f) (2024) and the readout (2 pi f)^2 n (2016)."""
+    d = (published_flight_results() if results is None else results)["lpf"]["delta_g"]
+    f = np.asarray(f, dtype=np.float64)
+    return np.sqrt(d["floor"] ** 2 + (d["tail_at_1mhz"] * 1e-3 / f) ** 2 + ((2 * math.pi * f) ** 2 * d["readout"]) ** 2)

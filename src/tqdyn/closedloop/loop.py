@@ -4,7 +4,8 @@ Built with ``control.interconnect`` (signals connected by their names).  The clo
 are the noise sources (:data:`SOURCES`, each component in the unit of its ASD) and one loop-break
 input ``d_<loop>[k]`` per controller channel (added to the controller output; the loop-at-a-time
 gain is L = -T/(1 + T), T the closed-loop transfer from ``d`` to the controller output ``c``);
-its outputs are the quantities of :data:`OUTPUTS` and the controller signals ``c_<loop>[k]``.
+its outputs are the quantities of :data:`OUTPUTS`, the controller signals ``c_<loop>[k]`` and the
+in-loop coordinates ``e_<loop>[k]`` (each controller's input).
 
 Frames: spacecraft quantities in S (body frame at the working point), TM quantities in OA_l
 (x the sensitive axis of the presets, X_OA_l).  Units SI.
@@ -18,10 +19,12 @@ import control
 import numpy as np
 
 from ..scenario.closed_loop import ATTITUDE_Z_SENSORS, SOURCES
+from .blocks import SensorRows, source_inputs, static_block as _static
 from .controllers import LOOPS, Controller
 from .plant import PlantParameters, WorkingPoint, linear_plant, sensitive_basis
+from .schemes import scheme_blocks
 
-__all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "build_closed_loop", "output_names", "source_inputs"]
+__all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "SensorRows", "build_closed_loop", "output_names", "source_inputs"]
 
 _AX = ("x", "y", "z")
 
@@ -71,22 +74,14 @@ def output_names(time_domain: bool = False) -> list[str]:
     return [k for k in OUTPUTS if not (time_domain and k in FREQUENCY_ONLY)]
 
 
-def source_inputs(source: str) -> list[str]:
-    """The closed loop's input signal names of one source."""
-    return [f"{source}[{k}]" for k in range(SOURCES[source][0])]
-
-
-def _static(D, inputs, outputs, name):
-    return control.ss(np.zeros((0, 0)), np.zeros((0, len(inputs))), np.zeros((len(outputs), 0)),
-                      np.asarray(D, dtype=np.float64), inputs=inputs, outputs=outputs, name=name)
-
 
 @dataclass(frozen=True)
 class ClosedLoop:
     """One spacecraft's closed loop at one working point.
 
     system : control.StateSpace, continuous; inputs: noise (SOURCES order) then ``d_*``; outputs:
-        :data:`OUTPUTS` (order of :func:`output_names`) then ``c_*``.
+        :data:`OUTPUTS` (order of :func:`output_names`), then the controller outputs ``c_*``, then their
+        inputs ``e_*`` (the in-loop coordinates: the sensed errors, sensor noise included).
     channel_names : the controller channels ``<loop>[k]``.
     dc_force : dict of the DC levels that scale the force-proportional sources:
         ``thruster_gain`` (3,) [N], ``actuation_force`` (6,) [N], ``actuation_torque`` (6,) [N m].
@@ -123,55 +118,21 @@ def _controllers_ss(controllers: dict, loops: dict = LOOPS) -> list:
     return out
 
 
-class SensorRows:
-    """The rows of a static sensor block: plant coordinates + sensor noise (+ ``extra`` signals) -> the error
-    signals ``e_<loop>[k]``; :meth:`add` one error signal as {signal: coefficient}, :meth:`block` the
-    python-control system (every sensor-noise input listed, used or not)."""
-
-    def __init__(self, extra=()):
-        self.inputs = ([f"x{l}[{i}]" for l in (1, 2) for i in range(3)]
-                       + [f"eta{l}[{i}]" for l in (1, 2) for i in range(3)]
-                       + [f"phi[{i}]" for i in range(3)] + ["dth[0]", "dth[1]"]
-                       + source_inputs("capacitive_translation") + source_inputs("capacitive_rotation")
-                       + source_inputs("interferometer") + source_inputs("dws") + source_inputs("star_tracker")
-                       + source_inputs("mosa_encoder") + list(extra))
-        self.index = {s: k for k, s in enumerate(self.inputs)}
-        self.rows, self.names = [], []
-
-    def add(self, name: str, coeffs: dict) -> None:
-        r = np.zeros(len(self.inputs))
-        for sig, c in coeffs.items():
-            r[self.index[sig]] += c
-        self.rows.append(r)
-        self.names.append(name)
-
-    def block(self) -> control.StateSpace:
-        return _static(np.array(self.rows), self.inputs, self.names, "sensors")
-
-
 def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
     """Plant coordinates + sensor noise -> the error signals ``e_<loop>[k]`` (static), "constellation" scheme:
     ``basis`` (2, 3, 3) of :func:`~tqdyn.closedloop.plant.sensitive_basis`, ``yoa`` (2, 3) Y_OA_l in S."""
     sr = SensorRows()
-    names = sr.names
-
-    def row(coeffs):
-        sr.add(f"_{len(sr.rows)}", coeffs)
-        sr.names.pop()
-
     for l in (1, 2):      # drag-free: IFO along e_l
         e = basis[l - 1, 0]
-        row({**{f"x{l}[{i}]": e[i] for i in range(3)}, f"interferometer[{l - 1}]": 1.0})
-        names.append(f"e_dragfree[{l - 1}]")
-    row({"x1[2]": 0.5, "x2[2]": 0.5, "capacitive_translation[2]": 0.5, "capacitive_translation[5]": 0.5})
-    names.append("e_dragfree[2]")
+        sr.add(f"e_dragfree[{l - 1}]", {**{f"x{l}[{i}]": e[i] for i in range(3)}, f"interferometer[{l - 1}]": 1.0})
+    sr.add("e_dragfree[2]", {"x1[2]": 0.5, "x2[2]": 0.5, "capacitive_translation[2]": 0.5,
+                             "capacitive_translation[5]": 0.5})
     for l in (1, 2):      # suspension: capacitive along p_l
         pv = basis[l - 1, 1]
-        row({**{f"x{l}[{i}]": pv[i] for i in range(3)},
-             **{f"capacitive_translation[{3 * (l - 1) + i}]": pv[i] for i in range(3)}})
-        names.append(f"e_suspension[{l - 1}]")
-    row({"x1[2]": 0.5, "x2[2]": -0.5, "capacitive_translation[2]": 0.5, "capacitive_translation[5]": -0.5})
-    names.append("e_suspension[2]")
+        sr.add(f"e_suspension[{l - 1}]", {**{f"x{l}[{i}]": pv[i] for i in range(3)},
+                                          **{f"capacitive_translation[{3 * (l - 1) + i}]": pv[i] for i in range(3)}})
+    sr.add("e_suspension[2]", {"x1[2]": 0.5, "x2[2]": -0.5, "capacitive_translation[2]": 0.5,
+                               "capacitive_translation[5]": -0.5})
     # DWS: pitch_l = Y_OA_l . phi + n, yaw_l = phi_z + dth_l + n; attitude estimate (phi_x, phi_y) from the
     # two pitches, phi_z from the mean yaw
     Pm = np.linalg.inv(yoa[:, :2])                      # (phi_x, phi_y) = Pm @ (pitch_1, pitch_2)
@@ -186,20 +147,18 @@ def _sensors(basis, yoa, attitude_z_sensor: str) -> control.StateSpace:
         return out
 
     for a in range(2):
-        row(comb(Pm[a], pitch))
-        names.append(f"e_attitude[{a}]")
+        sr.add(f"e_attitude[{a}]", comb(Pm[a], pitch))
     if attitude_z_sensor == "star_tracker":
-        row({"phi[2]": 1.0, "star_tracker[2]": 1.0})
+        sr.add("e_attitude_z[0]", {"phi[2]": 1.0, "star_tracker[2]": 1.0})
     else:     # mean DWS yaw minus the mean MOSA angle from the encoders
-        row(comb((0.5, 0.5, -0.5, -0.5), yaw + [{f"dth[{l}]": 1.0, f"mosa_encoder[{l}]": 1.0} for l in range(2)]))
-    names.append("e_attitude_z[0]")
+        sr.add("e_attitude_z[0]", comb((0.5, 0.5, -0.5, -0.5),
+                                       yaw + [{f"dth[{l}]": 1.0, f"mosa_encoder[{l}]": 1.0} for l in range(2)]))
     for l in range(2):
-        row(yaw[l])
-        names.append(f"e_mosa[{l}]")
+        sr.add(f"e_mosa[{l}]", yaw[l])
     for l in (1, 2):
         for i in range(3):
-            row({f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
-            names.append(f"e_tm_rotation[{3 * (l - 1) + i}]")
+            sr.add(f"e_tm_rotation[{3 * (l - 1) + i}]",
+                   {f"eta{l}[{i}]": 1.0, f"capacitive_rotation[{3 * (l - 1) + i}]": 1.0})
     return sr.block()
 
 
@@ -351,14 +310,12 @@ def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
     if scheme == "constellation":
         sensors, commands = _constellation_blocks(p, wp, chans, attitude_z_sensor)
     else:
-        from .schemes import scheme_blocks
-
         sensors, commands = scheme_blocks(scheme, p, wp)
     P = linear_plant(p, wp)
     actuators, dc = _actuators(p, wp, chans, commands)
     noise = [s for src in SOURCES for s in source_inputs(src)]
     inplist = noise + [f"d_{c}" for c in chans]
-    outlist = output_names() + [f"c_{c}" for c in chans]
+    outlist = output_names() + [f"c_{c}" for c in chans] + [f"e_{c}" for c in chans]
     syslist = [P, sensors, actuators, _observables(p, sensitive_basis(p))] + _controllers_ss(controllers, loops)
     cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
                               name="closed_loop", warn_duplicate=False)

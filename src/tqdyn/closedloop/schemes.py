@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .loop import SensorRows
+from .blocks import SensorRows
 from .plant import PlantParameters, WorkingPoint
 
 __all__ = ["collinear_separation", "scheme_blocks"]
