@@ -20,7 +20,7 @@ import math
 import numpy as np
 import pytest
 
-from tqdyn.closedloop.budget import check_stable, closed_loop_response, loop_margins
+from tqdyn.closedloop.budget import check_stable, loop_margins
 from tqdyn.closedloop.flight_observables import (STABILITY_DOF, delta_g_budget, residual_acceleration_budget,
                                                  stability_budget)
 from tqdyn.closedloop.flown import published_delta_g, published_flight_results
@@ -127,7 +127,7 @@ def test_lpf_star_tracker_limits_the_attitude_below_1_mhz(lpf, record_number):
     for d in ("Eta", "Phi"):
         b = st[d]
         assert np.all(np.argmax(b, axis=0) == i_st), d
-        sensing = np.sqrt(b[sources.index("capacitive_translation")] ** 2 + b[sources.index("capacitive_rotation")] ** 2)
+        sensing = np.hypot(b[sources.index("capacitive_translation")], b[sources.index("capacitive_rotation")])
         rise[d] = np.sqrt(np.sum(b ** 2, axis=0)) / sensing
         assert np.min(rise[d]) > 1.4, d
     fq = np.array([1e-4, 3e-4, 1e-3])
@@ -188,7 +188,8 @@ def test_lpf_orbit_around_l1_does_not_reach_the_loop(lpf, record_number):
     worst = {}
     for name, w in (("tide", dataclasses.replace(wp, gamma=np.zeros((3, 3)))),
                     ("rotation", dataclasses.replace(wp, omega=np.zeros(3)))):
-        worst[name] = float(np.max(np.abs(ref / totals(build_closed_loop(p, w, m.controllers, scheme="collinear")) - 1)))
+        other = totals(build_closed_loop(p, w, m.controllers, scheme="collinear"))
+        worst[name] = float(np.max(np.abs(ref / other - 1)))
     assert worst["tide"] < 1e-5 and worst["rotation"] < 1e-4, worst
     record_number("closed_loop_flown.lpf_orbit_effect_max_rel", [worst["tide"], worst["rotation"]], "")
     record_number("closed_loop_flown.lpf_tide_s2", float(np.max(np.abs(np.linalg.eigvalsh(wp.gamma)))), "s^-2")
@@ -217,12 +218,23 @@ def test_tianqin1_residual_acceleration_at_10_mhz(tq1, record_number):
     record_number("closed_loop_flown.tq1_ratio_to_published", total / pub["value"], "")
     record_number("closed_loop_flown.tq1_sensitivity_10mhz", float(abs(1 / (1 + C))), "")
     record_number("closed_loop_flown.tq1_published_sensitivity", pub["value"] / pub["thruster_noise"], "")
+    # for scale: the crossover of an integrator-dominated PI (zero at its crossover) with the published |S|
+    from scipy.optimize import brentq
+
+    from tqdyn.closedloop.controllers import pi_controller
+
+    def excess(lf):
+        c = pi_controller(10 ** lf, integrator_ratio=1.0)
+        return abs(1 / (1 + c.gain * (s - c.zeros[0]) / s)) - pub["value"] / pub["thruster_noise"]
+
+    record_number("closed_loop_flown.tq1_implied_crossover_hz", 10 ** brentq(excess, -2.5, 1.0), "Hz")
 
 
 def test_a_geometry_the_scheme_cannot_control_is_refused_in_one_line():
     """The constellation scheme (DWS pitches of two MOSAs) on LISA Pathfinder's collinear TMs, and the collinear
     scheme on LISA's 60-degree axes: one line naming closed_loop.scheme and what is allowed (before: a bare
-    LinAlgError from the constellation's geometry solve)."""
+    LinAlgError from the constellation's geometry solve); a single-spacecraft geometry key on a constellation
+    mission likewise (closed_loop.plant.tm_separation)."""
     from tqdyn.scenario.loader import closed_loop_config
 
     for table in ({"mission": "lpf", "scheme": "constellation"}, {"mission": "lisa", "scheme": "collinear"},
@@ -232,13 +244,15 @@ def test_a_geometry_the_scheme_cannot_control_is_refused_in_one_line():
         text = str(exc.value)
         assert text.startswith("closed_loop.scheme:") and "allowed:" in text and "\n" not in text, text
         assert len(text) < 300
+    with pytest.raises(ClosedLoopError, match=r"^closed_loop.plant.tm_separation: .* allowed: the single-spacecraft"):
+        static_closed_loop_model(closed_loop_config({"mission": "lisa", "plant": {"tm_separation": 0.3}}))
 
 
 def test_the_command_writes_a_missions_static_working_point_and_refuses_bad_input(tmp_path, capsys):
     """``tqdyn closed-loop --mission lpf``: a closed-loop file of one spacecraft whose budget's channels are the
     collinear scheme's (15) and whose source attributes are empty; bad input (a controller missing its gain, a
-    loop the scheme does not have, both or neither of RUN.h5 and --mission, an unknown mission) exits 2 with one
-    line naming the key, and writes nothing."""
+    loop the scheme does not have, both or neither of RUN.h5 and --mission, an unknown mission, a --set mission
+    other than --mission) exits 2 with one line naming the key, and writes nothing."""
     from cli_support import run_cli
 
     from tqdyn.formats.closed_loop import read_closed_loop
@@ -254,9 +268,10 @@ def test_the_command_writes_a_missions_static_working_point_and_refuses_bad_inpu
             "--set", "closed_loop.controllers.guidance.poles=[0, -1e-4]"],
            ["--mission", "lpf", "--set", "closed_loop.controllers.mosa.gain=1"],
            ["--mission", "tianqin-1", "--set", "closed_loop.scheme=constellation"],
-           [str(out), "--mission", "lpf"], [], ["--mission", "lpf-2"]]
+           [str(out), "--mission", "lpf"], [], ["--mission", "lpf-2"],
+           ["--mission", "lpf", "--set", "closed_loop.mission=lisa"]]
     keys = ["closed_loop.controllers.guidance.gain", "closed_loop.controllers.mosa", "closed_loop.scheme", "RUN.h5",
-            "RUN.h5", "--mission"]
+            "RUN.h5", "--mission", "closed_loop.mission"]
     for argv, key in zip(bad, keys):
         target = tmp_path / "bad.h5"
         status, _o, err = run_cli(["closed-loop", *argv, "--output", str(target), *small], capsys)

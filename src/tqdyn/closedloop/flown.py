@@ -126,7 +126,8 @@ def rule_crossover(ratio: float, part: str, f_band: float = LPF_BAND_LOW_HZ) -> 
 
     def excess(log_fc):
         c = lead_lag_pid(10.0 ** log_fc)
-        L = c.gain * np.prod(s - np.array(c.zeros, dtype=complex)) / np.prod(s - np.array(c.poles, dtype=complex)) / s ** 2
+        z, pl = np.array(c.zeros, dtype=complex), np.array(c.poles, dtype=complex)
+        L = c.gain * np.prod(s - z) / np.prod(s - pl) / s ** 2
         return math.log(abs((1.0 if part == "S" else L) / (1.0 + L)) / ratio)
 
     lo, hi = (math.log10(f_band), math.log10(f_band) + 4.0) if part == "S" else (math.log10(f_band) - 6.0,

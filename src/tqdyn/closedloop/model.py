@@ -43,7 +43,8 @@ class ClosedLoopModel:
     loops : list over satellites of lists of (t_start [s], ClosedLoop), one per segment.
     noise : {source: AsdModel}; mission : str; settings : dict
     (:meth:`tqdyn.scenario.closed_loop.ClosedLoopConfig.settings`: fs [Hz], duration [s] or None, seed,
-    segment [s], f_min, f_max [Hz], n_freq, attitude_z_sensor, scheme (resolved)); satellite_names : tuple; t_span : (t0, t1) [s].
+    segment [s], f_min, f_max [Hz], n_freq, attitude_z_sensor, scheme (resolved)); satellite_names : tuple;
+    t_span : (t0, t1) [s].
     parts : list over satellites of lists (one per segment, as ``loops``) of (PlantParameters,
     WorkingPoint) the loops were built from; controllers : {loop: Controller} (to rebuild a loop with
     changed parameters, e.g. without cross-talk).

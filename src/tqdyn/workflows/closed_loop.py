@@ -90,6 +90,9 @@ def _static_job(mission, out, dur, rate, seed, overrides) -> ClosedLoopJob:
     from ..scenario.loader import closed_loop_config
 
     cfg = closed_loop_config({"mission": mission}, overrides)
+    if cfg.raw.get("mission") != mission:
+        raise ValueError(f"--set closed_loop.mission={cfg.raw.get('mission')!r}: conflicts with --mission {mission!r}; "
+                         "allowed: the mission in --mission only")
     model = static_closed_loop_model(cfg, validate=True)
     s = model.settings
     dur = dur if dur is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
