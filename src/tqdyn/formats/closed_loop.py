@@ -50,8 +50,9 @@ ROOT_ATTRS = {
     "format": f'str, always "{FORMAT}"',
     "format_version": f"int, {FORMAT_VERSION}",
     "tqdyn_version": "str, version of tqdyn that wrote the file",
-    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji"',
-    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise",
+    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji" | "lpf" | "tianqin-1"',
+    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise; "
+                   "the source_* attributes are empty (0) for a mission's static working point (--mission)",
     "source_path": "str, absolute path of that file when the closed loop was computed",
     "source_sha256": "str, SHA-256 of the trajectory file's bytes",
     "source_scenario_sha256": "str, SHA-256 of the run's resolved scenario (its root attribute scenario, UTF-8)",

@@ -44,6 +44,7 @@ from .config import (
 
 __all__ = [
     "builtin_scenarios",
+    "closed_loop_config",
     "load_scenario",
     "loads_scenario",
     "parse_duration",
@@ -306,6 +307,20 @@ def _closed_loop_from_raw(table: Any) -> ClosedLoopConfig:
         if key in table:
             table[key] = _parse_duration(table[key], f"closed_loop.{key}")
     return ClosedLoopConfig(raw=table)
+
+
+def closed_loop_config(table: Any = None, overrides: Sequence[str] = ()) -> ClosedLoopConfig:
+    """A validated :class:`ClosedLoopConfig` from a ``[closed_loop]`` table (a dict, e.g. ``{"mission": "lpf"}``)
+    and ``--set closed_loop.KEY=VALUE`` overrides, without a scenario (the closed loop of a mission's static
+    working point, ``tqdyn closed-loop --mission``).  ScenarioError (one line naming the key) otherwise."""
+    raw = {"closed_loop": dict(table or {})}
+    for item in ((overrides,) if isinstance(overrides, str) else overrides):
+        if not isinstance(item, str) or "=" not in item or not item.split("=", 1)[0].strip().startswith("closed_loop."):
+            raise ScenarioError("override", item, "is not a closed-loop key=value",
+                                "closed_loop.KEY=VALUE (docs/scenarios.md#closed-loop)")
+        key, text = item.split("=", 1)
+        _closed_loop_override(raw, key.strip(), text)
+    return _closed_loop_from_raw(raw["closed_loop"])
 
 
 def _closed_loop_override(raw: dict, key: str, text: str) -> None:
