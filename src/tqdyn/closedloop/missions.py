@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from .._choices import unknown
 from ..scenario.closed_loop import MISSIONS
 from .controllers import Controller, lead_lag_pid
 from .noise import AsdModel
@@ -38,7 +39,7 @@ CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitu
 
 def _check(mission: str) -> None:
     if mission not in MISSIONS:
-        raise ValueError(f"closed_loop.mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+        raise ValueError(unknown("closed_loop.mission", mission, MISSIONS, problem="is not a mission"))
 
 
 def default_plant(mission: str) -> dict:

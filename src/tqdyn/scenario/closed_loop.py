@@ -33,7 +33,7 @@ from decimal import Decimal
 from typing import Any
 
 from .toml_text import toml_str, toml_value
-from .values import ScenarioError, _require
+from .values import ScenarioError, _require, _require_choice, _unknown_key
 
 __all__ = ["CLOSED_LOOP_KEYS", "LOOP_NAMES", "MISSIONS", "PLANT_KEYS", "SOURCE_UNITS", "ClosedLoopConfig",
            "check_asd", "check_controller"]
@@ -56,6 +56,8 @@ CLOSED_LOOP_KEYS = {"mission": "string", "fs": "number", "duration": "duration",
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1}
 _POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia")
+#: Where the keys, loops and noise sources are listed.
+_DOC = "docs/scenarios.md#closed_loop"
 
 
 def _num(v) -> bool:
@@ -75,11 +77,12 @@ class ClosedLoopConfig:
         allowed = tuple(CLOSED_LOOP_KEYS) + ("plant", "controllers", "noise")
         for key, v in raw.items():
             name = f"closed_loop.{key}"
-            _require(key in allowed, name, v, "is not a known key", ", ".join(allowed))
+            if key not in allowed:
+                raise _unknown_key(name, allowed, _DOC)
             if key == "mission":
-                _require(v in MISSIONS, name, v, "is not a mission", ", ".join(MISSIONS))
+                _require_choice(v, name, MISSIONS, problem="is not a mission")
             elif key == "attitude_z_sensor":
-                _require(v in ("dws", "star_tracker"), name, v, "is not a sensor", "'dws', 'star_tracker'")
+                _require_choice(v, name, ("dws", "star_tracker"), problem="is not a sensor")
             elif key in ("fs", "f_min", "f_max"):
                 _require(_num(v) and float(v) > 0, name, v, "is not a positive number", "a frequency > 0 Hz")
             elif key in ("seed", "n_freq"):
@@ -91,7 +94,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.plant]")
                 for pk, pv in v.items():
                     pname = f"{name}.{pk}"
-                    _require(pk in PLANT_KEYS, pname, pv, "is not a plant key", ", ".join(PLANT_KEYS))
+                    if pk not in PLANT_KEYS:
+                        raise _unknown_key(pname, tuple(PLANT_KEYS), _DOC, "is not a plant key")
                     n = PLANT_KEYS[pk]
                     ok = _num(pv) if n == 1 else (isinstance(pv, list) and len(pv) == n and all(_num(x) for x in pv))
                     _require(ok, pname, pv, "is not valid", "a number" if n == 1 else f"{n} numbers")
@@ -104,7 +108,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.controllers.<loop>]")
                 for loop, spec in v.items():
                     lname = f"{name}.{loop}"
-                    _require(loop in LOOPS, lname, spec, "is not a loop", ", ".join(LOOPS))
+                    if loop not in LOOPS:
+                        raise _unknown_key(lname, LOOPS, _DOC, "is not a loop")
                     _require(isinstance(spec, dict) and set(spec) <= {"zeros", "poles", "gain"}, lname, spec,
                              "is not a controller table", "zeros, poles, gain")
                     self._controller(loop, spec)
@@ -112,7 +117,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.noise.<source>]")
                 for src, spec in v.items():
                     sname = f"{name}.{src}"
-                    _require(src in SOURCES, sname, spec, "is not a noise source", ", ".join(SOURCES))
+                    if src not in SOURCES:
+                        raise _unknown_key(sname, tuple(SOURCES), _DOC, "is not a noise source", noun="sources")
                     _require(isinstance(spec, dict) and set(spec) <= {"level", "knees"}, sname, spec,
                              "is not a noise table", "level, knees")
                     self._asd(src, spec)

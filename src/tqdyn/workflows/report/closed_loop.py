@@ -28,6 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..._choices import unknown
 from ...analysis.closed_loop import BANDS, closed_loop_model
 from ...analysis.figures_closed_loop import (plot_budget_stack, plot_link_budget, plot_loop_gains,
                                              plot_residual_acceleration, plot_ttl_sources)
@@ -163,7 +164,7 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
     say = progress or (lambda msg: None)
     for m in missions:
         if m not in MISSIONS:
-            raise ValueError(f"mission: {m!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+            raise ValueError(unknown("mission", m, MISSIONS, problem="is not a mission"))
     rep = Report(out_dir=check_out_dir(out_dir))
     fig_dir = check_out_dir(rep.out_dir / "closed-loop")
     rep.values = {"frequencies_hz": list(FREQUENCIES_HZ), "link_frequencies_hz": list(LINK_FREQUENCIES_HZ),
