@@ -1,5 +1,6 @@
-"""What the ``tqdyn`` commands share: exit statuses, the one-line error and
-the overrides of the scenario shortcut options (``run``, ``forces``)."""
+"""What the ``tqdyn`` commands share: exit statuses, the one-line error, the
+choice option type whose refusal suggests the closest choice, and the
+overrides of the scenario shortcut options (``run``, ``forces``)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,10 @@ import sys
 
 import click
 
-__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_IO", "EXIT_INTERRUPTED", "EXIT_SIGHUP", "EXIT_SIGTERM", "fail"]
+from .._choices import allowed, did_you_mean
+
+__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_IO", "EXIT_INTERRUPTED", "EXIT_SIGHUP", "EXIT_SIGTERM", "Choice",
+           "fail"]
 
 #: some work failed (a sweep member, a study run) after the rest was written
 EXIT_FAILED = 1
@@ -29,6 +33,19 @@ def fail(message: str, status: int = EXIT_BAD_INPUT):
     """Print ``tqdyn: error: <message>`` on stderr and exit with ``status``."""
     click.echo(f"tqdyn: error: {message}", err=True)
     sys.exit(status)
+
+
+class Choice(click.Choice):
+    """``click.Choice`` whose refusal is one short line (:mod:`tqdyn._choices`):
+    the closest choices and, for a long list, the page ``doc`` that lists them."""
+
+    def __init__(self, choices, doc: str | None = None, **kwargs):
+        super().__init__(choices, **kwargs)
+        self.doc = doc
+
+    def get_invalid_choice_message(self, value, ctx) -> str:
+        names = list(self._normalized_mapping(ctx=ctx).values())
+        return f"{value!r} is not allowed{did_you_mean(value, names)}; allowed: {allowed(names, self.doc, quote=repr)}"
 
 
 def _overrides(sets, duration, step, output, precision) -> list[str]:

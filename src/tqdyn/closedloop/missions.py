@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from .._choices import unknown
+
 from ..scenario.closed_loop import (CONSTELLATION_MISSIONS, MISSIONS, PLANT_KEYS, SCHEME_LOOPS,
                                     SINGLE_SPACECRAFT_MISSIONS)
 from .controllers import Controller, lead_lag_pid
@@ -46,7 +48,7 @@ CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitu
 
 def _check(mission: str) -> None:
     if mission not in MISSIONS:
-        raise ValueError(f"closed_loop.mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+        raise ValueError(unknown("closed_loop.mission", mission, MISSIONS, problem="is not a mission"))
 
 
 def default_plant(mission: str) -> dict:

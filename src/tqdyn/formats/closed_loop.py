@@ -382,8 +382,8 @@ def read_closed_loop(path) -> ClosedLoopFile:
             fmt, ver = attrs.get("format"), attrs.get("format_version")
             if fmt != FORMAT:
                 raise ClosedLoopFormatError(
-                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} with "
-                    f"format_version <= {FORMAT_VERSION} (a file written by tqdyn closed-loop)")
+                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} "
+                    "(written by tqdyn closed-loop)")
             if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
                 raise ClosedLoopFormatError(f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; "
                                             f"expected an int 1..{FORMAT_VERSION}")

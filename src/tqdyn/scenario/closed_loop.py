@@ -39,7 +39,7 @@ from typing import Any
 
 from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
-from .values import ScenarioError, _one_of, _require
+from .values import ScenarioError, _require, _require_choice, _unknown_key
 
 __all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "COLLINEAR_LOOPS", "CONSTELLATION_MISSIONS", "DEFAULT_SERIES_S",
            "LOOPS", "MISSIONS", "MISSION_SCHEME", "PLANT_KEYS", "SCHEMES", "SCHEME_LOOPS", "SINGLE_SPACECRAFT_MISSIONS",
@@ -131,6 +131,8 @@ PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_i
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1, "tm2_stiffness": 3,
               "tm2_rotational_stiffness": 3, "tm_separation": 1}
 _POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia", "tm_separation")
+#: Where the keys, loops and noise sources are listed.
+_DOC = "docs/scenarios.md#closed_loop"
 
 
 def _num(v) -> bool:
@@ -149,13 +151,14 @@ class ClosedLoopConfig:
         allowed = tuple(CLOSED_LOOP_KEYS) + ("plant", "controllers", "noise")
         for key, v in raw.items():
             name = f"closed_loop.{key}"
-            _require(key in allowed, name, v, "is not a known key", ", ".join(allowed))
+            if key not in allowed:
+                raise _unknown_key(name, allowed, _DOC)
             if key == "mission":
-                _require(v in MISSIONS, name, v, "is not a mission", ", ".join(MISSIONS))
+                _require_choice(v, name, MISSIONS, problem="is not a mission")
             elif key == "scheme":
-                _require(v in SCHEMES, name, v, "is not a control scheme", ", ".join(SCHEMES))
+                _require_choice(v, name, SCHEMES, problem="is not a control scheme")
             elif key == "attitude_z_sensor":
-                _require(v in ATTITUDE_Z_SENSORS, name, v, "is not a sensor", _one_of(ATTITUDE_Z_SENSORS))
+                _require_choice(v, name, ATTITUDE_Z_SENSORS, problem="is not a sensor")
             elif key in ("fs", "f_min", "f_max"):
                 _require(_num(v) and float(v) > 0, name, v, "is not a positive number", "a frequency > 0 Hz")
             elif key in ("seed", "n_freq"):
@@ -167,7 +170,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.plant]")
                 for pk, pv in v.items():
                     pname = f"{name}.{pk}"
-                    _require(pk in PLANT_KEYS, pname, pv, "is not a plant key", ", ".join(PLANT_KEYS))
+                    if pk not in PLANT_KEYS:
+                        raise _unknown_key(pname, tuple(PLANT_KEYS), _DOC, "is not a plant key")
                     n = PLANT_KEYS[pk]
                     ok = _num(pv) if n == 1 else (isinstance(pv, list) and len(pv) == n and all(_num(x) for x in pv))
                     _require(ok, pname, pv, "is not valid", "a number" if n == 1 else f"{n} numbers")
@@ -181,8 +185,8 @@ class ClosedLoopConfig:
                 loops = SCHEME_LOOPS[self.scheme()]
                 for loop, spec in v.items():
                     lname = f"{name}.{loop}"
-                    _require(loop in loops, lname, spec, f"is not a loop of the {self.scheme()!r} scheme",
-                             ", ".join(loops))
+                    if loop not in loops:
+                        raise _unknown_key(lname, loops, _DOC, f"is not a loop of the {self.scheme()!r} scheme")
                     _require(isinstance(spec, dict) and set(spec) <= {"zeros", "poles", "gain"}, lname, spec,
                              "is not a controller table", "zeros, poles, gain")
                     self._controller(loop, spec)
@@ -190,7 +194,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.noise.<source>]")
                 for src, spec in v.items():
                     sname = f"{name}.{src}"
-                    _require(src in SOURCES, sname, spec, "is not a noise source", ", ".join(SOURCES))
+                    if src not in SOURCES:
+                        raise _unknown_key(sname, tuple(SOURCES), _DOC, "is not a noise source", noun="sources")
                     _require(isinstance(spec, dict) and set(spec) <= {"level", "knees"}, sname, spec,
                              "is not a noise table", "level, knees")
                     self._asd(src, spec)

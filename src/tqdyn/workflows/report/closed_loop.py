@@ -28,6 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..._choices import unknown
 from ...analysis.closed_loop import BANDS
 from ...analysis.closed_loop_paths import DC_SUSPENSION_LIMIT, dc_paths
 from ...analysis.figures_closed_loop import (plot_budget_stack, plot_link_budget, plot_loop_gains,
@@ -164,8 +165,7 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=CONSTELLATION_MISSIO
     say = progress or (lambda msg: None)
     for m in missions:
         if m not in CONSTELLATION_MISSIONS:
-            raise ValueError(f"mission: {m!r} is not a constellation mission; "
-                             f"allowed: {', '.join(CONSTELLATION_MISSIONS)}")
+            raise ValueError(unknown("mission", m, CONSTELLATION_MISSIONS, problem="is not a constellation mission"))
     rep = Report(out_dir=check_out_dir(out_dir))
     fig_dir = check_out_dir(rep.out_dir / "closed-loop")
     rep.values = {"frequencies_hz": list(FREQUENCIES_HZ), "link_frequencies_hz": list(LINK_FREQUENCIES_HZ),
