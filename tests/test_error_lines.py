@@ -228,7 +228,7 @@ def test_the_keys_section_lists_every_key_and_name():
 
     pages = _slugs(ROOT / "docs" / "scenarios.md")
     tables = {**{t: keys for t, keys in _SCHEMA.items()}, "satellites": _SAT_SCHEMA,
-              "closed_loop": (*cl.CLOSED_LOOP_KEYS, *cl.PLANT_KEYS, *cl.LOOP_NAMES, *cl.SOURCE_UNITS),
+              "closed_loop": (*cl.CLOSED_LOOP_KEYS, *cl.PLANT_KEYS, *{k for loops in cl.SCHEME_LOOPS.values() for k in loops}, *cl.SOURCES),
               "keys": _TOP_KEYS}
     tables["forces"] = (*tables["forces"], *THIRD_BODIES)
     missing = [f"{t}: {k}" for t, keys in tables.items() for k in keys

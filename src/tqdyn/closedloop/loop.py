@@ -331,10 +331,9 @@ def _constellation_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_senso
     yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
     det = float(np.dot(e_S[0], np.cross(e_S[1], [0.0, 0.0, 1.0])))
     if abs(det) < MIN_AXES_DETERMINANT or abs(np.linalg.det(yoa[:, :2])) < MIN_AXES_DETERMINANT:
-        raise ValueError(f"closed_loop.scheme: 'constellation' cannot control test masses whose sensitive axes "
-                         f"are parallel (|e_1 . (e_2 x Z_S)| = {abs(det):.3g}): the two DWS pitches then measure "
-                         "one angle, the rotation about the TM line is unobservable; allowed: 'collinear' "
-                         "(the TMs and the star tracker, LISA Pathfinder's modes)")
+        raise ValueError(f"closed_loop.scheme: 'constellation' cannot control parallel sensitive axes "
+                         f"(|e_1 . (e_2 x Z_S)| = {abs(det):.3g}): the rotation about the TM line is unobservable; "
+                         "allowed: 'collinear' (TMs + star tracker)")
     return _sensors(basis, yoa, attitude_z_sensor), _constellation_commands(p, basis, e_S)
 
 
