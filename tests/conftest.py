@@ -227,6 +227,22 @@ def _mpmath_precision_unchanged():
 _DEFAULT_RUN: dict = {}
 
 
+@pytest.fixture(autouse=True)
+def _cli_error_lines_short(monkeypatch, tmp_path_factory):
+    """Every ``tqdyn: error:`` line printed in-process during a test is at most
+    ``cli_support.MAX_ERROR_LINE`` characters (docs/reliability.md, "Error messages";
+    a path under the temporary directory counts as one under ``/home/user``):
+    ``click.echo`` is watched, and a longer line fails the test at teardown."""
+    import click
+    from cli_support import MAX_ERROR_LINE, ErrorLineWatch
+
+    watch = ErrorLineWatch(tmp_path_factory.getbasetemp())
+    monkeypatch.setattr(click, "echo", watch.echo)
+    yield watch
+    assert not watch.too_long, (f"error line(s) over {MAX_ERROR_LINE} characters: "
+                                + " | ".join(f"{len(ln)}: {ln}" for ln in watch.too_long))
+
+
 @pytest.fixture(scope="session")
 def default_run(tmp_path_factory):
     """``tqdyn run -q`` with no scenario argument -- the README's main job: the built-in ``tianqin`` scenario (full

@@ -213,3 +213,33 @@ def test_a_version_1_file_is_read_into_the_new_layout(budget_file, tmp_path):
     assert np.all(upper[v == 2.0] == 2.0) and np.all(np.isnan(lower[v == 2.0]))
     assert np.all(lower[np.isinf(v)] == 0.0) and np.all(np.isinf(upper[np.isinf(v)]))
     assert np.array_equal(b["gain_margin"].values, b["gain_margin_lower"].values, equal_nan=True)
+
+
+def test_collinear_scheme_stacked_as_interconnected_and_evaluated_as_per_loop():
+    """LISA Pathfinder's "collinear" loops through the stacked engine: the matrices equal python-control's
+    interconnect of the same named blocks to 1e-15 of their largest entry (measured 2.3e-16), and noise_asd
+    equals the LU evaluation of the state space (noise_budget) to 1e-6 of the output's total for the outputs
+    computed by cancellation (_CANCELLING; measured 7.1e-7), 1e-7 for the spacecraft's position (free and
+    Hill modes at low frequencies; measured 2.1e-8) and 5e-9 for the rest (measured 1.1e-9).  "single_tm"
+    (TianQin-1, a sensor reading a controller's output) is refused by the stacked engine in one line."""
+    from tqdyn.closedloop.model import static_closed_loop_model
+
+    m = static_closed_loop_model("lpf")
+    assert m.stack is not None and static_closed_loop_model("tianqin-1").stack is None
+    p, wp = m.parts[0][0]
+    z = m.settings["attitude_z_sensor"]
+    st = frequency.stack_loops([(p, wp)], m.controllers, z, "collinear")
+    cl = build_closed_loop(p, wp, m.controllers, z, "collinear")
+    mine = frequency.closed_loops(st)[0].system
+    assert mine.state_labels == cl.system.state_labels and mine.output_labels == cl.system.output_labels
+    for a, b in zip((mine.A, mine.B, mine.C, mine.D), (cl.system.A, cl.system.B, cl.system.C, cl.system.D)):
+        assert np.max(np.abs(a - b)) <= 1e-15 * np.max(np.abs(b))
+    new, src = frequency.noise_asd(st, [0], m.noise, F)
+    old, src_old = noise_budget(cl, m.noise, F)
+    assert src == src_old
+    total = np.sqrt(np.sum(old ** 2, axis=1))[:, None, :]
+    err = np.max(np.abs(new[0] - old) / np.where(total > 0, total, 1.0), axis=(1, 2))
+    for o, e in zip(output_names(), err):
+        assert e <= (1e-6 if o in _CANCELLING else 1e-7 if o.startswith("sc_position") else 5e-9), (o, e)
+    with pytest.raises(ValueError, match=r"^closed_loop\.scheme: 'single_tm' [^\n]*$"):
+        frequency.stack_loops([(p, wp)], m.controllers, z, "single_tm")

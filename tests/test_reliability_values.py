@@ -140,8 +140,7 @@ def _stop(sets, v, duration="6h"):
     exc = info.value
     assert exc.body == 1 and exc.step >= 1, str(exc)
     assert str(exc) == (f"propagation: the state of 'Sat2' is not finite at step {exc.step} (t = {exc.t:.9g} s TT after "
-                        "the epoch); stopped there: a force, an acceleration or an initial state of the scenario is "
-                        "out of range")
+                        "the epoch): a force, acceleration or initial state is out of range")
     return exc
 
 

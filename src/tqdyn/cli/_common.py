@@ -1,6 +1,6 @@
 """What the ``tqdyn`` commands share: exit statuses, the one-line error, the one mechanism every
-writing command runs its work in (:func:`guarded`: signals, a full disk) and the overrides of the
-scenario shortcut options (``run``, ``forces``)."""
+writing command runs its work in (:func:`guarded`: signals, a full disk), the choice option type whose
+refusal suggests the closest choice, and the overrides of the scenario shortcut options (``run``, ``forces``)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,10 @@ import sys
 
 import click
 
-__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_IO", "EXIT_INTERRUPTED", "EXIT_SIGHUP", "EXIT_SIGTERM", "fail",
-           "fail_io", "guarded"]
+from .._choices import allowed, did_you_mean
+
+__all__ = ["EXIT_FAILED", "EXIT_BAD_INPUT", "EXIT_IO", "EXIT_INTERRUPTED", "EXIT_SIGHUP", "EXIT_SIGTERM", "Choice",
+           "fail", "fail_io", "guarded"]
 
 #: some work failed (a sweep member, a study run) after the rest was written
 EXIT_FAILED = 1
@@ -120,6 +122,19 @@ def guarded(note=_no_note, *, bad_input=(), cleanup=None, deferred: bool = False
         for s, h in old.items():
             signal.signal(s, h)
         clear_stop()
+
+
+class Choice(click.Choice):
+    """``click.Choice`` whose refusal is one short line (:mod:`tqdyn._choices`):
+    the closest choices and, for a long list, the page ``doc`` that lists them."""
+
+    def __init__(self, choices, doc: str | None = None, **kwargs):
+        super().__init__(choices, **kwargs)
+        self.doc = doc
+
+    def get_invalid_choice_message(self, value, ctx) -> str:
+        names = list(self._normalized_mapping(ctx=ctx).values())
+        return f"{value!r} is not allowed{did_you_mean(value, names)}; allowed: {allowed(names, self.doc, quote=repr)}"
 
 
 def _overrides(sets, duration, step, output, precision) -> list[str]:

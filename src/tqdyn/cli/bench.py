@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from ._common import fail as _fail, guarded
+from ._common import Choice, fail as _fail, guarded
 
 __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
@@ -54,7 +54,7 @@ def _check_json_path(path) -> Path:
                    "365d].")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s] of the kepler model.")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
-@click.option("--model", "which", type=click.Choice(MODELS + ("all",)), multiple=True,
+@click.option("--model", "which", type=Choice(MODELS + ("all",), doc="docs/commands.md#tqdyn-bench"), multiple=True,
               help="kepler: monopole only; full: the full force model, pure gravity (and the reduced model vs "
                    "heyoka); coupled: the full coupled run (attitude + drag-free control); lisa: the heliocentric "
                    "lisa-esa scenario (ESA's orbits and force model, point masses); lisa-coupled: the coupled "

@@ -1,5 +1,6 @@
 """Command line: ``tqdyn closed-loop RUN.h5 --output CL.h5 [--duration D] [--fs HZ] [--seed N] [--set ...]
-[--per-source]``.
+[--per-source]``, or ``tqdyn closed-loop --mission NAME --output CL.h5 [...]`` (a mission's static working
+point, no run).
 
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.closed_loop`: the inputs are
 resolved and checked first (bad input: status 2, one line, nothing written), then the budget and the
@@ -44,7 +45,9 @@ class _Bars:
 
 
 @click.command("closed-loop")
-@click.argument("run_file", metavar="RUN.h5")
+@click.argument("run_file", metavar="[RUN.h5]", required=False)
+@click.option("--mission", help="Instead of RUN.h5: the mission's static working point (lpf, tianqin-1, or a "
+                                "constellation mission's representative point; docs/closed-loop.md).")
 @click.option("--output", "-o", required=True, help="Output closed-loop HDF5 file (replaced only by a complete one).")
 @click.option("--duration", help="Length of the time series: seconds, or with a unit: 3d, 6h, 30min, 3600s "
                                  "[default: closed_loop.duration, else the run's first day (its span if shorter)].")
@@ -56,11 +59,12 @@ class _Bars:
 @click.option("--per-source", is_flag=True, help="Also write the ASD of every output from every noise source "
                                                 "(/budget/asd; the totals and dominant sources are always written).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bars.")
-def closed_loop(run_file, output, duration, fs, seed, sets, per_source, quiet):
-    """The closed loop of the coupled run RUN.h5 (any mission): the drag-free, suspension, attitude
-    and MOSA loops linearised around the run's working point (docs/closed-loop.md), their noise
-    budget, margins and dominant sources, and seeded time series of every output per spacecraft,
-    streamed to the closed-loop file CL.h5 (docs/closed-loop-file.md)."""
+def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source, quiet):
+    """The closed loop of the coupled run RUN.h5 (any mission), or of a mission's static working point
+    (--mission, e.g. lpf or tianqin-1): the drag-free, suspension, attitude and MOSA loops linearised
+    around the working point (docs/closed-loop.md), their noise budget, margins and dominant sources,
+    and seeded time series of every output per spacecraft, streamed to the closed-loop file CL.h5
+    (docs/closed-loop-file.md)."""
     from tqdm import tqdm
 
     from ..formats import trajectory as io
@@ -68,9 +72,10 @@ def closed_loop(run_file, output, duration, fs, seed, sets, per_source, quiet):
 
     with guarded(bad_input=(ValueError, FileNotFoundError, io.OutputError)):
         job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets,
-                                          per_source=per_source)
+                                          per_source=per_source, mission=mission)
     n = job.attrs["n_samples"]
-    click.echo(f"tqdyn closed-loop: {job.attrs['source_file']}, mission {job.model.mission}, "
+    where = job.attrs["source_file"] or "static working point"
+    click.echo(f"tqdyn closed-loop: {where}, mission {job.model.mission}, "
                f"{len(job.model.loops)} spacecraft x {len(job.model.loops[0])} segment(s); time series "
                f"{job.duration_s:g} s at {job.fs:g} Hz ({n} samples), seed {job.seed}", err=True)
     n_loops = len(job.model.loops) * len(job.model.loops[0])

@@ -38,7 +38,7 @@ import click
 
 from .._version import __version__
 from ._common import EXIT_FAILED as _EXIT_RUN_FAILED
-from ._common import fail as _fail, guarded
+from ._common import Choice, fail as _fail, guarded
 
 __all__ = ["report"]
 
@@ -54,7 +54,7 @@ __all__ = ["report"]
               help="The default closed-loop designs of the three missions at the working points of short coupled "
                    "runs: budget stacks, loop gains with margins, residual TM acceleration (docs/closed-loop.md), "
                    "single-link TTL budgets (docs/tilt-to-length.md).")
-@click.option("--mission", type=click.Choice(["tianqin", "lisa"]), default=None,
+@click.option("--mission", type=Choice(["tianqin", "lisa"]), default=None,
               help="With --studies: the study set, tianqin (the paper's section V, default) or lisa (the same "
                    "studies on LISA and Taiji, one-year runs).")
 @click.option("--runs-dir", metavar="DIR", help="With --studies: directory of the study runs (default: OUT/runs).")

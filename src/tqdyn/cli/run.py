@@ -18,7 +18,7 @@ import sys
 import click
 
 from .._version import __version__
-from ._common import _overrides, fail as _fail, guarded
+from ._common import Choice, _overrides, fail as _fail, guarded
 
 __all__ = ["run"]
 
@@ -57,7 +57,7 @@ def _checkpoint_interval(text) -> float:
 @click.option("--duration", help="Propagation span: seconds, or with a unit: 90d, 12h, 30min, 3600s.")
 @click.option("--step", help="Integrator step [s] (fixed mode) or output interval (adaptive mode).")
 @click.option("--output", "-o", help="Output HDF5 trajectory file.")
-@click.option("--precision", type=click.Choice(["dd", "float64"]), help="Arithmetic of the propagation.")
+@click.option("--precision", type=Choice(["dd", "float64"]), help="Arithmetic of the propagation.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
               help="Override a scenario value, e.g. --set integrator.mode=adaptive or "
                    "--set satellites.2.nu_deg=151 (repeatable).")

@@ -219,9 +219,10 @@ def check_stable(cl: ClosedLoop, tol: float = 1e-9) -> None:
     worst = min(ms, key=lambda m: (m.phase_margin if math.isfinite(m.phase_margin) else -1e9))
     loop = worst.channel.split("[")[0]
     raise DesignError(f"closed_loop.controllers.{loop}",
-                      f"the closed loop is unstable (pole at Re = {np.max(ev.real):.3g} 1/s; channel {worst.channel}: "
-                      f"phase margin {worst.phase_margin:.3g} deg, gain margin {worst.gain_margin:.3g}); "
-                      "allowed: a stabilising design (docs/closed-loop.md)")
+                      f"the closed loop is unstable (pole Re = {np.max(ev.real):.3g} 1/s; {worst.channel}: "
+                      f"phase margin {worst.phase_margin:.3g} deg" + (f", gain margin {worst.gain_margin:.3g}"
+                                                                      if math.isfinite(worst.gain_margin) else "")
+                      + "); allowed: a stabilising design (docs/closed-loop.md)")
 
 
 def _first_min_per_row(rows, key, n_rows):

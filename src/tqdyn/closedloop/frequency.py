@@ -9,7 +9,8 @@ static observables z = Oy y + Ou u (w the noise inputs, d the loop breaks, z the
 
 * :func:`stack_loops` collects these blocks for many working points (``LoopStack``, a first axis over the
   loops) and :func:`closed_loop_matrices` joins them into the closed loops' state-space matrices (the plant's
-  40 states, then the controllers'; inputs w then d; outputs z then c), the same matrices as
+  40 states, then the controllers'; inputs w then d; outputs z, then c, then
+  the in-loop coordinates e), the same matrices as
   python-control's ``interconnect`` of the named blocks, without its per-loop numerical linearisation.
 * :func:`noise_asd` and :func:`loop_gains` evaluate the closed loops at s = i 2 pi f without their
   74 states: eliminating u, y, e and c leaves one 20 x 20 complex system per loop and frequency,
@@ -32,15 +33,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scenario.closed_loop import ATTITUDE_Z_SENSORS, check_controller
-from .controllers import LOOPS
+from ..scenario.closed_loop import SCHEME_LOOPS
 from .loop import SOURCES, ClosedLoop, channel_names, controller_realisations, loop_blocks, output_names, \
     source_inputs
 
-__all__ = ["LoopStack", "NOISE_INPUTS", "closed_loop_matrices", "closed_loops", "controller_response", "loop_gains",
-           "noise_asd", "stack_loops", "unstable_loops"]
+__all__ = ["LoopStack", "NOISE_INPUTS", "STACKED_SCHEMES", "closed_loop_matrices", "closed_loops",
+           "controller_response", "loop_gains", "noise_asd", "stack_loops", "unstable_loops"]
 
 #: The noise inputs w of a closed loop, in order (sources of :data:`SOURCES`, their components).
 NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
+#: Control schemes whose sensors read only plant outputs and noise (e = Sy y + Sw w), the form this module
+#: stacks.  "single_tm" is not one: its drag-free error is the suspension controller's output (TianQin-1's
+#: accelerometer mode), so its loops are built one at a time (build_closed_loop) and its budget takes the
+#: per-loop path (tqdyn.closedloop.budget.noise_budget).
+STACKED_SCHEMES = ("constellation", "collinear")
 #: Complex numbers held at once per evaluation chunk (bounds the memory: 16 bytes each).
 _CHUNK_ELEMENTS = 1_500_000
 
@@ -91,21 +97,29 @@ def _rows(D, names, wanted) -> np.ndarray:
     return D[[idx[s] for s in wanted]]
 
 
-def stack_loops(parts, controllers: dict, attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0]) -> LoopStack:
+def stack_loops(parts, controllers: dict, attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0],
+                scheme: str = "constellation") -> LoopStack:
     """The :class:`LoopStack` of the closed loops of ``parts`` (a sequence of (PlantParameters, WorkingPoint))
-    with the ``controllers`` ({loop: Controller}) and the attitude-z sensor (``loop_blocks``)."""
-    chans = channel_names()
+    with the ``controllers`` ({loop: Controller}), the attitude-z sensor and the control ``scheme``
+    (``loop_blocks``; one of :data:`STACKED_SCHEMES`).  ValueError (one line) otherwise."""
+    if scheme not in STACKED_SCHEMES:
+        raise ValueError(f"closed_loop.scheme: {scheme!r} has sensors reading controller outputs; allowed here: "
+                         f"{', '.join(STACKED_SCHEMES)} (build its loops one at a time: build_closed_loop)")
+    loops = SCHEME_LOOPS[scheme]
+    chans = channel_names(scheme)
     E, Cn, Dn = [f"e_{c}" for c in chans], [f"c_{c}" for c in chans], [f"d_{c}" for c in chans]
     outs = output_names()
     keys = ("A", "B", "C", "D", "Sy", "Sw", "Ac", "Ad", "Aw", "Oy", "Ou")
     acc = {k: [] for k in keys}
     dc, names = [], None
     for p, wp in parts:
-        b = loop_blocks(p, wp, attitude_z_sensor)
+        b = loop_blocks(p, wp, attitude_z_sensor, scheme)
         A, B, C, D, pin, pout, pst = b["plant"]
         names = (tuple(pin), tuple(pout), tuple(pst))
         sD, sin, sout = b["sensors"]
         sD = _rows(sD, sout, E)
+        if np.any(_columns(sD, sin, [s for s in sin if s not in pout and s not in NOISE_INPUTS])):
+            raise ValueError("closed loop: a sensor reads a signal that is neither a plant output nor a noise input")
         aD, ain, aout = b["actuators"]
         aD = _rows(aD, aout, pin)
         oD, oin, oout = b["observables"]
@@ -124,12 +138,13 @@ def stack_loops(parts, controllers: dict, attitude_z_sensor: str = ATTITUDE_Z_SE
     if np.any(np.einsum("sij,sjk->sik", st["Sy"], st["D"])):
         raise ValueError("closed loop: a sensor reads a plant output with direct feed-through (an algebraic loop)")
     zpk = []
-    for loop, (channels, *_r) in LOOPS.items():
+    realisations = tuple(controller_realisations(controllers, loops))
+    for loop, (channels, *_r) in loops.items():
         c = controllers[loop]
         zpk += [check_controller(c.name, list(c.zeros), list(c.poles), c.gain)] * len(channels)
     return LoopStack(plant=(st["A"], st["B"], st["C"], st["D"]), Sy=st["Sy"], Sw=st["Sw"], Ac=st["Ac"], Ad=st["Ad"],
                      Aw=st["Aw"], Oy=st["Oy"], Ou=st["Ou"], derivative=deriv,
-                     controllers=tuple(controller_realisations(controllers)), zpk=tuple(zpk), dc_force=dc,
+                     controllers=realisations, zpk=tuple(zpk), dc_force=dc,
                      plant_names=names, channels=tuple(chans))
 
 
@@ -145,8 +160,9 @@ def _block_diag(mats) -> np.ndarray:
 
 
 def closed_loop_matrices(st: LoopStack) -> tuple:
-    """The closed loops' state-space matrices A (n, nx, nx), B (n, nx, 58 + 17), C (n, 46 + 17, nx),
-    D (n, 46 + 17, 58 + 17) (module docstring; the plant's states, then each channel's controller states)."""
+    """The closed loops' state-space matrices A (n, nx, nx), B (n, nx, 58 + nc), C (n, 46 + 2 nc, nx),
+    D (n, 46 + 2 nc, 58 + nc), nc the channels (17 for "constellation") (module docstring; the plant's states,
+    then each channel's controller states; outputs z, c, e)."""
     AP, BP, CP, DP = st.plant
     Ak, Bk, Ck, Dk = (_block_diag([c[i] for c in st.controllers]) for i in range(4))
     mm = np.matmul
@@ -160,10 +176,13 @@ def closed_loop_matrices(st: LoopStack) -> tuple:
                         np.concatenate([mm(Bk, SC), np.broadcast_to(Ak, (n, nk, nk))], axis=2)], axis=1)
     B = np.concatenate([np.concatenate([mm(BP, Uw), mm(BP, st.Ad)], axis=2),
                         np.concatenate([mm(Bk, st.Sw), np.zeros((n, nk, nd))], axis=2)], axis=1)
+    ne = SC.shape[1]
     C = np.concatenate([np.concatenate([mm(st.Oy, CP) + mm(Zu, Uxp), mm(Zu, Uxc)], axis=2),
-                        np.concatenate([mm(Dk, SC), np.broadcast_to(Ck, (n,) + Ck.shape)], axis=2)], axis=1)
+                        np.concatenate([mm(Dk, SC), np.broadcast_to(Ck, (n,) + Ck.shape)], axis=2),
+                        np.concatenate([SC, np.zeros((n, ne, nk))], axis=2)], axis=1)
     D = np.concatenate([np.concatenate([mm(Zu, Uw), mm(Zu, st.Ad)], axis=2),
-                        np.concatenate([mm(Dk, st.Sw), np.zeros((n, Dk.shape[0], nd))], axis=2)], axis=1)
+                        np.concatenate([mm(Dk, st.Sw), np.zeros((n, Dk.shape[0], nd))], axis=2),
+                        np.concatenate([st.Sw, np.zeros((n, ne, nd))], axis=2)], axis=1)
     return A, B, C, D
 
 
@@ -175,7 +194,7 @@ def closed_loops(st: LoopStack, matrices=None) -> list[ClosedLoop]:
     A, B, C, D = closed_loop_matrices(st) if matrices is None else matrices
     chans = list(st.channels)
     inputs = list(NOISE_INPUTS) + [f"d_{c}" for c in chans]
-    outputs = output_names() + [f"c_{c}" for c in chans]
+    outputs = output_names() + [f"c_{c}" for c in chans] + [f"e_{c}" for c in chans]
     states = [f"plant_{s}" for s in st.plant_names[2]]
     for c, (a, *_r) in zip(chans, st.controllers):
         states += [f"C_{c.replace('[', '_').rstrip(']')}_x[{i}]" for i in range(a.shape[0])]

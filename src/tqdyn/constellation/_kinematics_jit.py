@@ -116,6 +116,7 @@ from math import atan2, sqrt
 
 from numba import njit
 
+from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..numerics.vec3 import add as _add, axpy as _axpy, cross as _cross, dot as _dot
 from ..numerics.vec3 import row as _row, scale as _scale, sub as _sub
@@ -152,7 +153,7 @@ def law_code(name: str) -> int:
     try:
         return LAW_CODES[name]
     except (KeyError, TypeError):
-        raise ValueError(f"pointing law {name!r} is not allowed; allowed: {', '.join(LAW_CODES)}") from None
+        raise ValueError(unknown("pointing law", name, LAW_CODES)) from None
 
 
 # ------------------------------------------------------------------ jets

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._choices import unknown
+
 __all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
            "SCHEME_CODES", "TM_GRAVITY_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "empirical_of", "make_cpar", "workspace",
            "aux_views"]
@@ -28,7 +30,7 @@ PRECISIONS = ("dd", "float64")
 def check_precision(precision):
     """ValueError naming ``run.precision`` unless it is one of :data:`PRECISIONS`."""
     if precision not in PRECISIONS:
-        raise ValueError(f"run.precision: {precision!r} is not allowed; allowed: {', '.join(PRECISIONS)}")
+        raise ValueError(unknown("run.precision", precision, PRECISIONS))
 
 
 MODE_POINT_MASS = 0

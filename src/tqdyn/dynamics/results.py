@@ -116,8 +116,7 @@ class NonFiniteStateError(ValueError):
         who = repr(name) if name else f"body {self.body}"
         scale = f" {time_scale}" if time_scale else ""
         super().__init__(f"propagation: the state of {who} is not finite at step {self.step} (t = {self.t:.9g} s"
-                         f"{scale} after the epoch); stopped there: a force, an acceleration or an initial state of "
-                         "the scenario is out of range")
+                         f"{scale} after the epoch): a force, acceleration or initial state is out of range")
 
 
 def check_finite_states(n0: int, t: np.ndarray, y: np.ndarray) -> None:

@@ -43,6 +43,7 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
 from ..numerics.dd import add, const, div, mul, sqrt, sub
 from ..readers.gravity_fields import GravityModel, egm2008
@@ -464,7 +465,7 @@ def earth_field_accel_batch(r, tdat, params, part: str = "total") -> np.ndarray:
     """
     flags = {"total": (True, True), "static": (True, False), "tides": (False, True)}
     if part not in flags:
-        raise ValueError(f"earth_field_accel_batch: part {part!r} not one of {tuple(flags)}")
+        raise ValueError(unknown("earth_field_accel_batch: part", part, flags))
     r = np.ascontiguousarray(np.atleast_2d(r), dtype=np.float64)
     tdat = np.ascontiguousarray(np.atleast_2d(tdat), dtype=np.float64)
     if r.shape[-1] != 3 or tdat.shape[0] not in (1, r.shape[0]):

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
 from ..astro.lunar_orientation import LIBRATIONS, lunar_pa_rotation
 from ..astro.timescales import tdb_jd
@@ -186,7 +187,7 @@ class MoonField:
         if self.degree < 2:
             raise ValueError(f"MoonField: degree {self.degree} < 2 (the monopole is the third-body term)")
         if self.libration not in LIBRATIONS:
-            raise ValueError(f"MoonField: libration {self.libration!r} is not one of {LIBRATIONS}")
+            raise ValueError(unknown("MoonField: libration", self.libration, LIBRATIONS))
         self.model()  # ValueError now if the degree exceeds the coefficient file's
 
     def model(self):

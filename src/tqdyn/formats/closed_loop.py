@@ -51,8 +51,9 @@ ROOT_ATTRS = {
     "format": f'str, always "{FORMAT}"',
     "format_version": f"int, {FORMAT_VERSION}",
     "tqdyn_version": "str, version of tqdyn that wrote the file",
-    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji"',
-    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise",
+    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji" | "lpf" | "tianqin-1"',
+    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise; "
+                   "the source_* attributes are empty (0) for a mission's static working point (--mission)",
     "source_path": "str, absolute path of that file when the closed loop was computed",
     "source_sha256": "str, SHA-256 of the trajectory file's bytes",
     "source_scenario_sha256": "str, SHA-256 of the run's resolved scenario (its root attribute scenario, UTF-8)",
@@ -384,8 +385,8 @@ def read_closed_loop(path) -> ClosedLoopFile:
             fmt, ver = attrs.get("format"), attrs.get("format_version")
             if fmt != FORMAT:
                 raise ClosedLoopFormatError(
-                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} with "
-                    f"format_version <= {FORMAT_VERSION} (a file written by tqdyn closed-loop)")
+                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} "
+                    "(written by tqdyn closed-loop)")
             if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
                 raise ClosedLoopFormatError(f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; "
                                             f"expected an int 1..{FORMAT_VERSION}")

@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from .._version import __version__ as _TQDYN_VERSION
 from . import trajectory as _io
 from .atomic import replacing_h5
@@ -49,13 +50,14 @@ def write_lisa_injection(out_path, t0: float, dt: float, series: dict, attrs: di
     if not (math.isfinite(t0) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"t0 = {t0!r}, dt = {dt!r}: must be finite with dt > 0 (s)")
     if not series:
-        raise ValueError("series: empty; allowed: datasets <point>_<ij> of " + ", ".join(POINTS))
+        raise ValueError("series: empty; allowed: datasets <point>_<ij> of " + allowed(POINTS))
     arrays, size = {}, None
     for name, v in series.items():
         point, _, mosa = str(name).rpartition("_")
         if point not in POINTS or mosa not in _MOSAS:
-            raise ValueError(f"series: dataset {name!r} is not <point>_<ij> with point in {', '.join(POINTS)} "
-                             f"and ij in {', '.join(_MOSAS)}")
+            raise ValueError(f"series: dataset {name!r} is not <point>_<ij>"
+                             f"{did_you_mean(name, [f'{p}_{m}' for p in POINTS for m in _MOSAS])}; allowed: point "
+                             f"in {allowed(POINTS)} and ij in {allowed(_MOSAS)}")
         a = np.asarray(v, dtype=np.float64)
         if a.ndim != 1 or (size is not None and a.size != size):
             raise ValueError(f"series[{name!r}]: shape {a.shape}; expected ({size if size else 'n'},) like the others")

@@ -46,6 +46,7 @@ from decimal import Decimal, InvalidOperation
 import erfa
 import numpy as np
 
+from .._choices import unknown
 from ..astro.timescales import tdb_after, tt_jd
 from .tdm import Tdm, TdmSegment, parse_epoch, read_tdm, write_tdm
 
@@ -113,7 +114,7 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     info: {key: value} written as header comments ``tqdyn key = value`` (the writer's own keys).
     Raises ValueError (one line) for an unknown type, a non-finite value, a sigma that is not > 0."""
     if time_scale not in TIME_SCALES:
-        raise ValueError(f"time_scale: {time_scale!r}; allowed: {', '.join(TIME_SCALES)}")
+        raise ValueError(unknown("time_scale", time_scale, TIME_SCALES))
     cols = {f: np.asarray(getattr(meas, f)) for f in _FIELDS}
     m = cols["t"].size
     if any(c.shape != (m,) for c in cols.values()):
@@ -137,7 +138,7 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     for i in range(m):
         typ = str(cols["type"][i])
         if typ not in TYPES:
-            raise ValueError(f"measurements.type[{i}] = {typ!r}; allowed: {', '.join(TYPES)}")
+            raise ValueError(unknown(f"measurements.type[{i}]", typ, TYPES))
         key = (typ, int(cols["sat"][i]), str(cols["peer"][i]), float(sig[i]))
         groups.setdefault(key, []).append(i)
     epochs = _epoch_texts(epoch, time_scale, cols["t"].astype(np.float64))
@@ -211,7 +212,7 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
         except ValueError as exc:
             raise ValueError(f"{name}: header: tqdyn epoch = {file_epoch!r} ({exc})") from None
     if file_scale not in TIME_SCALES:
-        raise ValueError(f"{name}: header: tqdyn time_scale = {file_scale!r}; allowed: {', '.join(TIME_SCALES)}")
+        raise ValueError(unknown(f"{name}: header: tqdyn time_scale", file_scale, TIME_SCALES))
     parts = {f: [] for f in _FIELDS + ("line",)}
     for k, seg in enumerate(tdm.segments, start=1):
         where = f"{name}, segment {k}"
@@ -222,7 +223,7 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
                              "written by tqdyn od simulate")
         typ = c["type"]
         if typ not in TYPES:
-            raise ValueError(f"{where}: tqdyn type = {typ!r}; allowed: {', '.join(TYPES)}")
+            raise ValueError(unknown(f"{where}: tqdyn type", typ, TYPES))
         kw, _, _, unit, _ = TYPES[typ]
         if seg.metadata.get("TIME_SYSTEM") != file_scale:
             raise ValueError(f"{where}: TIME_SYSTEM = {seg.metadata.get('TIME_SYSTEM')!r}; allowed: {file_scale} "

@@ -40,6 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from ..readers.dates import calendar_problem
 from .atomic import replacing
 
@@ -229,7 +230,8 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
             raise bad(n, "line", f"{line!r} is not 'KEYWORD = value'")
         if state == "header":
             if k not in _HEADER:
-                raise bad(n, k, f"not a TDM header keyword; expected one of {', '.join(_HEADER)} or COMMENT")
+                raise bad(n, k, f"not a TDM header keyword{did_you_mean(k, _HEADER)}; expected one of "
+                                f"{allowed(_HEADER)} or COMMENT")
             if k in tdm.header:
                 raise bad(n, k, "appears twice in the header")
             if not v:

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
+from .._choices import unknown
 from .._version import __version__ as _TQDYN_VERSION
 from ..ttl.coupling import LINEAR_FIELDS, MOSAS
 from .atomic import replacing_h5
@@ -38,6 +39,8 @@ DATASET_SUFFIX = {"local_phi": "phi_rx", "distant_phi": "phi_tx", "local_eta": "
 #: Spline degrees LISA Instrument 2.3 accepts (``TTLSourceInterp``).
 ORDERS = (3, 5)
 #: The root attributes tqdyn adds (LISA Instrument reads none of them).
+#: Where the attributes are listed.
+ATTRS_DOC = "docs/tilt-to-length.md#time-varying-coefficients-and-lisa-instruments-coefficient-file"
 TQDYN_ATTRS = {
     "tqdyn_version": "str, version of tqdyn that wrote the file",
     "time_axis": "str, what t is",
@@ -95,7 +98,7 @@ def write_ttl_file(path, t, coefficients: dict, order: int = 5, attrs: dict | No
     extra = {"tqdyn_version": _TQDYN_VERSION, **{k: str(v) for k, v in (attrs or {}).items()}}
     bad = [k for k in extra if k not in TQDYN_ATTRS]
     if bad:
-        raise ValueError(f"attrs: unknown attribute {bad[0]!r}; allowed: {', '.join(TQDYN_ATTRS)}")
+        raise ValueError(unknown("attrs", bad[0], TQDYN_ATTRS, ATTRS_DOC, problem="is not an attribute of the file"))
     out = check_writable(path)
     with replacing_h5(out, "TTL coefficient file") as h5:
         h5.attrs["interpolation_order"] = int(order)

@@ -13,7 +13,8 @@ from decimal import Decimal
 from typing import Any
 
 from .initial import epoch_from_label
-from .values import MAX_ACCELERATION, ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
+from .values import (MAX_ACCELERATION, _NOVALUE, ScenarioError, _fmt, _num_array, _require, _require_choice, _set,
+                     _to_decimal)
 
 __all__ = ["SELF_GRAVITY_MODELS", "TM_AXES", "SpacecraftConfig"]
 
@@ -159,7 +160,10 @@ class SpacecraftConfig:
                                    **kw)
         except ArchitectureError as exc:
             key = _CRAFT_KEYS.get(exc.field, exc.field)
-            raise ScenarioError(f"spacecraft.{key}", exc.value, "is invalid", exc.allowed) from None
+            given = getattr(self, key, None)  # the value as the scenario gives it, if it does
+            value = given if given is not None else exc.value
+            raise ScenarioError(f"spacecraft.{key}", value if len(_fmt(value)) <= 40 else _NOVALUE, exc.problem,
+                                exc.allowed) from None
         return craft
 
     def self_gravity_values(self):

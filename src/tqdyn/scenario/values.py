@@ -10,6 +10,8 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any, Sequence
 
+from .._choices import allowed as _allowed, did_you_mean as _did_you_mean, shown as _shown
+
 __all__ = ["MAX_ACCELERATION", "ScenarioError"]
 
 #: Largest component [m/s^2] of an acceleration a scenario gives (``[accelerations]``,
@@ -29,29 +31,46 @@ _NOVALUE = object()
 # --------------------------------------------------------------------------- errors
 
 
-def _has_decimal(value: Any) -> bool:
-    return isinstance(value, Decimal) or (isinstance(value, (list, tuple)) and any(_has_decimal(x) for x in value))
+class _Exact:
+    """A Decimal as the scenario writes it (``0.5``, not ``Decimal('0.5')``), for :func:`_fmt`."""
+
+    def __init__(self, d: Decimal):
+        self.d = d
+
+    def __repr__(self) -> str:
+        return str(self.d)
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as the scenario writes it: Decimals exact (``0.5``), lists and tuples as TOML arrays."""
+    if isinstance(value, Decimal):
+        return _Exact(value)
+    if isinstance(value, (list, tuple)):
+        return [_plain(x) for x in value]
+    return value
 
 
 def _fmt(value: Any) -> str:
+    """A value as an error message quotes it: Decimals as written, paths as strings,
+    long lists and tables cut (:func:`tqdyn._choices.shown`)."""
     if isinstance(value, Decimal):
         return str(value)
-    if isinstance(value, (list, tuple)) and _has_decimal(value):
-        return "[" + ", ".join(_fmt(x) for x in value) + "]"
     if isinstance(value, Path):
         return repr(str(value))
-    return repr(value)
+    return _shown(_plain(value))
 
 
 class ScenarioError(ValueError):
     """Invalid scenario: one line ``"<field>: <value> <problem>; allowed: <allowed>"``.
 
     Attributes ``field`` (dotted TOML path such as ``"satellites.2.e"``),
-    ``value`` (the offending value, or ``None``), ``problem`` and ``allowed``.
+    ``value`` (the offending value, or ``None``; ``has_value``: whether the
+    message names one), ``problem`` and ``allowed``.
     """
 
     def __init__(self, field: str, value: Any = _NOVALUE, problem: str = "", allowed: str | None = None):
         self.field = field
+        self.has_value = value is not _NOVALUE
         self.value = None if value is _NOVALUE else value
         self.problem = problem
         self.allowed = allowed
@@ -66,8 +85,18 @@ class ScenarioError(ValueError):
         super().__init__(msg.replace("\n", " "))
 
 
-def _one_of(options: Sequence[str]) -> str:
-    return ", ".join(repr(o) for o in options)
+def _one_of(options: Sequence[str], doc: str | None = None) -> str:
+    """The allowed choices of a message: all of them quoted, or (a long list) their
+    number and the page ``doc`` that lists them (:func:`tqdyn._choices.allowed`)."""
+    return _allowed(options, doc, quote=repr)
+
+
+def _unknown_key(field: str, keys: Sequence[str], doc: str | None = None, problem: str = "is not a known key",
+                 value: Any = _NOVALUE, noun: str = "keys") -> ScenarioError:
+    """The error of an unknown key (``value``, by default the last part of ``field``): the
+    closest of ``keys`` and where they are documented (``doc``, a docs page and anchor)."""
+    key = field.rsplit(".", 1)[-1] if value is _NOVALUE else value
+    return ScenarioError(field, value, problem + _did_you_mean(key, keys), _allowed(keys, doc, noun=noun))
 
 
 # --------------------------------------------------------------------------- value helpers
@@ -100,8 +129,12 @@ def _require(cond: bool, name: str, value: Any, problem: str, allowed: str) -> N
         raise ScenarioError(name, value, problem, allowed)
 
 
-def _require_choice(value: Any, name: str, options: Sequence[str]) -> None:
-    _require(isinstance(value, str) and value in options, name, value, "is not a valid choice", _one_of(options))
+def _require_choice(value: Any, name: str, options: Sequence[str], doc: str | None = None,
+                    problem: str = "is not a valid choice") -> None:
+    """ScenarioError naming ``name``, ``value`` and the closest of ``options`` (all
+    of them, or the page ``doc`` that lists them) unless ``value`` is one of them."""
+    if not (isinstance(value, str) and value in options):
+        raise ScenarioError(name, value, problem + _did_you_mean(value, options), _one_of(options, doc))
 
 
 def _set(obj: Any, name: str, value: Any) -> None:

@@ -25,8 +25,9 @@ __all__ = ["ClosedLoopJob", "ClosedLoopSummary", "check_closed_loop_inputs", "cl
 
 @dataclass
 class ClosedLoopJob:
-    """What :func:`check_closed_loop_inputs` resolved: the trajectory, the model, the output path and
-    the time-domain settings (duration [s], fs [Hz], seed), the configuration and the root attributes."""
+    """What :func:`check_closed_loop_inputs` resolved: the trajectory (None for a mission's static working
+    point), the model, the output path and the time-domain settings (duration [s], fs [Hz], seed), the
+    configuration and the root attributes."""
 
     traj: object
     model: object
@@ -85,19 +86,68 @@ def file_sha256(path) -> str:
     return h.hexdigest()
 
 
+def _series(model, dur, rate, seed) -> tuple:
+    """(duration [s], fs [Hz], seed, n_samples) of the time series: the options given, else the model's
+    settings (the duration: ``closed_loop.duration``, else :func:`tqdyn.analysis.closed_loop.default_series_s`);
+    ValueError (one line) for less than one sample."""
+    from ..analysis.closed_loop import default_series_s
+
+    s = model.settings
+    dur = dur if dur is not None else (s["duration"] or default_series_s(model))
+    rate = rate if rate is not None else s["fs"]
+    seed = seed if seed is not None else s["seed"]
+    n = int(round(float(dur) * rate))
+    if n < 1:
+        raise ValueError(f"--duration: {dur!r} s at {rate!r} Hz is less than one sample; allowed: duration x fs >= 1")
+    return dur, rate, seed, n
+
+
+def _static_job(mission, out, dur, rate, seed, overrides, per_source: bool) -> ClosedLoopJob:
+    """The job of a mission's static working point (no run file): the source_* attributes are empty."""
+    from ..closedloop.model import static_closed_loop_model
+    from ..scenario.loader import closed_loop_config
+
+    cfg = closed_loop_config({"mission": mission}, overrides)
+    if cfg.raw.get("mission") != mission:
+        raise ValueError(f"--set closed_loop.mission={cfg.raw.get('mission')!r}: conflicts with --mission {mission!r}; "
+                         "allowed: the mission in --mission only")
+    model = static_closed_loop_model(cfg, validate=True)
+    s = model.settings
+    dur, rate, seed, n = _series(model, dur, rate, seed)
+    _check_size(model, n, out)
+    conf = resolved_configuration(cfg, mission, {**s, "fs": rate, "duration": float(dur), "seed": int(seed)})
+    conf["working_point"] = "static"
+    attrs = {"mission": model.mission, "source_file": "", "source_path": "", "source_sha256": "",
+             "source_scenario_sha256": "", "source_format_version": 0, "source_tqdyn_version": "",
+             "source_epoch_utc": "", "source_time_scale": "", "configuration": json.dumps(conf),
+             "closed_loop_toml": "\n".join(cfg.to_toml_lines()), "seed": int(seed), "fs": float(rate),
+             "duration_s": n / rate, "n_samples": n, "t0": 0.0,
+             "satellite_names": json.dumps(list(model.satellite_names))}
+    return ClosedLoopJob(traj=None, model=model, output=out, duration_s=n / rate, fs=float(rate), seed=int(seed),
+                         attrs=attrs, per_source=bool(per_source))
+
+
 def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None, overrides=(),
-                             per_source: bool = False) -> ClosedLoopJob:
+                             per_source: bool = False, mission=None) -> ClosedLoopJob:
     """Resolve a ``tqdyn closed-loop`` job; raise (one line) FileNotFoundError, ValueError
     (TrajectoryFormatError, ScenarioError, ClosedLoopError, DesignError: a bad option, a run without
     test masses or a pure-gravity run, an unknown loop or source, a bad ASD, an unstable design naming
     the loop and its margin) or OutputError (the output path) before anything is written.
     ``overrides``: ``closed_loop.KEY=VALUE`` strings, as the scenario's ``--set``; ``per_source``: also write
-    the ASD of every output from every source (``/budget/asd``, n_segment x n_sat x 46 x n_source x n_freq)."""
-    from ..analysis.closed_loop import default_series_s
+    the ASD of every output from every source (``/budget/asd``, n_segment x n_sat x 46 x n_source x n_freq).
+    ``mission`` (instead of ``run_file``): the mission's static working point
+    (:func:`tqdyn.closedloop.model.static_closed_loop_model`; the file's source_* attributes are then empty,
+    its configuration says ``"working_point": "static"``)."""
     from ..closedloop.model import closed_loop_model
     from ..scenario import loads_scenario
+    from ..scenario.closed_loop import MISSIONS
     from ..scenario.loader import parse_duration
 
+    if (run_file is None) == (mission is None):
+        raise ValueError("RUN.h5: give either a run file or --mission (not both, not neither); allowed: "
+                         "tqdyn closed-loop RUN.h5 --output CL.h5, or tqdyn closed-loop --mission NAME --output CL.h5")
+    if mission is not None and mission not in MISSIONS:
+        raise ValueError(f"--mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
     dur = None if duration is None else _positive("--duration", duration, parse_duration)
     rate = None if fs is None else _positive("--fs", fs, float)
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
@@ -106,6 +156,9 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
         if not str(o).startswith("closed_loop."):
             raise ValueError(f"--set: {o!r} is not a closed-loop key; allowed: closed_loop.KEY=VALUE "
                              "(docs/scenarios.md#closed-loop)")
+    if mission is not None:
+        return _static_job(mission, check_output(output, "--output", {}), dur, rate, seed, overrides,
+                           per_source)
     src = os.path.abspath(os.path.expanduser(os.fspath(run_file)))
     if not os.path.isfile(src):
         raise FileNotFoundError(f"RUN.h5: trajectory file {src!r} does not exist or is not a file")
@@ -114,12 +167,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     scen = loads_scenario(traj.scenario_toml, list(overrides), source=f"{src} (attribute scenario) and --set")
     model = closed_loop_model(traj, scen.closed_loop, validate=True)
     s = model.settings
-    dur = dur if dur is not None else (s["duration"] or default_series_s(model))
-    rate = rate if rate is not None else s["fs"]
-    seed = seed if seed is not None else s["seed"]
-    n = int(round(float(dur) * rate))
-    if n < 1:
-        raise ValueError(f"--duration: {dur!r} s at {rate!r} Hz is less than one sample; allowed: duration x fs >= 1")
+    dur, rate, seed, n = _series(model, dur, rate, seed)
     _check_size(model, n, out)
     settings = {**s, "fs": rate, "duration": float(dur), "seed": int(seed)}
     conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings)

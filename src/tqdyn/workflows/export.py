@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from .._version import __version__ as _TQDYN_VERSION
 from ..formats import trajectory as _io
 from ..formats.atomic import check_output
@@ -71,11 +72,11 @@ def _resolve_frame(traj, frame, axes, time_origin, src) -> str:
     if frame is None:
         frame = "bcrs" if helio else "gcrs"
     if frame not in FRAMES:
-        raise ValueError(f"frame = {frame!r} is not allowed; allowed: {', '.join(FRAMES)}")
+        raise ValueError(unknown("frame", frame, FRAMES))
     if axes not in AXES:
-        raise ValueError(f"axes = {axes!r} is not allowed; allowed: {', '.join(AXES)}")
+        raise ValueError(unknown("axes", axes, AXES))
     if time_origin not in TIME_ORIGINS:
-        raise ValueError(f"time_origin = {time_origin!r} is not allowed; allowed: {', '.join(TIME_ORIGINS)}")
+        raise ValueError(unknown("time_origin", time_origin, TIME_ORIGINS))
     if helio and frame == "gcrs":
         raise ValueError(f"{src}: a heliocentric trajectory (origin 'sun', BCRS, TDB) exports with frame = 'bcrs' "
                          "only (origin the solar-system barycentre, TCB)")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from ..analysis.ttl_budget import worst_case_coefficients
 from ..ttl.coupling import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
 from ..formats.atomic import check_output
@@ -72,7 +73,7 @@ def read_coefficient_file(path) -> TTLCoefficients:
         raise ValueError(f"{p}: expected tables {', '.join(LINEAR_FIELDS)}")
     for k in data:
         if k not in LINEAR_FIELDS:
-            raise ValueError(f"{p}: unknown key {k!r} (allowed: {', '.join(LINEAR_FIELDS)})")
+            raise ValueError(unknown(str(p), k, LINEAR_FIELDS, problem="is not a key"))
     try:
         return TTLCoefficients(**{f: data.get(f) for f in LINEAR_FIELDS})
     except ValueError as exc:

@@ -25,6 +25,7 @@ from typing import Callable
 
 import numpy as np
 
+from .._choices import allowed as allowed_names, did_you_mean, unknown
 from ..formats import trajectory as io
 from ..formats.atomic import check_output, replacing, same_file
 from ..formats.od_estimate import estimate_contents, write_estimate_file
@@ -52,10 +53,10 @@ def parse_tracking(text, option: str = "--tracking") -> tuple[str, ...]:
     allowed = _problem().TRACKING_KINDS
     kinds = tuple(k.strip() for k in (text.split(",") if isinstance(text, str) else text))
     if not kinds or any(not k for k in kinds):
-        raise ValueError(f"{option}: {text!r} is empty; allowed: a comma-separated list of {', '.join(allowed)}")
+        raise ValueError(f"{option}: {text!r} is empty; allowed: a comma-separated list of {allowed_names(allowed)}")
     for k in kinds:
         if k not in allowed:
-            raise ValueError(f"{option}: {k!r} is not a tracking type; allowed: {', '.join(allowed)}")
+            raise ValueError(unknown(option, k, allowed, problem="is not a tracking type"))
     if len(set(kinds)) != len(kinds):
         raise ValueError(f"{option}: {text!r} names a tracking type twice")
     return kinds
@@ -99,9 +100,10 @@ def parse_biases(items, option: str = "--bias") -> dict:
     allowed = _problem().BIAS_TYPES
     out = {}
     for key, value in _key_values(items, option, "TYPE=VALUE or TYPE/STATION=VALUE"):
-        if key.removeprefix("bias/").split("/")[0] not in allowed:
-            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(allowed)} "
-                             f"(or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
+        typ = key.removeprefix("bias/").split("/")[0]
+        if typ not in allowed:
+            raise ValueError(f"{option}: {key!r} is not allowed{did_you_mean(typ, allowed)}; allowed: "
+                             f"{', '.join(allowed)} (or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
         out[key] = _number(value, option, key, positive=False)
     return out
 
@@ -120,9 +122,10 @@ def parse_a_priori(items, option: str = "--a-priori") -> dict:
     out: dict = {}
     for key, value in pairs:
         group, _, typ = key.partition("/")
-        if group not in groups or (typ and (group != "bias" or typ not in _problem().BIAS_TYPES)):
-            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(groups)} (or bias/TYPE, TYPE "
-                             f"one of {', '.join(_problem().BIAS_TYPES)})")
+        if group not in groups:
+            raise ValueError(unknown(option, key, groups) + " (or bias/TYPE)")
+        if typ and (group != "bias" or typ not in _problem().BIAS_TYPES):
+            raise ValueError(unknown(option, key, [f"bias/{t}" for t in _problem().BIAS_TYPES]))
         parts = value.split(",") if isinstance(value, str) else [value]
         if len(parts) != (2 if group == "state" else 1):
             raise ValueError(f"{option}: {key} = {value!r} is not allowed; allowed: "

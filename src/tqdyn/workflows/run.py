@@ -267,8 +267,7 @@ def check_checkpoint(scen, resume: bool) -> None:
         try:
             io.TrajectoryWriter.check_partial(data.partial, data.rows)
         except io.OutputError as exc:
-            raise ValueError(f"--resume: {exc} (checkpoint {ckpt}); remove the checkpoint and run again "
-                             f"without --resume") from None
+            raise ValueError(f"--resume: {exc}; remove the checkpoint {ckpt} to start again") from None
     elif ckpt.exists():
         raise ValueError(f"{ckpt} holds the checkpoint of an interrupted run: continue it with "
                          f"--resume, or delete it to start again")

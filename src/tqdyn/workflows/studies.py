@@ -57,6 +57,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from .._choices import unknown
+
 __all__ = [
     "BASE_SCENARIO",
     "COARSE_EVERY",
@@ -196,6 +198,8 @@ RUNS: dict[str, RunSpec] = _runs()
 _SG_RUNS = tuple(f"sg{label}-90d" for label in SG_DIRECTIONS)
 
 #: The studies of the paper's section V by name (in report order).
+#: Where the studies are listed.
+STUDIES_DOC = "docs/report.md#studies"
 STUDIES: dict[str, Study] = {s.name: s for s in [
     Study("pointing", "Pointing error of the global and Taylor laws vs the iterative law", "Fig. 5",
           ("dragfree-global-30d-50s",),
@@ -268,7 +272,7 @@ def _check_names(studies, catalogue=None) -> tuple[str, ...]:
         studies = (studies,)
     for s in studies:
         if s not in catalogue:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(catalogue)}")
+            raise ValueError(unknown("study", s, catalogue, STUDIES_DOC, problem="is not a study"))
     return tuple(studies)
 
 

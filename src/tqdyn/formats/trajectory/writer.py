@@ -514,7 +514,7 @@ class TrajectoryWriter:
         self = cls.__new__(cls)
         self._path = check_writable(path)
         if not os.path.isfile(partial):
-            raise OutputError(f"partial trajectory {str(partial)!r} of the checkpoint is missing; cannot resume")
+            raise OutputError(f"partial trajectory {os.path.basename(partial)!r} is missing")
         self._state = {"tmp": str(partial)}
         self._finalizer = weakref.finalize(self, _cleanup, self._state)
         try:

@@ -108,13 +108,13 @@ def connect(scheduler, *, security=None, timeout: float = DEFAULT_CONNECT_TIMEOU
 
         if not dask.config.get("distributed.comm.tls.ca-file", None):
             raise _err("scheduler", scheduler, "is a tls:// address but no TLS certificates are configured",
-                       "--tls-ca-file/--tls-cert/--tls-key, or Dask's distributed.comm.tls.ca-file / "
-                       "distributed.comm.tls.client.cert / .key configuration")
+                       "--tls-* options, or Dask's distributed.comm.tls configuration")
     kwargs = {} if security is None else {"security": security}
     try:
         return Client(scheduler, timeout=timeout, **kwargs)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
-        raise _err("scheduler", scheduler, f"cannot be reached within {timeout:g} s ({one_line(exc)})",
+        why = "timed out" if "timed out" in str(exc).lower() else one_line(exc)
+        raise _err("scheduler", scheduler, f"cannot be reached within {timeout:g} s ({why})",
                    "the address of a running Dask scheduler, e.g. tcp://host:8786") from None
 
 
