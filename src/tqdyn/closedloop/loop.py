@@ -301,24 +301,6 @@ def _check_sensor(attitude_z_sensor: str) -> None:
                          f"allowed: {', '.join(repr(x) for x in ATTITUDE_Z_SENSORS)}")
 
 
-def loop_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0]) -> dict:
-    """The blocks of the closed loop of a spacecraft with parameters ``p`` at working point ``wp`` as plain
-    matrices with their signal names (what :func:`build_closed_loop` joins): ``plant`` (A, B, C, D, inputs,
-    outputs, states) of :func:`~tqdyn.closedloop.plant.plant_matrices`; ``sensors``, ``actuators`` and
-    ``observables`` (D, inputs, outputs) of the static blocks; ``dc_force`` (:attr:`ClosedLoop.dc_force`);
-    ``channels`` (:func:`channel_names`)."""
-    _check_sensor(attitude_z_sensor)
-    basis = sensitive_basis(p)                         # (2, 3, 3) rows e, p, q in OA_l
-    from ..constellation.control import oa_rotation
-    R = np.transpose(oa_rotation(wp.theta), (0, 2, 1))  # OA_l -> S
-    e_S = np.array([R[l] @ basis[l, 0] for l in range(2)])
-    yoa = np.array([R[l][:, 1] for l in range(2)])       # Y_OA_l in S
-    chans = channel_names()
-    actuators, dc = _actuators(p, wp, basis, e_S, chans)
-    return {"plant": plant_matrices(p, wp), "sensors": _sensors(basis, yoa, attitude_z_sensor),
-            "actuators": actuators, "observables": _observables(p, basis), "dc_force": dc, "channels": chans}
-
-
 def _constellation_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str):
     """(sensors, commands) of the "constellation" scheme; ValueError (one line) for sensitive axes that do
     not span the plane (collinear test masses: the DWS pitches of the two MOSAs then measure one angle)."""
