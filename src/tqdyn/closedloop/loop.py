@@ -315,7 +315,7 @@ def _constellation_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_senso
     if abs(det) < MIN_AXES_DETERMINANT or abs(np.linalg.det(yoa[:, :2])) < MIN_AXES_DETERMINANT:
         raise ValueError(f"closed_loop.scheme: 'constellation' cannot control parallel sensitive axes "
                          f"(|e_1 . (e_2 x Z_S)| = {abs(det):.3g}): the rotation about the TM line is unobservable; "
-                         "allowed: 'collinear' (TMs + star tracker)")
+                         "allowed: 'collinear'")
     return _sensors(basis, yoa, attitude_z_sensor), _constellation_commands(p, basis, e_S)
 
 

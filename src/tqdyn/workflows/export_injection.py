@@ -137,9 +137,8 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
         raise ValueError(f"{run_file}: n_sat = {traj.n_sat}; the six links need 3 satellites")
     signs = _axis_signs(traj, run_file) if tm else None
     n = int(cl.attrs.get("n_samples", 0))
-    check_memory(n * BYTES_PER_SAMPLE, f"CL.h5: the injection file of its {n} samples",
-                 lambda budget: f"a closed-loop file of at most {budget / BYTES_PER_SAMPLE:.3g} samples (tqdyn "
-                                "closed-loop --duration, --fs)")
+    check_memory(n * BYTES_PER_SAMPLE, f"CL.h5: the injection of its {n} samples",
+                 lambda budget: f"at most {budget / BYTES_PER_SAMPLE:.3g} samples (closed-loop --duration, --fs)")
     ts = cl.timeseries(list(ANGLE_OUTPUTS) + (["tm1_acceleration", "tm2_acceleration"] if tm else []))
     t = np.asarray(ts["time"].values, dtype=np.float64)
     dt = 1.0 / float(cl.attrs["fs"])

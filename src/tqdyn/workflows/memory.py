@@ -43,14 +43,14 @@ def available_memory() -> int | None:
 
 def check_memory(nbytes: float, what: str, allowed) -> None:
     """ValueError (one line) when ``what`` needs ``nbytes`` of memory, more than
-    :data:`MEMORY_FRACTION` of :func:`available_memory`: ``"<what> needs about N of memory, more than
-    50% of the M available; allowed: <allowed>"``.  ``allowed`` names the option that bounds it: a
+    :data:`MEMORY_FRACTION` of :func:`available_memory`: ``"<what> needs ~N of memory, over 50% of the
+    M available; allowed: <allowed>"``.  ``allowed`` names the option that bounds it: a
     str, or a function of the bytes the job may use returning one."""
     avail = available_memory()
     if avail is not None and nbytes > MEMORY_FRACTION * avail:
         text = allowed(MEMORY_FRACTION * avail) if callable(allowed) else allowed
-        raise ValueError(f"{what} needs about {human_bytes(nbytes)} of memory, more than "
-                         f"{MEMORY_FRACTION:.0%} of the {human_bytes(avail)} available; allowed: {text}")
+        raise ValueError(f"{what} needs ~{human_bytes(nbytes)} of memory, over {MEMORY_FRACTION:.0%} of the "
+                         f"{human_bytes(avail)} available; allowed: {text}")
 
 
 def check_space(nbytes: float, path, what: str, allowed: str) -> None:
