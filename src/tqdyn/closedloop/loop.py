@@ -21,7 +21,7 @@ import numpy as np
 from ..scenario.closed_loop import ATTITUDE_Z_SENSORS, SOURCES
 from .blocks import SensorRows, source_inputs, static_block as _static
 from .controllers import LOOPS, Controller
-from .plant import PlantParameters, WorkingPoint, linear_plant, plant_matrices, sensitive_basis
+from .plant import PlantParameters, WorkingPoint, plant_matrices, sensitive_basis
 from .schemes import scheme_blocks
 
 __all__ = ["OUTPUTS", "SOURCES", "ClosedLoop", "SensorRows", "build_closed_loop", "channel_names",
