@@ -176,18 +176,34 @@ def test_ctrl_c_exits_130_without_a_file(run_file, tmp_path, capsys, monkeypatch
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
-def test_front_door_wrappers_match_the_command(run_file, tmp_path, capsys):
-    """tqdyn.od_simulate / od_fit / od_covariance / read_od_estimate give what the commands write."""
+def test_front_door_in_memory_matches_the_command(run_file, tmp_path, capsys):
+    """tqdyn.od_simulate / od_fit / od_covariance (in memory) give what the commands write: the TDM's
+    rows, the estimate file's values and sigmas, the covariance JSON's sigmas (reference: the files the
+    commands wrote, read back with their readers and the open_* names)."""
+    import json
+
     import tqdyn
 
-    a, b = tmp_path / "a.tdm", tmp_path / "b.tdm"
+    a, e = tmp_path / "a.tdm", tmp_path / "e.h5"
     assert _simulate(run_file, a, capsys)[0] in (0, None)
-    s = tqdyn.od_simulate(run_file, ["gnss", "slr", "isr", "dsn"], 43200, output=b, seed=3)
-    assert s.counts["slr_range"] == 219
-    strip = [ln for ln in a.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
-    assert strip == [ln for ln in b.read_text().splitlines() if not ln.startswith("CREATION_DATE")]
-    est = tqdyn.od_fit(str(run_file), b, output=tmp_path / "e.h5", edit_sigma=6.0)
-    f = tqdyn.read_od_estimate(tmp_path / "e.h5")
-    assert np.array_equal(f.parameters["values"], est.values) and f.attrs["edit_sigma"] == 6.0
+    ds = tqdyn.od_simulate(run_file, ["gnss", "slr", "isr", "dsn"], 43200, seed=3)
+    on_file = tqdyn.open_measurements(a)
+    assert int((ds.type == "slr_range").sum()) == 219
+    for name in ("t", "value", "sigma", "sat"):
+        assert np.array_equal(ds[name].values, on_file[name].values), name
+    assert list(ds.type.values) == list(on_file.type.values) and list(ds.peer.values) == list(on_file.peer.values)
+    status, _, err = run_cli(["od", "fit", str(run_file), str(a), "--output", str(e), "--edit-sigma", "6"], capsys)
+    assert status in (0, None), err
+    est = tqdyn.od_fit(str(run_file), ds, edit_sigma=6.0)
+    f = tqdyn.open_od_estimate(e)
+    assert tqdyn.read_od_estimate is tqdyn.open_od_estimate and tqdyn.read_closed_loop is tqdyn.open_closed_loop
+    assert np.array_equal(f.parameters["values"], est.estimate.values)
+    assert np.array_equal(f.parameters["sigma"], est.sigma.values) and est.attrs["edit_sigma"] == 6.0
+    assert est.attrs["chi2"] == f.attrs["chi2"] and list(est.parameter.values) == list(f.parameters["names"])
+    assert np.array_equal(tqdyn.od_fit(str(run_file), on_file, edit_sigma=6.0).estimate.values, est.estimate.values)
     cov = tqdyn.od_covariance("tianqin-kepler", "slr", "12h", estimate="s_frame")
-    assert cov.names == ("Sat1/s_x", "Sat2/s_x", "Sat3/s_x")
+    assert list(cov.parameter.values) == ["Sat1/s_x", "Sat2/s_x", "Sat3/s_x"]
+    js = tmp_path / "c.json"
+    assert run_cli(["od", "covariance", "tianqin-kepler", "--tracking", "slr", "--arc", "12h", "--estimate", "s_frame",
+                    "--json", str(js)], capsys)[0] in (0, None)
+    assert np.array_equal(json.loads(js.read_text())["sigma"], cov.sigma.values)

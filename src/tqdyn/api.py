@@ -36,9 +36,9 @@ from .workflows.run import RunSummary, load_run_scenario, output_attrs, run_to_f
 
 __all__ = ["LightTravelTimes", "RunSummary", "Scenario", "ScenarioError", "Trajectory", "breathing_angles",
            "builtin_scenarios", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
-           "light_travel_times", "load_scenario", "od_covariance", "od_fit", "od_simulate", "open_trajectory",
-           "plot_od_residuals", "propagate", "range_asd", "read_closed_loop", "read_od_estimate", "requirement_asd",
-           "run"]
+           "light_travel_times", "load_scenario", "od_covariance", "od_fit", "od_simulate", "open_closed_loop",
+           "open_measurements", "open_od_estimate", "open_trajectory", "plot_od_residuals", "propagate", "range_asd",
+           "read_closed_loop", "read_od_estimate", "requirement_asd", "run"]
 
 
 def _overrides(overrides) -> list[str]:
@@ -208,7 +208,7 @@ def closed_loop_timeseries(model, duration_s: float | None = None, fs: float | N
     return g(model, duration_s, fs, seed, sink, block_size)
 
 
-def read_closed_loop(path):
+def open_closed_loop(path):
     """Open a closed-loop file (docs/closed-loop-file.md): ``.budget`` (xarray.Dataset), ``.timeseries()``,
     ``.attrs``, ``.configuration`` -- :func:`tqdyn.formats.closed_loop.read_closed_loop`."""
     from .formats.closed_loop import read_closed_loop as g
@@ -216,50 +216,58 @@ def read_closed_loop(path):
     return g(path)
 
 
-def od_simulate(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
-                sp3=None, overrides: Mapping[str, object] | Sequence[str] = ()):
-    """Simulate tracking on a run, as ``tqdyn od simulate``: the run file's scenario (its
-    ``[accelerations]`` and initial states are the truth), ``tracking`` ``"gnss,slr,isr"`` or a sequence
-    of ``tqdyn.od``'s ``problem.TRACKING_KINDS``, ``arc`` seconds or ``"7d"``, seeded noise, constant
-    measurement biases ``bias`` ({"slr_range": 0.02, "slr_range/Graz": -0.01, ...} [m, m/s for
-    dsn_range_rate]), GNSS transmitters from the SP3 files ``sp3`` (a path or a list; None: the nominal
-    GPS and BeiDou constellations), written as a CCSDS TDM to ``output``.  Returns
-    :class:`tqdyn.workflows.od.SimulateSummary` (:func:`tqdyn.workflows.od.simulate_to_tdm`)."""
-    from .workflows.od import simulate_to_tdm
+def od_simulate(run, tracking, arc=None, **options):
+    """Simulated tracking on a run, in memory: an ``xarray.Dataset`` of measurements (dimension ``row``:
+    ``value``, ``sigma`` [m, m/s for range rates] with coordinates ``t`` [s since the epoch], ``type``,
+    ``sat``, ``peer``; the plan in its attributes).  ``run``: a trajectory (:func:`propagate`,
+    :func:`open_trajectory`), a run file or a scenario -- its ``[accelerations]`` and initial states
+    are the truth; ``tracking``: ``"gnss,slr,isr"`` or a sequence of kinds with ``arc`` (seconds or
+    ``"7d"``), or a ``tqdyn.od.problem.Tracking``; keywords ``seed``, ``interval``, ``stations``,
+    ``bias`` ({"slr_range": 0.02, "slr_range/Graz": -0.01} [m, m/s]), ``sp3`` (SP3 files of the GNSS
+    transmitters), ``overrides`` (:func:`tqdyn.workflows.od_memory.od_simulate`; an unknown keyword or
+    a bad value: one line).  ``tqdyn od simulate`` writes the same measurements as a CCSDS TDM."""
+    from .workflows.od_memory import od_simulate as g
 
-    return simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval, stations=stations,
-                           bias=bias, sp3=sp3, overrides=_overrides(overrides))
-
-
-def od_fit(scenario, tdm, *, output=None, estimate=None, consider=None, a_priori=None,
-           edit_sigma: float | None = None, sp3=None, overrides: Mapping[str, object] | Sequence[str] = (), figure=None,
-           **options):
-    """Fit a scenario (a name, a TOML path or a run file) to the measurements of the TDM ``tdm``, as
-    ``tqdyn od fit`` (``output``: the estimate file, None: none; ``figure``: the residuals' figure,
-    ``.png`` or ``.pdf``, None: none; ``a_priori``: {group: sigma}, e.g. {"bias": 0.05, "state":
-    (100.0, 0.01)}, needed for each considered group; ``sp3``: the SP3 files the TDM was simulated
-    with, as :func:`od_simulate`); returns the
-    :class:`tqdyn.od.estimator.Estimate` (:func:`tqdyn.workflows.od.fit_to_file`)."""
-    from .workflows.od import fit_to_file
-
-    return fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider, a_priori=a_priori,
-                       edit_sigma=edit_sigma, sp3=sp3, overrides=_overrides(overrides), figure=figure,
-                       **options)[0]
+    return g(run, tracking, arc, **options)
 
 
-def od_covariance(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, a_priori=None,
-                  stations=None, sp3=None, overrides: Mapping[str, object] | Sequence[str] = (), json=None):
-    """The predicted covariance of a tracking plan on a scenario, as ``tqdyn od covariance``; returns the
-    :class:`tqdyn.od.estimator.Covariance` (``json``: also write it there; ``a_priori`` as
-    :func:`od_fit`, ``sp3`` as :func:`od_simulate`; :func:`tqdyn.workflows.od.covariance_of`)."""
-    from .workflows.od import covariance_of
+def od_fit(scenario, measurements, tracking=None, **options):
+    """The batch least-squares fit of ``scenario`` (a name, TOML, run file, trajectory or
+    :class:`Scenario`) to ``measurements`` (:func:`od_simulate`'s or :func:`open_measurements`'s
+    Dataset), in memory: an ``xarray.Dataset`` with ``estimate``, ``sigma``, ``covariance``,
+    ``correlation`` over ``parameter`` (coordinate ``unit``), the consider quantities, the residuals,
+    and the chi^2 statistics in its attributes.  ``tracking``: the kinds (None: the measurements'
+    own) or a ``tqdyn.od.problem.Tracking``; keywords ``estimate``, ``consider``, ``a_priori``
+    ({group: sigma}, e.g. {"bias": 0.05, "state": (100.0, 0.01)}), ``edit_sigma``, ``sp3``,
+    ``overrides`` and the estimator's ``step_tol``, ``max_iterations``, ``max_condition``,
+    ``min_kept_fraction``, ``max_edit_passes`` (:func:`tqdyn.workflows.od_memory.od_fit`; an unknown
+    keyword or a bad value: one line).  ``tqdyn od fit`` writes the same estimate as a file."""
+    from .workflows.od_memory import od_fit as g
 
-    return covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate, consider=consider,
-                         a_priori=a_priori, stations=stations, sp3=sp3, overrides=_overrides(overrides),
-                         json_out=json)[0]
+    return g(scenario, measurements, tracking, **options)
 
 
-def read_od_estimate(path):
+def od_covariance(scenario, tracking, arc=None, **options):
+    """The predicted covariance of a tracking plan on a scenario, without measurements: an
+    ``xarray.Dataset`` (``nominal``, ``sigma``, ``covariance``, ``correlation``, ``consider_sigma`` over
+    ``parameter``; the condition number in its attributes).  ``tracking``, ``arc`` as
+    :func:`od_simulate`; keywords ``interval``, ``estimate``, ``consider``, ``a_priori``, ``stations``,
+    ``sp3``, ``overrides`` (:func:`tqdyn.workflows.od_memory.od_covariance`).  ``tqdyn od covariance
+    --json`` writes the same numbers."""
+    from .workflows.od_memory import od_covariance as g
+
+    return g(scenario, tracking, arc, **options)
+
+
+def open_measurements(path, scenario=None):
+    """A measurement file (CCSDS TDM of ``tqdyn od simulate``) as the Dataset :func:`od_simulate`
+    returns (``scenario``: check it against the scenario's epoch; None: the file's own)."""
+    from .workflows.od_memory import open_measurements as g
+
+    return g(path, scenario)
+
+
+def open_od_estimate(path):
     """Read an estimate file (``tqdyn od fit --output``): ``.attrs``, ``.parameters``, ``.measurements``
     -- :func:`tqdyn.formats.od_estimate.read_estimate_file`."""
     from .formats.od_estimate import read_estimate_file
@@ -267,11 +275,20 @@ def read_od_estimate(path):
     return read_estimate_file(path)
 
 
+#: The readers' former names (kept: scripts written for them keep working).
+read_closed_loop = open_closed_loop
+read_od_estimate = open_od_estimate
+
+
 def plot_od_residuals(estimate, path, title: str | None = None):
-    """Draw the normalised post-fit residuals of an estimate file (its path, or what
-    :func:`read_od_estimate` returned) against time per measurement type and satellite, and their
+    """Draw the normalised post-fit residuals of an estimate (an estimate file's path, what
+    :func:`open_od_estimate` returned, or :func:`od_fit`'s Dataset) against time per measurement type and satellite, and their
     histogram against the unit normal, into ``path`` (``.png`` or ``.pdf``), as ``tqdyn od fit
     --figure``; returns what was drawn (:class:`tqdyn.analysis.figures_od.ResidualFigure`)."""
     from .analysis.figures_od import plot_od_residuals as plot
 
-    return plot(estimate if hasattr(estimate, "measurements") else read_od_estimate(estimate), path, title=title)
+    if hasattr(estimate, "data_vars"):  # od_fit's Dataset
+        from .workflows.od_memory import estimate_file_of
+
+        estimate = estimate_file_of(estimate)
+    return plot(estimate if hasattr(estimate, "measurements") else open_od_estimate(estimate), path, title=title)

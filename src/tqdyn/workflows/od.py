@@ -319,48 +319,41 @@ def _check_sp3_against(info: dict, paths, tdm) -> list:
 def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=None, stations=None, bias=None,
                     sp3=None, overrides=(), progress: Callable[[str], None] | None = None) -> SimulateSummary:
     """Simulate the measurements of ``tracking`` (kinds) over ``arc`` from the run file's scenario (its
-    ``[accelerations]`` are the truth) with noise seed ``seed``, and write them as a TDM to ``output``.
+    ``[accelerations]`` are the truth) with noise seed ``seed``, and write them as a TDM to ``output``:
+    :func:`tqdyn.workflows.od_memory.simulate` between the file checks and the file.
     stations: ground-station names (None: the plan's defaults); bias: constant measurement biases
     (:func:`parse_biases`; None: none), recorded in the TDM's header; sp3: SP3 files of the GNSS
     transmitters (a path or a sequence; None: the nominal constellations), their names and SHA-256
     recorded in the header."""
+    from .od_memory import simulate
+
     say = progress or (lambda stage: None)
-    kinds = parse_tracking(tracking)
-    biases = parse_biases(bias)
-    arc_s = parse_arc(arc)
-    interval_s = _interval(interval)
-    sp3_paths = _sp3_paths(sp3, kinds)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ValueError(f"--seed: {seed!r} is not allowed; allowed: an integer >= 0")
-    if not io.is_trajectory_file(run_file):
-        raise (FileNotFoundError(f"RUN.h5: trajectory file {str(run_file)!r} does not exist or is not a file")
-               if not os.path.isfile(os.fspath(run_file)) else
-               ValueError(f"RUN.h5: {str(run_file)!r} is not a trajectory file; allowed: a file written by tqdyn run"))
-    out = check_output(output, "--output", {"RUN.h5": run_file, **_sp3_inputs(sp3_paths)})
-    scen, notes, label = _scenario(run_file, overrides)
-    _check_arc(scen, arc_s, label)
-    p = _problem()
-    plan = _tracking(kinds, arc_s, interval_s, **_stations(stations), **_sp3_orbits(sp3_paths, scen, arc_s))
-    say("scheduling")
-    p.schedule(scen, plan)  # visibility refusals (a station below the horizon) before the simulation
-    say("simulating")
-    meas = p.simulate(scen, plan, None, seed, bias=biases)
-    info = {"tracking": ",".join(kinds), "arc_s": repr(arc_s), "interval_s": repr(float(plan.interval_s)),
-            "seed": str(seed), "scenario": scen.name, "run_file": pathlib.Path(run_file).name,
-            "run_sha256": file_sha256(run_file)}
-    if biases:
-        info["bias"] = json.dumps(biases)
-    if plan.stations is not None:
-        info["stations"] = ",".join(plan.stations)
-    if sp3_paths:
-        info["sp3"] = json.dumps(_sp3_record(sp3_paths))
+    box = {}
+
+    def ready():
+        if not io.is_trajectory_file(run_file):
+            raise (FileNotFoundError(f"RUN.h5: trajectory file {str(run_file)!r} does not exist or is not a file")
+                   if not os.path.isfile(os.fspath(run_file)) else
+                   ValueError(f"RUN.h5: {str(run_file)!r} is not a trajectory file; allowed: a file written by "
+                              "tqdyn run"))
+        box["out"] = check_output(output, "--output", {"RUN.h5": run_file, **_sp3_inputs(sp3)})
+
+    s = simulate(run_file, tracking, arc, seed=seed, interval=interval, stations=stations, bias=bias, sp3=sp3,
+                 overrides=overrides, progress=say, ready=ready, cli=True)
+    info = {}
+    for key, value in s.info.items():
+        info[key] = value
+        if key == "scenario":
+            info["run_file"] = pathlib.Path(run_file).name
+            info["run_sha256"] = file_sha256(run_file)
     say("writing")
-    path = write_measurements_tdm(out, meas, epoch=scen.epoch, time_scale=scen.reference.time_scale,
-                                  satellite_names=[s.name for s in scen.satellites], info=info)
+    scen = s.scenario
+    path = write_measurements_tdm(box["out"], s.meas, epoch=scen.epoch, time_scale=scen.reference.time_scale,
+                                  satellite_names=[x.name for x in scen.satellites], info=info)
     counts: dict = {}
-    for typ in np.asarray(meas.type).tolist():
+    for typ in np.asarray(s.meas.type).tolist():
         counts[typ] = counts.get(typ, 0) + 1
-    return SimulateSummary(path, counts, plan, tuple(notes))
+    return SimulateSummary(path, counts, s.tracking, s.notes)
 
 
 def _measurements(fields):
@@ -387,8 +380,16 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
     SP3 files the TDM was simulated with (its header names them; refused when they differ, by
     SHA-256; None: none, the nominal constellations).  Returns
     (:class:`tqdyn.od.estimator.Estimate`, the scenario, notes).  ``options`` go to
-    :func:`tqdyn.od.estimator.estimate` with ``edit_sigma``."""
+    :func:`tqdyn.od.estimator.estimate` with ``edit_sigma`` (checked: those of
+    :data:`tqdyn.workflows.od_memory.ESTIMATOR_OPTIONS`).  The fit is
+    :func:`tqdyn.workflows.od_memory.fit` between the TDM and the files."""
+    from .od_memory import ESTIMATOR_OPTIONS, fit
+
     say = progress or (lambda stage: None)
+    for key in options:
+        if key not in ESTIMATOR_OPTIONS:
+            raise TypeError(unknown("fit_to_file()", key, ["edit_sigma", *ESTIMATOR_OPTIONS],
+                                    problem="is not an estimator option", noun="options"))
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
     sig = parse_a_priori(a_priori)
     _check_consider(con_names, sig)
@@ -414,41 +415,23 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
     say("reading")
     fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale,
                                          with_lines=True)
-    kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
-        tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
-    parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
-    sp3_paths = _sp3_paths(sp3, kinds)
-    sp3_record = _check_sp3_against(info, sp3_paths, tdm)
-    arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
-    _check_rows(scen, fields, arc_s, tdm)
-    _check_arc(scen, arc_s, label)
-    interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
-    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
-                     **_stations(info.get("stations")), **_sp3_orbits(sp3_paths, scen, arc_s))
-    meas = _measurements(fields)
-    say("fitting")
-    if edit_sigma is not None:
-        options["edit_sigma"] = float(edit_sigma)
-    fit = _problem().fit(scen, meas, plan, **options)
-    rows = _problem().residual_rows(meas)
-    units = [parameter_unit(n) for n in fit.names]
-    attrs = {"scenario": scen.to_toml(), "scenario_name": scen.name, "epoch": scen.epoch.iso,
-             "time_scale": scen.reference.time_scale, "tdm_file": pathlib.Path(tdm).name,
-             "tdm_sha256": file_sha256(tdm), "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
-             "tracking": json.dumps({"kinds": list(kinds), "arc_s": arc_s, "interval_s": float(plan.interval_s),
-                                     "estimate": list(_problem().estimated_groups(scen, plan)),
-                                     "consider": list(plan.consider),
-                                     "a_priori_sigma": plan.a_priori_sigma or {},
-                                     **({"sp3": sp3_record} if sp3_record else {})})}
+    f = fit(label, fields, info, estimate=est_names, consider=con_names, a_priori=sig, edit_sigma=edit_sigma,
+            sp3=sp3, options=options, name=str(tdm), progress=say, cli=True, scen=scen)
+    attrs = {}
+    for key, value in f.attrs.items():
+        if key == "edit_sigma":
+            attrs.update(tdm_file=pathlib.Path(tdm).name, tdm_sha256=file_sha256(tdm))
+        attrs[key] = value
+    fit_, meas, rows, units = f.estimate, f.meas, f.residual_rows, f.units
     if out is not None:
         say("writing")
-        write_estimate_file(out, fit, meas, attrs=attrs, units=units, residual_rows=rows)
+        write_estimate_file(out, fit_, meas, attrs=attrs, units=units, residual_rows=rows)
     if figure is not None:
         from ..analysis.figures_od import plot_od_residuals
 
         say("plotting")
         try:
-            plot_od_residuals(estimate_contents(fit, meas, attrs=attrs, units=units, residual_rows=rows), figure)
+            plot_od_residuals(estimate_contents(fit_, meas, attrs=attrs, units=units, residual_rows=rows), figure)
         except io.OutputIOError as exc:  # a full disk: status 3, the estimate file stays
             err = io.OutputIOError(f"--figure: {exc}")
             err.tqdyn_note = ("the figure was not written" + (f", the estimate file {str(out)!r} was"
@@ -458,34 +441,31 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
             raise ValueError(f"--figure: {str(figure)!r} could not be written ({exc}); nothing was written there"
                              + (f", the estimate file {str(out)!r} was" if out is not None else "")
                              + "; allowed: a writable file with space for the figure") from None
-    return fit, scen, tuple(notes)
+    return fit_, scen, tuple(notes)
 
 
 def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, consider=None, a_priori=None,
                   stations=None, sp3=None, overrides=(), json_out=None, progress: Callable[[str], None] | None = None):
     """The predicted covariance (:class:`tqdyn.od.estimator.Covariance`) of the tracking plan on the
-    scenario (a_priori, sp3: as :func:`simulate_to_tdm`'s), and (optionally) its JSON file ``json_out``.
-    Returns (covariance, scenario, notes)."""
+    scenario (a_priori, sp3: as :func:`simulate_to_tdm`'s), and (optionally) its JSON file ``json_out``:
+    :func:`tqdyn.workflows.od_memory.covariance` and the file.  Returns (covariance, scenario, notes)."""
+    from .od_memory import covariance
+
     say = progress or (lambda stage: None)
-    kinds = parse_tracking(tracking)
-    arc_s = parse_arc(arc)
-    interval_s = _interval(interval)
-    sp3_paths = _sp3_paths(sp3, kinds)
-    est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
-    sig = parse_a_priori(a_priori)
-    _check_consider(con_names, sig)
-    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None, **_sp3_inputs(sp3_paths)}
-    out = check_output(json_out, "--json", inputs) if json_out is not None else None
-    scen, notes, label = _scenario(scenario, overrides)
-    _check_arc(scen, arc_s, label)
-    plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
-                     **_stations(stations), **_sp3_orbits(sp3_paths, scen, arc_s))
-    say("covariance")
-    cov = _problem().covariance(scen, plan)
-    if out is not None:
+    box = {}
+
+    def ready():
+        paths = [sp3] if isinstance(sp3, (str, os.PathLike)) else list(sp3 or ())
+        inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None, **_sp3_inputs(paths)}
+        box["out"] = check_output(json_out, "--json", inputs) if json_out is not None else None
+
+    cov, scen, plan, sp3_paths, notes = covariance(scenario, tracking, arc, interval=interval, estimate=estimate,
+                                                   consider=consider, a_priori=a_priori, stations=stations, sp3=sp3,
+                                                   overrides=overrides, ready=ready, progress=say, cli=True)
+    if box["out"] is not None:
         say("writing")
         rec = covariance_record(cov, scen, plan, sp3_paths)
-        with replacing(out, "the covariance JSON") as tmp:
+        with replacing(box["out"], "the covariance JSON") as tmp:
             tmp.write_text(json.dumps(rec, indent=1) + "\n", encoding="utf-8")
     return cov, scen, tuple(notes)
 
