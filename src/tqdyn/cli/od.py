@@ -199,3 +199,12 @@ def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, 
     click.echo(f"condition number {cov.condition_number:.3g}")
     if json_out:
         click.echo(f"output: {json_out}")
+
+
+def _register_campaign() -> None:
+    from .od_campaign import campaign
+
+    od.add_command(campaign)
+
+
+_register_campaign()

@@ -83,12 +83,25 @@ def _seed(seed, cli: bool) -> int:
     return int(seed)
 
 
-def _load(source, overrides, writes: bool = False):
+def _override_list(overrides) -> list[str]:
+    """``{"run.duration": "2d"}``, ``["run.duration=2d"]`` or one string -> ``["run.duration=2d", ...]``."""
+    from collections.abc import Mapping
+
+    from ..scenario.toml_text import toml_value
+
+    if isinstance(overrides, str):
+        return [overrides]
+    if isinstance(overrides, Mapping):
+        return [f"{key}={toml_value(value)}" for key, value in overrides.items()]
+    return list(overrides or ())
+
+
+def _load(source, overrides):
     """(scenario, notes, label) of a trajectory in memory (its recorded scenario), a Scenario, a run
-    file, a built-in name or a TOML path."""
+    file, a built-in name or a TOML path, with ``overrides`` (:func:`_override_list`)."""
     from ..scenario import Scenario, loads_scenario
 
-    over = list(overrides)
+    over = _override_list(overrides)
     if isinstance(source, Scenario):
         scen = loads_scenario(source.to_toml(), over, source=f"scenario {source.name!r}") if over else source
         return scen, (), source.name

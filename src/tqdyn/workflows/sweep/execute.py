@@ -165,8 +165,9 @@ def _lost_counts(client, keys) -> dict:
 
 
 def run_on_dask(task, items: Sequence, key: Callable[[Any], str], scheduler, n_workers: int | None,
-                done: Callable[[Any, dict], None], **client_options) -> None:
-    """Run ``task(item.scenario_toml)`` for every item as a Dask task (on
+                done: Callable[[Any, dict], None], argument: Callable[[Any], Any] | None = None,
+                **client_options) -> None:
+    """Run ``task(item.scenario_toml)`` (``argument(item)`` when given) for every item as a Dask task (on
     the cluster of :func:`dask_client`, ``client_options`` passed to it) and
     call ``done(item, result)`` as each finishes, in completion order.
     ``task`` is a module-level function returning a result dict (e.g.
@@ -180,7 +181,8 @@ def run_on_dask(task, items: Sequence, key: Callable[[Any], str], scheduler, n_w
     from distributed import as_completed
 
     with dask_client(scheduler, n_workers, len(items), **client_options) as client:
-        futures = {client.submit(task, item.scenario_toml, key=key(item), pure=False): item for item in items}
+        arg = argument or (lambda item: item.scenario_toml)
+        futures = {client.submit(task, arg(item), key=key(item), pure=False): item for item in items}
         try:
             for fut in as_completed(list(futures)):
                 try:
