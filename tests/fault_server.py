@@ -40,7 +40,7 @@ def _warm() -> None:
     import tqdyn.cli  # noqa: F401
     for name in ("tqdyn.workflows.run", "tqdyn.workflows.export", "tqdyn.workflows.export_oem",
                  "tqdyn.workflows.export_ttl", "tqdyn.workflows.export_injection", "tqdyn.workflows.closed_loop",
-                 "tqdyn.workflows.od", "tqdyn.workflows.report", "tqdyn.workflows.sweep", "tqdyn.workflows.bench",
+                 "tqdyn.workflows.od", "tqdyn.workflows.od_files", "tqdyn.workflows.report", "tqdyn.workflows.sweep", "tqdyn.workflows.bench",
                  "tqdyn.analysis.closed_loop", "tqdyn.analysis.figures", "tqdyn.analysis.figures_od",
                  "tqdyn.analysis.budget", "tqdyn.od.problem", "xarray", "h5netcdf", "control", "tqdm"):
         importlib.import_module(name)

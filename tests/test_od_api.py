@@ -66,10 +66,11 @@ def test_a_tracking_plan_object_and_the_covariance(traj):
 
 @pytest.mark.parametrize("call, pattern", [
     (lambda t: tqdyn.od_fit("tianqin-kepler", None, "slr", edit_sigm=3.0),
-     r"^od_fit\(\): edit_sigm is not a keyword argument \(did you mean 'edit_sigma'\?\); allowed: "),
+     r"^od_fit\(\): 'edit_sigm' is not a keyword argument \(did you mean 'edit_sigma'\?\); allowed: one of the "
+     r"14 keywords in docs/python.md$"),
     (lambda t: tqdyn.od_simulate(t, "slr", "1d", output="m.tdm"),
-     r"^od_simulate\(\): output is not a keyword argument; allowed: "),
-    (lambda t: tqdyn.od_simulate(t, "slrr", "1d"), r"^tracking: slrr is not a tracking type \(did you mean 'slr'"),
+     r"^od_simulate\(\): 'output' is not a keyword argument; allowed: one of the 9 keywords in docs/python.md"),
+    (lambda t: tqdyn.od_simulate(t, "slrr", "1d"), r"^tracking: 'slrr' is not a tracking type \(did you mean 'slr'"),
     (lambda t: tqdyn.od_simulate(t, "slr"), r"^arc: missing; allowed: seconds"),
     (lambda t: tqdyn.od_simulate(t, "slr", "-2h"), r"^arc: '-2h' is not a duration > 0"),
     (lambda t: tqdyn.od_simulate(t, "slr", "1d", seed=-1), r"^seed: -1 is not allowed; allowed: an integer >= 0"),
@@ -77,7 +78,8 @@ def test_a_tracking_plan_object_and_the_covariance(traj):
     (lambda t: tqdyn.od_simulate(t, odp.Tracking(("slr",), 3600.0), "1d"), r"^arc: '1d' is given with a Tracking"),
     (lambda t: tqdyn.od_covariance("tianqin-kepler", "slr", "1h", consider="s_frame"),
      r"^consider: 's_frame' needs an a priori sigma; allowed: with a_priori s_frame=SIGMA"),
-    (lambda t: tqdyn.od_covariance("tianqin-kepler", "slr", "1h", a_priori={"stat": 1.0}), r"^a_priori: stat"),
+    (lambda t: tqdyn.od_covariance("tianqin-kepler", "slr", "1h", a_priori={"stat": 1.0}),
+     r"^a_priori: 'stat' is not allowed \(did you mean 'state'\?\)"),
 ])
 def test_bad_arguments_are_one_line_naming_the_argument(traj, call, pattern):
     """An unknown keyword (TypeError) or a bad value (ValueError): one line of at most 200 characters

@@ -1,6 +1,6 @@
 """Orbit-determination campaigns on Dask (``tqdyn od campaign``, tqdyn.workflows.od_campaign).
 
-A recovery campaign simulates tracking on a truth with 1e-10 m/s^2 of S-frame acceleration along Y_S
+A recovery campaign simulates tracking on a truth with 1e-9 m/s^2 of S-frame acceleration along Y_S
 injected on every satellite of tianqin-gravity (SLR + ISR over 12 h every 1800 s) and fits the nominal
 scenario, one seed per Dask task.  References: the chi-square law of the estimates' normalised errors
 (x_hat - x_true)^T P^-1 (x_hat - x_true) of a correct linear(ised) least-squares fit with Gaussian noise,
@@ -25,7 +25,7 @@ from cli_support import run_cli
 from tqdyn.workflows import od_campaign as oc
 from tqdyn.workflows.sweep import read_sweep_netcdf
 
-INJECTED = 1e-10
+INJECTED = 1e-9
 TRUTH = (f"accelerations.s_frame=[[0.0, {INJECTED}, 0.0], [0.0, {INJECTED}, 0.0], [0.0, {INJECTED}, 0.0]]",)
 #: Chi-square acceptance quantiles.
 Q_LOW, Q_HIGH = 1e-3, 1.0 - 1e-3
@@ -63,13 +63,13 @@ def _check_chi2(ds, record_number=None, tag=""):
     return chi, dof
 
 
-def test_recovery_chi_square_over_20_seeds(twenty):
+def test_recovery_chi_square_over_20_seeds(twenty, record_number):
     """20 seeds on a local Dask cluster: the sum of the 20 x 27 normalised errors lies inside the 1e-3 and
     1 - 1e-3 quantiles of chi-square with 540 degrees of freedom; the file holds the dataset (read back
     with its checksums); a second run of the same campaign skips every member and gives the same file."""
     ds = twenty.dataset
     assert twenty.n_ran == 20 and ds.sizes["seed"] == 20 and bool(ds.ok.all())
-    _check_chi2(ds)
+    _check_chi2(ds, record_number, "20")
     back = read_sweep_netcdf(twenty.output)
     np.testing.assert_array_equal(back.estimate.values, ds.estimate.values)
     again = oc.run_campaign(_spec(twenty.output.parent, 20), n_workers=2, dashboard=None)
@@ -135,17 +135,17 @@ def test_covariance_campaign_over_plans_and_arcs(tmp_path, capsys):
     import tqdyn
 
     out = tmp_path / "cov.nc"
-    argv = ["od", "campaign", "covariance", "tianqin-kepler", "--tracking", "slr", "--tracking", "slr,isr",
-            "--arc", "6h", "--arc", "12h", "--interval", "1800", "--workers", "1", "-q", "-o", str(out)]
+    argv = ["od", "campaign", "covariance", "tianqin-kepler", "--tracking", "slr,isr", "--tracking", "gnss,slr,isr",
+            "--arc", "12h", "--arc", "1d", "--interval", "1800", "--workers", "1", "-q", "-o", str(out)]
     status, stdout, err = run_cli(argv + ["--seeds", "3"], capsys)
     assert status == 2 and "--seeds: a covariance campaign has no seeds" in err
     status, stdout, err = run_cli(argv, capsys)
     assert status in (0, None), err
     assert "campaign covariance: 4 members: 0 already done, 4 ran, 0 failed" in stdout
     ds = read_sweep_netcdf(out)
-    assert list(ds.plan.values) == ["slr", "slr,isr"] and list(ds.arc_s.values) == [21600.0, 43200.0]
-    direct = tqdyn.od_covariance("tianqin-kepler", "slr,isr", "6h", interval=1800)
-    np.testing.assert_array_equal(ds.sigma.values[1, 0, 0], direct.sigma.values)
+    assert list(ds.plan.values) == ["slr,isr", "gnss,slr,isr"] and list(ds.arc_s.values) == [43200.0, 86400.0]
+    direct = tqdyn.od_covariance("tianqin-kepler", "gnss,slr,isr", "1d", interval=1800)
+    np.testing.assert_array_equal(ds.sigma.values[1, 1, 0], direct.sigma.values)
     status, stdout, _ = run_cli(argv, capsys)
     assert "4 members: 4 already done, 0 ran" in stdout
 

@@ -1,6 +1,6 @@
 """Command line: ``tqdyn od simulate | fit | covariance`` -- orbit determination from files.
 
-Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.od`: bad input (an unknown
+Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.od_files` (the jobs) and :mod:`tqdyn.workflows.od`: bad input (an unknown
 tracking type, an arc outside the run, a malformed TDM, a station below the horizon for the whole
 arc, an output path that is an input, an unobservable fit, a ``--figure`` that is not a writable
 ``.png`` or ``.pdf``, a ``--bias`` or ``--a-priori`` that is not TYPE=VALUE / GROUP=SIGMA, a
@@ -109,7 +109,7 @@ def od():
 def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, output, sets, quiet):
     """Simulate the measurements of a tracking plan on the run RUN.h5: its recorded scenario, with its
     [accelerations] and initial states as the truth, seeded white noise; written as a CCSDS TDM."""
-    from ..workflows import od as wf
+    from ..workflows import od_files as wf
 
     stages = _Stages(("scheduling", "simulating", "writing"), quiet, "od simulate")
     s = _run(lambda: wf.simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval,
@@ -142,7 +142,7 @@ def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, out
 def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, figure, sets, quiet):
     """Fit SCENARIO (a built-in name, a TOML file or a run file) to the measurements MEAS.tdm by batch
     least squares; print each estimated parameter with its 1-sigma, and chi^2/dof."""
-    from ..workflows import od as wf
+    from ..workflows import od as od_inputs, od_files as wf
 
     stages = _Stages(("reading", "fitting", "writing") + (("plotting",) if figure else ()), quiet, "od fit")
     est, _, notes = _run(lambda: wf.fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider,
@@ -150,7 +150,7 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
                                                 figure=figure,
                                                 progress=stages), stages)
     _notes(notes)
-    units = [wf.parameter_unit(n) for n in est.names]
+    units = [od_inputs.parameter_unit(n) for n in est.names]
     click.echo("\n".join(summary_lines(est.names, est.values, est.sigma, units,
                                        est.consider_sigma if est.consider_names else None)))
     m = int(len(est.edited))
@@ -186,14 +186,14 @@ def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, 
                quiet):
     """Predict, without measurements, how well a tracking plan determines SCENARIO's parameters: the
     1-sigma of each (and with --consider the consider sigma)."""
-    from ..workflows import od as wf
+    from ..workflows import od as od_inputs, od_files as wf
 
     stages = _Stages(("covariance", "writing") if json_out else ("covariance",), quiet, "od covariance")
     cov, _, notes = _run(lambda: wf.covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate,
                                                   consider=consider, a_priori=a_priori, stations=stations,
                                                   sp3=sp3, overrides=sets, json_out=json_out, progress=stages), stages)
     _notes(notes)
-    units = [wf.parameter_unit(n) for n in cov.names]
+    units = [od_inputs.parameter_unit(n) for n in cov.names]
     click.echo("\n".join(summary_lines(cov.names, None, cov.sigma, units,
                                        cov.consider_sigma if cov.consider_names else None)))
     click.echo(f"condition number {cov.condition_number:.3g}")

@@ -34,7 +34,7 @@ of equal t in the order of their segments -- the order written when the table is
 Errors: one-line ``ValueError`` naming the file, the segment or the line, and the field (the TDM
 reader's checks, :mod:`tqdyn.formats.tdm`; a value whose metres overflow float64; a negative
 ``tqdyn sat``).  The rows' epochs against a run (its span, its step grid) are checked by the caller
-with the rows' lines (``with_lines``; ``tqdyn od fit``: :func:`tqdyn.workflows.od.fit_to_file`).
+with the rows' lines (``with_lines``; ``tqdyn od fit``: :func:`tqdyn.workflows.od_files.fit_to_file`).
 """
 
 from __future__ import annotations

@@ -61,8 +61,8 @@ def checked_keywords(func):
     def wrapper(*args, **kwargs):
         for key in kwargs:
             if key not in names:
-                raise TypeError(unknown(f"{func.__name__}()", key, names, problem="is not a keyword argument",
-                                        noun="keywords"))
+                raise TypeError(unknown(f"{func.__name__}()", key, names, "docs/python.md",
+                                        problem="is not a keyword argument", noun="keywords", quote=repr))
         return func(*args, **kwargs)
 
     return wrapper
