@@ -1,6 +1,6 @@
 """Orbit-determination campaigns on Dask (``tqdyn od campaign``, tqdyn.workflows.od_campaign).
 
-A recovery campaign simulates tracking on a truth with 1e-9 m/s^2 of S-frame acceleration along Y_S
+A recovery campaign simulates tracking on a truth with 3e-9 m/s^2 of S-frame acceleration along Y_S
 injected on every satellite of tianqin-gravity (SLR + ISR over 12 h every 1800 s) and fits the nominal
 scenario, one seed per Dask task.  References: the chi-square law of the estimates' normalised errors
 (x_hat - x_true)^T P^-1 (x_hat - x_true) of a correct linear(ised) least-squares fit with Gaussian noise,
@@ -25,7 +25,7 @@ from cli_support import run_cli
 from tqdyn.workflows import od_campaign as oc
 from tqdyn.workflows.sweep import read_sweep_netcdf
 
-INJECTED = 1e-9
+INJECTED = 3e-9
 TRUTH = (f"accelerations.s_frame=[[0.0, {INJECTED}, 0.0], [0.0, {INJECTED}, 0.0], [0.0, {INJECTED}, 0.0]]",)
 #: Chi-square acceptance quantiles.
 Q_LOW, Q_HIGH = 1e-3, 1.0 - 1e-3
