@@ -80,25 +80,18 @@ def _frames_rotation(epoch, t_hi, t_lo):
     return earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS
 
 
-@njit(cache=True)
 def _pack(out, col, c, filled, lt):
     """Packed lower triangle of c (n_inst, k+1, k+1) into out[:, col:col+lt]
     (index n (n+1)/2 + m): added to the entries of degree <= filled, stored
     into the others; entries beyond degree k are zeroed if filled < 0."""
-    k1 = c.shape[1]
-    f = (filled + 1) * (filled + 2) // 2  # entries already holding data
-    for i in range(c.shape[0]):
-        j = col
-        for n in range(k1):
-            for m in range(n + 1):
-                if j - col < f:
-                    out[i, j] += c[i, n, m]
-                else:
-                    out[i, j] = c[i, n, m]
-                j += 1
-        if filled < 0:
-            for jj in range(j, col + lt):
-                out[i, jj] = 0.0
+    rows, cols = np.tril_indices(c.shape[1])  # row by row: the index n (n+1)/2 + m
+    v = c[:, rows, cols]
+    nv = v.shape[1]
+    f = min((filled + 1) * (filled + 2) // 2, nv)  # entries already holding data
+    out[:, col:col + f] += v[:, :f]
+    out[:, col + f:col + nv] = v[:, f:]
+    if filled < 0:
+        out[:, col + nv:col + lt] = 0.0
 
 
 def _provider_degree(p):
