@@ -51,6 +51,7 @@ import os
 
 import erfa
 import numpy as np
+from numba import njit
 
 from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
@@ -120,9 +121,10 @@ def default_ephemeris_path() -> str:
 
 
 # --------------------------------------------------------------------------
-# Chebyshev evaluation
+# compiled Chebyshev evaluation
 
 
+@njit(cache=True)
 def _cheb_eval(coef, init, intlen, type3, jd1, jd2, sel, want_vel, out_p, out_v, ob, base_p, base_v, bb, bsign):
     """Evaluate one SPK Chebyshev segment at many instants, adding a base state.
 
@@ -136,54 +138,58 @@ def _cheb_eval(coef, init, intlen, type3, jd1, jd2, sel, want_vel, out_p, out_v,
         out_p[i, ob, :] = position [m] + bsign * base_p[i, bb, :]
         out_v[i, ob, :] = velocity [m/s] + bsign * base_v[i, bb, :]   (if want_vel)
 
-    out_*, base_*: (n, *, 3) float64; bsign = 0 ignores the base.  Vectorised
-    over the instants (numpy: nothing to compile), each instant's arithmetic
-    in the order of the scalar recurrence (Chebyshev polynomials by forward
-    recurrence, sums from the smallest terms).
+    out_*, base_*: (n, *, 3) float64; bsign = 0 ignores the base.
     """
     n_rec, _, n_coef = coef.shape
-    idx = sel if sel.shape[0] > 0 else slice(None)
+    tk = np.empty(n_coef)
+    dk = np.zeros(n_coef)
     scale = 2.0 / intlen
-    a = (jd1[idx] - _J2000) * _DAY - init  # exact for jd1 on a half day
-    b = jd2[idx] * _DAY
-    k = np.clip(np.floor((a + b) / intlen).astype(np.int64), 0, n_rec - 1)  # the end point: the last record
-    off = (a - k * intlen) + b  # a - k intlen exact (integers of s)
-    s = off * scale - 1.0
-    tk = np.empty((n_coef,) + s.shape)  # T_j(s), j = 0 .. n_coef - 1
-    tk[0] = 1.0
-    if n_coef > 1:
-        tk[1] = s
-    s2 = 2.0 * s
-    for j in range(2, n_coef):
-        tk[j] = s2 * tk[j - 1] - tk[j - 2]
-    rec = coef[k]  # (m, n_comp, n_coef)
-    if want_vel and not type3:  # dT_j/ds
-        dk = np.zeros_like(tk)
+    use_sel = sel.shape[0] > 0
+    n = sel.shape[0] if use_sel else jd1.shape[0]
+    der = want_vel and not type3
+    for m in range(n):
+        i = sel[m] if use_sel else m
+        a = (jd1[i] - _J2000) * _DAY - init  # exact for jd1 on a half day
+        b = jd2[i] * _DAY
+        k = int(math.floor((a + b) / intlen))
+        if k >= n_rec:  # the end point belongs to the last record
+            k = n_rec - 1
+        if k < 0:
+            k = 0
+        off = (a - k * intlen) + b  # a - k intlen exact (integers of s)
+        s = off * scale - 1.0
+        # Chebyshev polynomials T_j(s) and derivatives dT_j/ds, forward recurrence
+        tk[0] = 1.0
         if n_coef > 1:
+            tk[1] = s
             dk[1] = 1.0
+        s2 = 2.0 * s
         for j in range(2, n_coef):
-            dk[j] = 2.0 * tk[j - 1] + s2 * dk[j - 1] - dk[j - 2]
-    for c in range(3):
-        acc = np.zeros(s.shape)
-        for j in range(n_coef - 1, -1, -1):  # small terms first
-            acc += rec[:, c, j] * tk[j]
-        p = acc * _KM
-        if bsign != 0.0:
-            p += bsign * base_p[idx, bb, c]
-        out_p[idx, ob, c] = p
-        if want_vel:
-            acc = np.zeros(s.shape)
-            if type3:
-                for j in range(n_coef - 1, -1, -1):
-                    acc += rec[:, c + 3, j] * tk[j]
-                v = acc * _KM
-            else:
-                for j in range(n_coef - 1, 0, -1):
-                    acc += rec[:, c, j] * dk[j]
-                v = acc * (scale * _KM)
+            tk[j] = s2 * tk[j - 1] - tk[j - 2]
+        if der:
+            for j in range(2, n_coef):
+                dk[j] = 2.0 * tk[j - 1] + s2 * dk[j - 1] - dk[j - 2]
+        for c in range(3):
+            acc = 0.0
+            for j in range(n_coef - 1, -1, -1):  # small terms first
+                acc += coef[k, c, j] * tk[j]
+            p = acc * _KM
             if bsign != 0.0:
-                v += bsign * base_v[idx, bb, c]
-            out_v[idx, ob, c] = v
+                p += bsign * base_p[i, bb, c]
+            out_p[i, ob, c] = p
+            if want_vel:
+                acc = 0.0
+                if type3:
+                    for j in range(n_coef - 1, -1, -1):
+                        acc += coef[k, c + 3, j] * tk[j]
+                    v = acc * _KM
+                else:
+                    for j in range(n_coef - 1, 0, -1):
+                        acc += coef[k, c, j] * dk[j]
+                    v = acc * (scale * _KM)
+                if bsign != 0.0:
+                    v += bsign * base_v[i, bb, c]
+                out_v[i, ob, c] = v
 
 
 _ALL = np.zeros(0, dtype=np.int64)  # "every instant" for _cheb_eval

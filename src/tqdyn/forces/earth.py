@@ -84,14 +84,15 @@ def _pack(out, col, c, filled, lt):
     """Packed lower triangle of c (n_inst, k+1, k+1) into out[:, col:col+lt]
     (index n (n+1)/2 + m): added to the entries of degree <= filled, stored
     into the others; entries beyond degree k are zeroed if filled < 0."""
-    rows, cols = np.tril_indices(c.shape[1])  # row by row: the index n (n+1)/2 + m
-    v = c[:, rows, cols]
-    nv = v.shape[1]
-    f = min((filled + 1) * (filled + 2) // 2, nv)  # entries already holding data
-    out[:, col:col + f] += v[:, :f]
-    out[:, col + f:col + nv] = v[:, f:]
+    j = col
+    for n in range(c.shape[1]):  # row n: entries n (n+1)/2 .. n (n+1)/2 + n, held iff n <= filled
+        if n <= filled:
+            out[:, j:j + n + 1] += c[:, n, :n + 1]
+        else:
+            out[:, j:j + n + 1] = c[:, n, :n + 1]
+        j += n + 1
     if filled < 0:
-        out[:, col + nv:col + lt] = 0.0
+        out[:, j:col + lt] = 0.0
 
 
 def _provider_degree(p):
