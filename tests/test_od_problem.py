@@ -189,7 +189,7 @@ def test_lisa_dsn_and_isr_covariance():
 @pytest.mark.parametrize("make, match", [
     (lambda: odp.Tracking(("gps",), DAY), "tracking.kinds: 'gps' is not allowed"),
     (lambda: odp.Tracking(("slr",), DAY, estimate=("state", "j2")), "tracking.estimate: 'j2'"),
-    (lambda: odp.Tracking(("slr",), DAY, consider=("rtn",)), "tracking.consider: 'rtn' has no a priori sigma"),
+    (lambda: odp.Tracking(("slr",), DAY, consider=("rtn",)), "tracking.consider: 'rtn' needs an a priori sigma"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), 60 * 365.25 * DAY, DAY)),
      "tracking.arc_s: .* ends beyond the span of the ephemeris"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, 625.0)),
