@@ -1,7 +1,7 @@
 """The registry of measurement types (:class:`~tqdyn.od.measurement_type.MeasurementType`): the
 one list that tracking plans (:mod:`.tracking`), the problem (:mod:`.problem`), the workflows,
 the TDM files (:mod:`tqdyn.formats.od_tdm`) and the figures read.  Adding a type is a module
-with its class and one line in :data:`TYPES`.
+with its class and one line in :data:`TYPES` (:mod:`.measurements_ttc` is one).
 
 Built-in types:
 
@@ -11,7 +11,9 @@ Built-in types:
 * ``isr_range`` (isr): one-way inter-satellite light-path ranges of the six links
   (:mod:`.measurements_isr`);
 * ``dsn_range``, ``dsn_range_rate`` (dsn): two-way range and range rate from deep-space stations
-  (:mod:`.measurements_dsn`).
+  (:mod:`.measurements_dsn`);
+* ``ttc_range``, ``ttc_range_rate`` (ttc): two-way range and range rate from the mission's TT&C
+  ground stations, listed in a stations file the user can replace (:mod:`.measurements_ttc`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from .measurements_dsn import DEEP_SPACE_STATIONS, DSN_DOPPLER_SIGMA_M_S, DSN_RA
 from .measurements_gnss import BEIDOU_MEO, GNSS_SIGMA_M, GPS, pseudorange
 from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
 from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
+from .measurements_ttc import TTC_TYPES
 
 __all__ = ["BIAS_TYPES", "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS", "TYPES", "kind_of", "measurement_type",
            "unit_text"]
@@ -114,7 +117,7 @@ class DsnRangeRate(_DeepSpace):
 
 #: Every measurement type, by name, in the row order of the measurement tables.
 TYPES: dict[str, MeasurementType] = {x.name: x for x in (GnssPseudorange(), SlrRange(), IsrRange(), DsnRange(),
-                                                         DsnRangeRate())}
+                                                         DsnRangeRate(), *TTC_TYPES)}
 MEASUREMENT_TYPES = tuple(TYPES)
 #: Tracking kinds, and the types of each.
 TRACKING_KINDS = tuple(dict.fromkeys(x.kind for x in TYPES.values()))
