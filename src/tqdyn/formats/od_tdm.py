@@ -172,9 +172,9 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
         typ = str(cols["type"][i])
         if typ not in REGISTRY:
             raise ValueError(unknown(f"measurements.type[{i}]", typ, TYPES))
-        if REGISTRY[typ].two_way and not (np.isfinite(tau[i]) and tau[i] >= 0):
+        if REGISTRY[typ].two_way and not np.isfinite(tau[i]):
             raise ValueError(f"measurements.tau_down[{i}] = {tau[i]}: a two-way {typ} row needs its downlink light "
-                             "time (s >= 0; tqdyn.od's problem.simulate gives it) to be tagged at reception")
+                             "time (s; tqdyn.od's problem.simulate gives it) to be tagged at reception")
         key = (typ, int(cols["sat"][i]), str(cols["peer"][i]), float(sig[i]))
         groups.setdefault(key, []).append(i)
     t_tag = cols["t"].astype(np.float64) + np.where(np.isfinite(tau), tau, 0.0)
