@@ -59,7 +59,7 @@ def ttc_stations() -> dict:
 
 @functools.lru_cache(maxsize=8)
 def _read(path: str) -> dict:
-    where = f"TT&C stations file {path!r}"
+    where = f"TT&C stations file {pathlib.Path(path).name!r}"
     try:
         doc = tomllib.loads(pathlib.Path(path).read_text(encoding="utf-8"))
     except OSError as exc:
