@@ -151,7 +151,7 @@ def test_ccsds_ndm_reads_the_ranges_at_their_tags(tdm_file):
     back on the downleg, the transmission on the upleg; c (round trip) / 2 agrees to 1 mm (to the
     um the tags' 1-ns digits allow)."""
     ndm_io = pytest.importorskip("ccsds_ndm.ndm_io")
-    scen, meas, path, t_grid, states = tdm_file
+    scen, _, path, t_grid, states = tdm_file
     segs = ndm_io.NdmIo().from_path(pathlib.Path(path)).body.segment
     tt0 = scen.epoch.tt
     eop = eop_table(scen.forces.eop, scen.forces.eop_interpolation)      # the scenario's, as the models
@@ -173,10 +173,10 @@ def test_ccsds_ndm_reads_the_ranges_at_their_tags(tdm_file):
             k = int(np.argmin(np.abs(t_grid - off_r)))
             off_r -= t_grid[k]                             # from the grid instant: no cancellation
 
-            def station(dt):
+            def station(dt, k=k, itrs=itrs):
                 return station_states_gcrs(scen.epoch, t_grid[k:k + 1], itrs, dt=np.array([[dt]]), eop=eop)[0][0, 0]
 
-            def sat(dt):
+            def sat(dt, k=k, sat_i=sat_i):
                 return states[k, sat_i, :3] + states[k, sat_i, 3:] * dt
 
             R_r, off_b = station(off_r), off_r

@@ -58,7 +58,6 @@ from decimal import Decimal, InvalidOperation, localcontext
 
 import erfa
 import numpy as np
-
 from scipy.constants import c as SPEED_OF_LIGHT
 
 from .._choices import unknown

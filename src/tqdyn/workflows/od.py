@@ -33,7 +33,7 @@ from ..formats.od_tdm import read_measurements_tdm, write_measurements_tdm
 from .closed_loop import file_sha256
 from .run import load_run_scenario
 
-__all__ = ["KIND_OF_TYPE", "SimulateSummary", "covariance_of", "fit_to_file", "parameter_unit", "parse_arc",
+__all__ = ["KIND_OF_TYPE", "SimulateSummary", "covariance_of", "fit_to_file", "parameter_unit", "parse_arc",  # noqa: F822
            "parse_names", "parse_tracking", "simulate_to_tdm"]
 
 
