@@ -142,11 +142,11 @@ def test_self_gravity_recovered_gauss_newton_20_seeds(recovery, record_number):
 
 def test_partials_against_central_differences(record_number):
     """compute()'s H against central differences of compute()'s h between dd propagations
-    (tianqin-gravity, 1 day every 3 h, GNSS + SLR + ISR + DSN): the columns of Sat1's x
+    (tianqin-gravity, 1 day every 3 h, GNSS + SLR + ISR + DSN + TT&C): the columns of Sat1's x
     (steps +-1 m) and Sat2's s_y (+-1e-9 m/s^2).  Expected: the float64 variational equations
     (~1e-10 relative, docs/orbit-determination.md) and the differences' round-off (~1e-8 m
     on 1e8 m ranges over ~1-4 m of change, ~1e-8)."""
-    tr = odp.Tracking(("gnss", "slr", "isr", "dsn"), DAY, 3 * 3600.0)
+    tr = odp.Tracking(("gnss", "slr", "isr", "dsn", "ttc"), DAY, 3 * 3600.0)
     meas = odp.schedule(SCEN, tr)
     assert np.all(np.diff(meas.t) >= 0) and np.all(np.isnan(meas.value))
     assert set(meas.type) == set(odp.MEASUREMENT_TYPES)

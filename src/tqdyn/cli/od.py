@@ -90,7 +90,8 @@ def od():
 
 @od.command("simulate")
 @click.argument("run_file", metavar="RUN.h5")
-@click.option("--tracking", required=True, help="Tracking kinds, comma-separated (gnss, slr, isr, dsn, ...: the measurement types of "
+@click.option("--tracking", required=True,
+              help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
                    "docs/orbit-determination.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
@@ -165,7 +166,8 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
 
 @od.command("covariance")
 @click.argument("scenario", metavar="SCENARIO")
-@click.option("--tracking", required=True, help="Tracking kinds, comma-separated (gnss, slr, isr, dsn, ...: the measurement types of "
+@click.option("--tracking", required=True,
+              help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
                    "docs/orbit-determination.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")

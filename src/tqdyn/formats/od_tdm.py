@@ -20,7 +20,8 @@ rows' first appearance, with the standard's keywords:
   the satellite (the models' own tag), ``RANGE`` with ``RANGE_UNITS = km``;
 * two-way types (``PATH = 1,2,1``: SLR, deep-space and TT&C range and range rate): tagged at the
   reception at the station, the model's tag (the bounce at the satellite) plus the row's downlink
-  light time (``Measurements.tau_down``); ``RANGE`` with ``RANGE_UNITS = s``: the round-trip light
+  light time (``Measurements.tau_down``; a table without it: half the round trip, what the reader
+  takes back, ~1e-6 s from the reception geocentric); ``RANGE`` with ``RANGE_UNITS = s``: the round-trip light
   time 2 v / c (v the model's two-way range c (tau_up + tau_down) / 2 [m]); ``DOPPLER_INSTANTANEOUS``
   [km/s]: the range rate with respect to the reception time, v c / (c + v) for the rate v with
   respect to the bounce time (d t_receive / d t_bounce = 1 + tau_down' and tau_down' = v / c to
@@ -75,6 +76,9 @@ TYPES = MEASUREMENT_TYPES
 TIMETAG_REFS = ("TRANSMIT", "RECEIVE")
 _C = Decimal(int(SPEED_OF_LIGHT))           # m/s, exact
 _DIGITS = 40                                 # significant digits of the light-time and Doppler conversions
+#: Largest distance [s] of a two-way row's bounce (tag less half the round trip) from the grid that is
+#: moved onto it: (tau_down - tau_up) / 2 is ~1e-6 s geocentric, < 0.02 s heliocentric.
+_SNAP_S = 0.1
 #: run time scale -> the function (epoch, t) -> two-part JD in it
 TIME_SCALES = {"TT": tt_jd, "TDB": tdb_after}
 _FIELDS = ("t", "type", "sat", "peer", "value", "sigma")
@@ -164,16 +168,13 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     def sat_name(k: int) -> str:
         return names[k] if 0 <= k < len(names) else f"SAT{k}"
 
-    tau = getattr(meas, "tau_down", None)
-    tau = np.full(m, np.nan) if tau is None else np.asarray(tau, np.float64)
+    for i in range(m):
+        if str(cols["type"][i]) not in REGISTRY:
+            raise ValueError(unknown(f"measurements.type[{i}]", str(cols["type"][i]), TYPES))
+    tau = _light_times(cols, getattr(meas, "tau_down", None))
     groups: dict = {}
     for i in range(m):
         typ = str(cols["type"][i])
-        if typ not in REGISTRY:
-            raise ValueError(unknown(f"measurements.type[{i}]", typ, TYPES))
-        if REGISTRY[typ].two_way and not np.isfinite(tau[i]):
-            raise ValueError(f"measurements.tau_down[{i}] = {tau[i]}: a two-way {typ} row needs its downlink light "
-                             "time (s; tqdyn.od's problem.simulate gives it) to be tagged at reception")
         key = (typ, int(cols["sat"][i]), str(cols["peer"][i]), float(sig[i]))
         groups.setdefault(key, []).append(i)
     t_tag = cols["t"].astype(np.float64) + np.where(np.isfinite(tau), tau, 0.0)
@@ -205,6 +206,25 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     return tdm
 
 
+def _light_times(cols: dict, tau) -> np.ndarray:
+    """The downlink light time [s] of each row (m,): the table's ``tau_down`` where finite; else, on
+    a two-way row, half its round trip (a range: value / c; a range rate: its range row's at the same
+    t, satellite and peer, else 0) -- what the reader takes back (module docstring); NaN elsewhere."""
+    m = cols["t"].size
+    out = np.full(m, np.nan) if tau is None else np.array(tau, np.float64)
+    typ = cols["type"].astype(str)
+    two = np.array([REGISTRY[x].two_way for x in typ.tolist()], bool)
+    rng = two & np.array([REGISTRY[x].tdm_keyword == "RANGE" for x in typ.tolist()], bool)
+    half = {(t, s, p): v / SPEED_OF_LIGHT for t, s, p, v, r in zip(cols["t"].tolist(), cols["sat"].tolist(),
+                                                                    cols["peer"].astype(str).tolist(),
+                                                                    cols["value"].astype(np.float64).tolist(), rng)
+            if r}
+    for i in np.flatnonzero(two & ~np.isfinite(out)):
+        key = (cols["t"][i].item(), cols["sat"][i].item(), str(cols["peer"][i]))
+        out[i] = float(cols["value"][i]) / SPEED_OF_LIGHT if rng[i] else half.get(key, 0.0)
+    return out
+
+
 def write_measurements_tdm(path, meas, **kw) -> pathlib.Path:
     """Write :func:`measurements_to_tdm` ``(meas, **kw)`` to ``path`` atomically."""
     return write_tdm(path, measurements_to_tdm(meas, **kw))
@@ -231,7 +251,7 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
     given as an Epoch they must agree with it.  grid_s [s]: the grid of the time tags (a run's
     ``integrator.step``): the bounce instants of two-way rows tagged at reception or transmission
     (the tag less or plus half the round-trip light time, within ~1e-6 s geocentric) are moved onto
-    it when within 1 % of a step (None: not moved).  Raises ValueError (one line naming ``name``)."""
+    it when within 0.1 s and 1 % of a step of it (None: not moved).  Raises ValueError (one line naming ``name``)."""
     from ..astro.timescales import Epoch
 
     info = _tqdyn_comments(tdm.comments)
@@ -330,7 +350,7 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
         for j, typ in enumerate(x[0] for x in parts["type"]):
             if REGISTRY[typ].two_way:
                 snapped = np.round(parts["t"][j] / grid_s) * grid_s
-                near = np.abs(parts["t"][j] - snapped) <= 0.01 * grid_s
+                near = np.abs(parts["t"][j] - snapped) <= min(0.01 * grid_s, _SNAP_S)
                 parts["t"][j] = np.where(near, snapped, parts["t"][j])
     cat = {f: np.concatenate(v) for f, v in parts.items()}
     order = np.argsort(cat["t"], kind="stable")

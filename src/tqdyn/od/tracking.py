@@ -1,9 +1,8 @@
 """Tracking plans and measurement rows of orbit determination (:mod:`.problem` puts them
-together): the tracking kinds and measurement types, the :class:`Tracking` plan, the
-:class:`Measurements` table, and the measurement models of :mod:`.measurements_gnss`,
-:mod:`.measurements_slr`, :mod:`.measurements_isr`, :mod:`.measurements_dsn` evaluated on a grid
-of states (every computable row with its partials with respect to the satellites' position and
-velocity at the time tag, chained with the full-system state transition matrix and
+together): the tracking kinds and measurement types (those of :mod:`.registry`), the
+:class:`Tracking` plan, the :class:`Measurements` table, and the registered measurement types
+evaluated on a grid of states (every computable row with its partials with respect to the
+satellites' position and velocity at the time tag, chained with the full-system state transition matrix and
 sensitivities by :func:`jacobian`).  Time tags t [s since the epoch, the run's time scale: TT
 geocentric, TDB heliocentric]; states [m, m/s] in the run's frame.
 """
@@ -66,8 +65,10 @@ class Tracking:
 
     kinds: subset of :data:`TRACKING_KINDS`; arc_s [s] from the epoch; interval_s [s] sampling
     interval, a multiple of ``integrator.step``; sigma: {measurement type: sigma [m or m/s]}
-    overriding :data:`DEFAULT_SIGMA`; stations: SLR (:data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`)
-    and deep-space (:data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`) station names (None:
+    overriding :data:`DEFAULT_SIGMA`; stations: station names of the station kinds
+    (:data:`STATION_KINDS`: SLR :data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`, deep-space
+    :data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`, TT&C the stations file of
+    :mod:`~tqdyn.od.measurements_ttc`) (None:
     all of them); estimate, consider: parameter groups (:data:`GROUPS`; estimate None: the
     run's defaults, :meth:`estimated`); a_priori_sigma: {group:
     sigma} a priori sigmas per group (``"state"``: (sigma_r [m], sigma_v [m/s]); the acceleration

@@ -121,7 +121,7 @@ def parse_biases(items, option: str = "--bias") -> dict:
         typ = key.removeprefix("bias/").split("/")[0]
         if typ not in allowed:
             raise ValueError(f"{option}: {key!r} is not allowed{did_you_mean(typ, allowed)}; allowed: "
-                             f"{', '.join(allowed)} (or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
+                             f"{', '.join(allowed)}, or TYPE/PEER")
         out[key] = _number(value, option, key, positive=False)
     return out
 
