@@ -37,7 +37,6 @@ from .measurements import Observable, geocentric_two_way
 __all__ = ["TTC_TYPES", "TtcRange", "TtcRangeRate", "ttc_stations", "use_ttc_stations"]
 
 _SHIPPED = pathlib.Path(__file__).resolve().parent.parent / "data" / "ttc_stations.toml"
-_NAMES = ("ttc_range", "ttc_range_rate")
 _chosen: list = []
 
 
@@ -145,3 +144,4 @@ class TtcRangeRate(_Ttc):
 
 #: The TT&C measurement types (registered in :mod:`.registry`).
 TTC_TYPES = (TtcRange(), TtcRangeRate())
+_NAMES = tuple(x.name for x in TTC_TYPES)
