@@ -40,7 +40,7 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, 
     mission's TM acceleration requirement [m/s^2/Hz^1/2]; ``dominant`` (segment, sat, output, band) the
     largest source per band (:data:`BANDS`); ``gain_margin`` [1] and ``phase_margin`` [deg] and
     ``crossover`` [Hz] per (segment, sat, channel).  ``dt`` [s]: the zero-order-hold discretised loops'
-    budget (what the time domain runs).  ``progress``: called with 1 after each (segment, satellite) loop
+    budget (a sampled loop on held noise; the time series realise the continuous budget).  ``progress``: called with 1 after each (segment, satellite) loop
     (segments x satellites calls).  Coordinates carry units and frames (attrs)."""
     import xarray as xr
 

@@ -8,8 +8,9 @@ and frozen-coefficient segment), :mod:`~tqdyn.closedloop.plant` (the linearised 
 :mod:`~tqdyn.closedloop.controllers`, :mod:`~tqdyn.closedloop.noise` (one-sided ASD models),
 :mod:`~tqdyn.closedloop.loop` (the named interconnection), :mod:`~tqdyn.closedloop.missions` (the
 defaults of TianQin, LISA and Taiji), :mod:`~tqdyn.closedloop.budget` (frequency domain: budgets,
-margins), :mod:`~tqdyn.closedloop.simulate` (time domain) and :mod:`~tqdyn.closedloop.one_dof` (the
-one-axis reference loop).  The loop and noise-source tables are the scenario's
+margins), :mod:`~tqdyn.closedloop.simulate` (time domain), :mod:`~tqdyn.closedloop.synthesis` (how the
+time series realise the budget: two bands) and :mod:`~tqdyn.closedloop.one_dof` (the one-axis reference
+loop).  The loop and noise-source tables are the scenario's
 (:data:`tqdyn.scenario.closed_loop.LOOPS`, :data:`tqdyn.scenario.closed_loop.SOURCES`).
 
 The public names below are imported from their modules on first use (python-control is slow to
@@ -30,6 +31,7 @@ _HOME = {
     "MISSIONS": "missions", "default_controllers": "missions", "default_noise": "missions", "default_plant": "missions",
     "representative_plant": "missions", "representative_working_point": "missions", "requirement": "missions",
     "working_points": "working_point",
+    "series_psd": "synthesis",
 }
 
 __all__ = sorted(_HOME)
