@@ -212,3 +212,31 @@ def test_a_boundary_between_different_loops_switches_the_spectrum():
         sigma = math.sqrt(1.06 * 1.94 / (k_seg * sel.sum()))
         assert abs(np.mean(P[sel] / budgets[-1]) - 1) < 5 * sigma + SYSTEMATIC
     assert np.min(budgets[1] / budgets[0]) > 5                    # the two spectra differ
+
+
+def test_the_direct_forms_give_the_modal_forms_series(monkeypatch):
+    """Without the modal decompositions (tolerance below any error: the low band's direct recursion, the
+    high band's transfer functions by one LU solve per frequency) the series of the one-DOF loop is the
+    same to round-off (1e-9 of the largest value)."""
+    from tqdyn.closedloop import synthesis
+    from tqdyn.closedloop.noise import AsdModel
+    from tqdyn.closedloop.one_dof import one_dof_loop
+
+    cl = one_dof_loop(lead_lag_pid(0.05), 2000.0, -1e-6)
+    noise = {"thruster_force": AsdModel(1e-7, ((0.1, 1.0),), "N", "n"),
+             "interferometer": AsdModel(1e-12, ((2e-3, -2.0),), "m", "n")}
+    modal = simulate([[(0.0, cl)]], noise, FS, 2000, seed=4).values
+    monkeypatch.setattr(synthesis, "MODAL_TOLERANCE", -1.0)
+    direct = simulate([[(0.0, cl)]], noise, FS, 2000, seed=4).values
+    assert np.max(np.abs(modal - direct)) <= 1e-9 * np.max(np.abs(modal))
+
+
+def test_filters_longer_than_the_limit_are_refused_in_one_line(monkeypatch):
+    """A loop whose high-band filters need more than FIR_MAX samples (here the limit lowered to 512) is
+    refused with one line naming closed_loop.fs and the source."""
+    from tqdyn.closedloop import synthesis
+
+    monkeypatch.setattr(synthesis, "FIR_MAX", 512)
+    with pytest.raises(ValueError, match=r"closed_loop\.fs: 4 Hz needs high-band filters of closed_loop\.noise\.") as e:
+        simulate([[(0.0, _loop("lisa"))]], default_noise("lisa"), FS, 100)
+    assert "\n" not in str(e.value)
