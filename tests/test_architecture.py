@@ -22,11 +22,13 @@ PACKAGE = pathlib.Path(tqdyn.__file__).resolve().parent
 #: Layers from the bottom up (docs/design.md).  ``readers`` may also import
 #: ``astro.constants``, the one dependency-free module of ``astro``.  ``_version``
 #: is the version string alone (so that no layer imports the package root,
-#: whose lazy attributes import the front door).  ``peers`` (other libraries'
+#: whose lazy attributes import the front door); ``_choices`` words every
+#: layer's message about a name that is not allowed (the closest names, where
+#: the list is documented).  ``peers`` (other libraries'
 #: formulations of tqdyn's models) sit just above ``numerics``, so that they
 #: cannot borrow tqdyn's physics; only the workflows use them
 #: (:func:`test_only_workflows_use_the_peers`).
-LAYERS = ("_version", "numerics", "peers", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
+LAYERS = ("_version", "_choices", "numerics", "peers", "readers", "astro", "forces", "constellation", "lightpath", "dynamics", "scenario",
           "closedloop", "ttl", "od",
           "formats", "analysis", "workflows", "cli", "<front>")
 #: Top-level modules outside the layer packages: the front door and the
@@ -34,6 +36,7 @@ LAYERS = ("_version", "numerics", "peers", "readers", "astro", "forces", "conste
 FRONT = ("__init__", "api", "io", "sweep")
 #: Third-party packages a layer must not import (I/O, plotting, CLI, distributed engine).
 FORBIDDEN = {
+    "_choices": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "numerics": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "peers": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),
     "readers": ("h5py", "matplotlib", "click", "dask", "distributed", "xarray", "tqdm"),

@@ -18,7 +18,8 @@ from scipy import signal
 from tqdyn.closedloop.budget import DesignError, check_stable, closed_loop_response, loop_margins, noise_budget
 from tqdyn.closedloop.controllers import Controller, lead_lag_pid
 from tqdyn.closedloop.loop import SOURCES, build_closed_loop, output_names
-from tqdyn.closedloop.missions import MISSIONS, default_controllers, default_noise, default_plant, requirement
+from tqdyn.closedloop.missions import (CONSTELLATION_MISSIONS, default_controllers, default_noise, default_plant,
+                                      requirement)
 from tqdyn.closedloop.noise import AsdModel, shaping_error
 from tqdyn.closedloop.one_dof import one_dof_loop
 from tqdyn.closedloop.plant import PlantParameters, WorkingPoint
@@ -81,7 +82,7 @@ def test_one_dof_time_domain_asd_agrees_with_the_budget_within_welch_statistics(
     assert abs(np.mean(r[band]) - 1) < 4 * sigma + 0.01
 
 
-@pytest.mark.parametrize("mission", MISSIONS)
+@pytest.mark.parametrize("mission", CONSTELLATION_MISSIONS)
 def test_default_designs_are_stable_with_margins_and_name_their_dominant_sources(mission):
     """Every loop channel of the default design: phase margin 40..60 deg near its design crossover (the
     lead-lag design gives 49 deg on 1/s^2); the budget names a largest source for every output and band."""
@@ -114,7 +115,7 @@ def _margins_agree(cl, rel=1e-9):
         assert math.isfinite(a.phase_margin) and math.isfinite(a.f_phase_margin), a
 
 
-@pytest.mark.parametrize("mission", MISSIONS)
+@pytest.mark.parametrize("mission", CONSTELLATION_MISSIONS)
 def test_windowed_margins_equal_the_full_grid_at_the_representative_working_point(mission):
     """tqdyn.closedloop.missions.representative_working_point (the first-principles working point) and the
     default design of each mission."""
@@ -124,7 +125,7 @@ def test_windowed_margins_equal_the_full_grid_at_the_representative_working_poin
                                      default_controllers(mission)))
 
 
-@pytest.mark.parametrize("mission", MISSIONS)
+@pytest.mark.parametrize("mission", CONSTELLATION_MISSIONS)
 def test_frequency_response_equals_python_control(mission):
     """closed_loop_response's batched solve against python-control's frequency_response (per-frequency
     solve, without slycot) on every output and input of the default design, continuous and zero-order-hold

@@ -43,7 +43,8 @@ def made(runs, tmp_path_factory):
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         try:
-            status = cli.main(["closed-loop", str(runs / "tq.h5"), "--output", str(out), "--seed", "5", *SMALL])
+            status = cli.main(["closed-loop", str(runs / "tq.h5"), "--output", str(out), "--seed", "5", "--per-source",
+                               *SMALL])
         except SystemExit as exc:
             status = exc.code
     return status, out, err.getvalue()
@@ -69,7 +70,7 @@ def test_the_command_writes_what_the_entry_points_compute(runs, made):
     ts = closed_loop_timeseries(model, duration_s=600.0, fs=1.0, seed=5)
     assert np.array_equal(f.timeseries()["values"].values, ts["values"].values)
     b = closed_loop_budget(model)
-    for name in ("asd", "total", "gain_margin", "phase_margin", "frequency"):
+    for name in ("asd", "total", "gain_margin", "gain_margin_lower", "gain_margin_upper", "phase_margin", "frequency"):
         assert np.array_equal(f.budget[name].values, b[name].values, equal_nan=True), name
     assert f.attrs["source_file"] == "tq.h5" and f.attrs["seed"] == 5 and f.attrs["fs"] == 1.0
     assert f.attrs["source_sha256"] == hashlib.sha256((runs / "tq.h5").read_bytes()).hexdigest()
@@ -114,10 +115,11 @@ def test_output_may_not_be_the_run_and_an_existing_output_is_replaced_only_when_
                                                                                          capsys):
     """As tqdyn run: the output replaces an existing file on success (atomically), never the input."""
     status, _o, err = run_cli(["closed-loop", str(runs / "tq.h5"), "--output", str(runs / "tq.h5")], capsys)
-    assert status == 2 and "the run file itself" in err and err.count("\n") == 1
+    assert status == 2 and "is the input RUN.h5" in err and err.count("\n") == 1
     out = tmp_path / "cl.h5"
     out.write_bytes(b"old")
-    status, stdout, err = run_cli(["closed-loop", str(runs / "tq.h5"), "-o", str(out), "--seed", "5", *SMALL], capsys)
+    status, stdout, err = run_cli(["closed-loop", str(runs / "tq.h5"), "-o", str(out), "--seed", "5", "--per-source",
+                                   *SMALL], capsys)
     assert status in (0, None) and "output:" in stdout
     assert out.read_bytes() == made[1].read_bytes()          # the same bytes as the first file (deterministic)
 

@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 import pytest
 
-from tqdyn.formats.closed_loop import FORMAT, ClosedLoopFormatError, ClosedLoopWriter, read_closed_loop
+from tqdyn.formats.closed_loop import FORMAT, FORMAT_VERSION, ClosedLoopFormatError, ClosedLoopWriter, read_closed_loop
 
 F = np.logspace(-4, 0, 8)
 
@@ -80,7 +80,7 @@ def test_every_dataset_is_chunked_with_fletcher32(tmp_path, model_and_budget):
 
     with h5py.File(path, "r") as h5:
         h5.visititems(visit)
-        assert h5.attrs["format"] == FORMAT and h5.attrs["format_version"] == 1
+        assert h5.attrs["format"] == FORMAT and h5.attrs["format_version"] == FORMAT_VERSION
         assert h5["timeseries/tm1_acceleration"].attrs["units"] == "m/s^2"
     assert "timeseries/t" in seen and "budget/asd" in seen and "budget/dominant" in seen
 

@@ -1,9 +1,23 @@
-"""The Python examples of the documentation run (README.md, docs/python.md, docs/lisa-toolchain.md).
+"""The Python examples of the documentation run (README.md, docs/python.md, docs/lisa-toolchain.md,
+docs/lisa-ttl.md).
 
 Each ```python block of the listed pages is executed in a fresh namespace in
 a temporary directory (matplotlib without a display); a block fails the test
 if it raises.  What the example computes is checked against the physics in
 the other tests; here the claim is only that the documented code works.
+README.md and docs/python.md propagate the same two days: the second page
+gets the first page's trajectory (``tqdyn.propagate`` answered once per
+identical call within this module).
+
+The two LISA tool-chain recipes (a minute of LISA Instrument and PyTDI with
+their tqdyn runs) are slow tests; the default suite runs their tool
+functions on the same calls and checks the same claims:
+docs/lisa-toolchain.md in tests/test_export_lisa_bcrs.py::test_x2_suppresses_laser_noise
+(``x2_chain`` on a TianQin and a LISA-like orbit file of tqdyn, 12000
+samples, X2 suppression > 1e7), docs/lisa-ttl.md in
+tests/test_lisa_injection.py (``make_files`` and ``simulate`` with the
+recipe's arguments; X2 zero without the injection file and not with it, in
+test_lisa_instrument_readouts_reproduce_the_ttl).
 """
 
 import os
@@ -13,7 +27,15 @@ import re
 import pytest
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs"
-PAGES = ("../README.md", "python.md", "lisa-toolchain.md", "lisa-ttl.md")
+PAGES = ("../README.md", "python.md", pytest.param("lisa-toolchain.md", marks=pytest.mark.slow),
+         pytest.param("lisa-ttl.md", marks=pytest.mark.slow))
+
+
+@pytest.fixture(scope="module")
+def same_propagation():
+    """{(scenario, overrides): Trajectory}: the in-memory propagations of this module's examples."""
+    return {}
+
 
 
 def _blocks(page):
@@ -22,13 +44,24 @@ def _blocks(page):
 
 
 @pytest.mark.parametrize("page", PAGES)
-def test_python_blocks_run(page, tmp_path, monkeypatch, capsys):
+def test_python_blocks_run(page, tmp_path, monkeypatch, capsys, same_propagation):
     import matplotlib
+
+    import tqdyn
 
     matplotlib.use("Agg")
     blocks = _blocks(page)
     assert blocks, f"{page} has no python example"
     monkeypatch.chdir(tmp_path)
+    propagate = tqdyn.propagate
+
+    def once(scenario=None, overrides=(), **kw):
+        key = repr((scenario, overrides, sorted(kw.items())))
+        if key not in same_propagation:
+            same_propagation[key] = propagate(scenario, overrides, **kw)
+        return same_propagation[key]
+
+    monkeypatch.setattr(tqdyn, "propagate", once)
     for code in blocks:
         exec(compile(code, f"{page}", "exec"), {"__name__": "__docs__"})
     out = capsys.readouterr().out

@@ -1,4 +1,4 @@
-"""The measured numbers of README.md and docs/*.md against their JSON records (docs/numbers.md).
+"""The measured numbers of README.md, CHANGELOG.md and docs/*.md against their JSON records (docs/numbers.md).
 
 Every page is rendered in memory by ``tools/render_docs.py`` from ``docs/data/*.json`` (the records that
 ``tqdyn bench --json``, ``tqdyn report --studies`` and ``pytest --record-numbers`` write); a page whose
@@ -60,8 +60,11 @@ TYPED_ALLOWED = [
     ("docs/design.md", "1 MB per\ndataset", "HDF5's default chunk cache, a library setting"),
     ("docs/design.md", "1 MB per dataset", "HDF5's default chunk cache, a library setting"),
     ("docs/design.md", "~10 MB each", "n_tdat x 13 stages x 512 steps x 8 bytes: arithmetic"),
+    ("docs/closed-loop-file.md", "2 MiB", "the chunk-size bound of the closed-loop writer, a setting"),
     ("docs/reliability.md", "2.6 MB tmpfs", "the size of the test's file system, a test setting"),
     ("docs/reliability.md", "1 MiB", "the headroom constant of the writer"),
+    ("docs/reliability.md", "1 kB", "the file-size limit of the fault-table test, a test setting"),
+    ("docs/reliability.md", "64 kB", "the size of the fault-table test's file system, a test setting"),
     ("docs/reliability.md", "100 B, 5 kB\n  and 5 MB", "the sizes the test cuts the ephemeris file to"),
     ("docs/reliability.md", "100 B, 5 kB and 5 MB", "the sizes the test cuts the ephemeris file to"),
     ("docs/lisa-toolchain.md", "takes about 30 s", "tools/lisa_toolchain_x2.py: not recorded yet (the page is being "

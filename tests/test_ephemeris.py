@@ -145,7 +145,7 @@ def test_out_of_span_raises_naming_date_and_span(eph):
 
 
 def test_bad_bodies_and_files(eph, tmp_path):
-    with pytest.raises(ValueError, match="unknown body 'pluto2'"):
+    with pytest.raises(ValueError, match="'pluto2' is not a body \\(did you mean 'pluto'\\?\\)"):
         eph.geocentric("pluto2", JD_EPOCH, 0.0)
     missing = tmp_path / "de440.bsp"
     with pytest.raises(FileNotFoundError, match=str(missing)):

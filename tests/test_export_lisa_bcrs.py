@@ -331,6 +331,8 @@ def test_cli_bcrs(helio, tmp_path, capsys):
 
 @pytest.mark.parametrize("case", ["TianQin", "LISA"])
 def test_x2_suppresses_laser_noise(case, helio, geo):
+    """The claim of docs/lisa-toolchain.md's recipe (a slow test of tests/test_docs_examples.py) on this
+    module's files: x2_chain as the recipe calls it, X2 suppression > 1e7 on TianQin and LISA-like orbits."""
     # the whole chain: tqdyn orbit file -> lisainstrument (laser noise only, six lasers on cavities) -> pytdi X2;
     # measured median ASD ratio in 0.01-1 Hz: 8.6e8 (TianQin, 4 h), 5.7e8 (LISA-like, 3 days) at 10000 s
     pytest.importorskip("lisainstrument")

@@ -11,6 +11,7 @@ the 8 MB blocks freed -- 200 MB stay resident without the policy, none
 with it.
 """
 
+import os
 import platform
 import subprocess
 import sys
@@ -42,7 +43,12 @@ print(rss() - base)              # MB still resident of the 200 MB freed
 
 
 def _retained_mb(mode: str) -> float:
-    out = subprocess.run([sys.executable, "-c", _SCRIPT, mode], capture_output=True, text=True, check=True)
+    # glibc's default policy: no MALLOC_* tunables (Dask's nanny puts MALLOC_TRIM_THRESHOLD_ into the
+    # environment of a process that started a local cluster, and a set trim threshold turns glibc's
+    # dynamic mmap threshold off)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("MALLOC_")}
+    out = subprocess.run([sys.executable, "-c", _SCRIPT, mode], capture_output=True, text=True, check=True,
+                         env=env)
     return float(out.stdout)
 
 

@@ -63,3 +63,51 @@ def test_stale_version_folders_are_pruned(monkeypatch, tmp_path):
     os.utime(recent, (now - 40 * 86400, now - 40 * 86400))
     assert _jit.prune_stale_caches(now=now) == []     # pruned less than a day ago
     assert _jit.prune_stale_caches(now=now + 2 * 86400) == [recent]
+
+
+def test_dynamic_constants_share_one_compiled_callee():
+    """numba compiles a jitted callee once per distinct constant argument (literal types); passed through
+    ``numerics.jit.dynamic`` the constants are run-time values and the callee compiles once (numba's own
+    ``signatures`` of the callee are the reference).  Without it, the same calls give three versions."""
+    from numba import njit
+
+    def callee(a, k, flag):
+        return a + k if flag else a - k
+
+    plain, wrapped = njit(callee), njit(callee)
+
+    @njit
+    def with_constants(a):
+        return plain(a, 1, True) + plain(a, 2, True) + plain(a, 3, False)
+
+    @njit
+    def with_dynamic(a):
+        d = _jit.dynamic
+        return wrapped(a, d(1), d(True)) + wrapped(a, d(2), d(True)) + wrapped(a, d(3), d(False))
+
+    assert with_constants(1.0) == with_dynamic(1.0) == 2.0 + 3.0 - 2.0
+    assert len(plain.signatures) == 3
+    assert len(wrapped.signatures) == 1 and str(wrapped.signatures[0]) == "(float64, int64, bool)"
+
+
+def test_compile_clock_counts_compilations_not_calls():
+    """The start-up benchmark's clock (workflows.bench_mission.compile_clock): one compiled function (with its
+    callee compiled inside it) counts once, with positive time; calling it again, compiled, adds nothing."""
+    from numba import njit
+
+    from tqdyn.workflows.bench_mission import compile_clock
+
+    @njit
+    def inner(x):
+        return 2.0 * x
+
+    @njit
+    def outer(x):
+        return inner(x) + 1.0
+
+    with compile_clock() as jit:
+        assert outer(1.0) == 3.0
+        first = dict(jit)
+        assert outer(2.0) == 5.0
+    assert first["n"] == 1 and 0.0 < first["cpu_s"] and 0.0 < first["wall_s"] < 60.0
+    assert jit == first

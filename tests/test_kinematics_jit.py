@@ -207,7 +207,7 @@ def test_frames_orthonormal_bisector_normal(law):
 def _kernel_beam(law, i, m, r_hi, r_lo, v, a):
     """Kernel beam jet (b, b', b'') of satellite i towards m (private helper, same code as sat_kinematics)."""
     jm, sm = _monopole_jerk_snap(tuple(r_hi[m] + r_lo[m]), tuple(v[m]), tuple(a[m]), GM)
-    return _beam_jet(LAW_CODES[law], i, m, r_hi, r_lo, v, a, jm, sm, C)
+    return _beam_jet(LAW_CODES[law], Z33, i, m, r_hi, r_lo, v, a, jm, sm, C)  # an array: the law as given
 
 
 def test_iterative_light_time_and_beams_against_mpmath():

@@ -265,7 +265,8 @@ def test_propagator_dense_output_vs_direct_propagation():
     from tqdyn.scenario import load_scenario
 
     blocks = []
-    propagate(load_scenario("tianqin-kepler", ["run.duration=2h"]), sink=blocks.append)
+    dp87 = "integrator.method=dp87"  # DP87 rows and reference (tests/test_multistep.py: the multistep rows)
+    propagate(load_scenario("tianqin-kepler", ["run.duration=2h", dp87]), sink=blocks.append)
     rows = Rows.concatenate(blocks)
     t, R, V, A = rows.t, rows.sat_r, rows.sat_v, rows.sat_a_gravity
     res = LP.light_travel_times(t, R, V, A)
@@ -277,7 +278,7 @@ def test_propagator_dense_output_vs_direct_propagation():
         step = (Decimal(mpmath.nstr(te, 40, min_fixed=-1, max_fixed=50)) / m).quantize(Decimal("1e-28"))
         duration = step * m  # exact in Decimal; |duration - te| <= m * 5e-29 s
         gap = float(mpmath.mpf(str(duration)) - te)
-    direct = propagate(load_scenario("tianqin-kepler", [f"run.duration={duration}", f"integrator.step={step}"]))
+    direct = propagate(load_scenario("tianqin-kepler", [f"run.duration={duration}", f"integrator.step={step}", dp87]))
     y = direct.y_final[ln.emitter.index]  # (6, 2) dd
     worst = 0.0
     with mpmath.workdps(DPS):

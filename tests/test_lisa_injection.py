@@ -101,6 +101,12 @@ def test_lisa_instrument_readouts_reproduce_the_ttl(chain, record_number):
         assert np.std(_bandpass(np.roll(sci1[m] - sci0[m], 1))[cut] - b) / np.std(b) > 1e-2   # and the time
     record_number("lisa_injection.readout_rel_error", worst)
     assert worst < 1e-3
+    # docs/lisa-ttl.md's recipe (the same make_files and simulate calls; tests/test_docs_examples.py, slow): with
+    # every noise off, X2 is zero without the injection file and not with it (only the TTL in X2)
+    x2_1, x2_0 = runs[(True, False)][2], runs[(False, False)][2]
+    ok = np.isfinite(x2_1) & np.isfinite(x2_0)
+    ok[:100] = False
+    assert np.std(x2_0[ok]) == 0 < np.std(x2_1[ok])
 
 
 def test_x2_with_ttl_minus_without_is_the_x2_of_the_ttl(chain, record_number):

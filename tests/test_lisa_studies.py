@@ -481,7 +481,7 @@ def test_lisa_catalogue():
     assert st.scaled_duration_s(sl.YEAR_DAYS, sl.QUICK_SCALE, 21600.0) == 16 * 21600
     assert "spacecraft.self_gravity_common=[0, 1e-9, 0]" in sl.RUNS["sg+y-1y"].overrides
     assert sl.NO_RAMP in sl.RUNS["sg+y-1y"].overrides and sl.RUNS["sg+y-1y"].scenario == "lisa"
-    with pytest.raises(ValueError, match="study: 'fig5' is not a study; allowed: estimate"):
+    with pytest.raises(ValueError, match="study: 'fig5' is not a study; allowed: one of the 7 names in docs/report"):
         st.plan_studies("x", studies=["fig5"], catalogue=sl.STUDIES, runs=sl.RUNS)
     # the TianQin set is unchanged by the catalogue arguments
     assert st.plan_studies("/nonexistent/runs", studies=["extreme"], duration_scale=st.QUICK_SCALE,
@@ -508,8 +508,9 @@ def test_cli_lisa_quick(tmp_path, capsys):
 
 @pytest.mark.parametrize("args, match", [
     (["report", "--mission", "lisa", "x.h5"], "--mission: only applies with --studies"),
-    (["report", "--studies", "--mission", "mars"], "'mars' is not one of"),
-    (["report", "--studies", "--mission", "lisa", "--study", "fig5"], "study: 'fig5' is not a study; allowed: estimate"),
+    (["report", "--studies", "--mission", "mars"], "'mars' is not allowed; allowed: 'tianqin', 'lisa'"),
+    (["report", "--studies", "--mission", "lisa", "--study", "fig5"],
+     "study: 'fig5' is not a study; allowed: one of the 7 names in docs/report.md#studies"),
     (["report", "--studies", "--mission", "lisa", "--quick", "--duration-scale", "0.5"], "conflicts"),
     (["report", "--studies", "--mission", "lisa", "--set", "spacecraft.tm_distance=-1"], "spacecraft.tm_distance"),
 ])

@@ -33,6 +33,8 @@ from tqdyn.scenario import ScenarioError, load_scenario, loads_scenario
 from tqdyn.workflows.bench import _analytic_final, _max_dist
 
 MS = ["integrator.method=multistep"]
+#: The references: DP87 runs (the built-in scenarios integrate with the default method, the multistep one).
+DP = ["integrator.method=dp87"]
 #: The coupled TianQin model without the inputs whose float64 rounding is
 #: noise at the 1e-21 m/s^2 level (ephemeris positions of the Sun, Moon and
 #: planets, and everything derived from them; EOP tables; the Earth field's
@@ -65,9 +67,10 @@ def _kepler_error(duration, precision="dd", extra=()):
 
 
 def test_default_scenario_text_unchanged():
-    """DP87 scenarios write no multistep keys (built-in outputs stay byte-identical);
-    a multistep scenario writes and reads back its order and corrector."""
-    text = load_scenario("tianqin").to_toml()
+    """DP87 scenarios write no multistep keys (their resolved text, and so the digests of
+    the studies' runs, are those written before the multistep method existed); a multistep
+    scenario writes and reads back its order and corrector."""
+    text = load_scenario("tianqin", DP).to_toml()
     assert "order =" not in text and "corrector =" not in text
     scen = load_scenario("tianqin-kepler", MS + ["integrator.order=12", "integrator.corrector=pece"])
     back = loads_scenario(scen.to_toml())
@@ -108,7 +111,7 @@ def test_startup_rows_are_the_dp87_rows():
     """The first K steps are DP87 steps at the same step: rows 0 .. K-1 equal
     the DP87 run's bit for bit; a run of at most K steps is all start-up."""
     ms, _ = _rows("tianqin", ["run.duration=600s", *MS, "integrator.order=12"])
-    dp, _ = _rows("tianqin", ["run.duration=600s"])
+    dp, _ = _rows("tianqin", ["run.duration=600s", *DP])
     assert len(ms) == len(dp) == 13
     for name, a in dp.items():
         b = getattr(ms, name)
@@ -188,7 +191,7 @@ def test_orders_kepler_tianqin_and_lisa(record_number):
     for order in (6, 8, 10, 12, 16):
         record_number(f"multistep.orders.K{order}", {c: {"tianqin_90d": out[order, c][0], "lisa_10y": out[order, c][1]}
                                                      for c in ("pe", "pece")}, "m")
-    dp87_lisa, _ = _lisa_kepler_error("3652.5d", method=())
+    dp87_lisa, _ = _lisa_kepler_error("3652.5d", method=DP)
     print(f"\nDP87: LISA 10 y {dp87_lisa:.2e} m")
     record_number("multistep.orders.dp87_lisa_10y", dp87_lisa, "m")
     for c in ("pe", "pece"):
@@ -206,7 +209,7 @@ def test_corrector_smooths_the_rows(record_number):
     fourth differences' noise gain): measured 1.5e-18 m with the predictor
     alone, 4.8e-20 m with PEC and PECE (smooth inputs; 5.1e-16 / 1.6e-17 m
     with float64 ones).  Bound: PEC and PECE at most 1/10 of PE's."""
-    dp, _ = _rows("tianqin", ["run.duration=10d"])
+    dp, _ = _rows("tianqin", ["run.duration=10d", *DP])
     rms = {}
     for corrector in ("pe", "pec", "pece"):
         ms, _ = _rows("tianqin", ["run.duration=10d", *MS, f"integrator.corrector={corrector}"])
@@ -243,7 +246,7 @@ def _compare(name, overrides, duration, reference=()):
     and suspension accelerations' largest difference relative to their
     largest magnitude."""
     ms, res = _rows(name, [f"run.duration={duration}", *overrides, *MS])
-    dp, _ = _rows(name, [f"run.duration={duration}", *overrides, *reference])
+    dp, _ = _rows(name, [f"run.duration={duration}", *overrides, *DP, *reference])
     if reference:  # a finer DP87 grid: its rows on the multistep grid
         every = len(dp) // (len(ms) - 1)
         dp = Rows(**{k: (v[0][::every], v[1][::every]) if isinstance(v, tuple) else v[::every] for k, v in dp.items()})
@@ -278,8 +281,8 @@ def test_coupled_full_model_one_day_vs_dp87(record_number):
     record_number("multistep.full_1d_vs_dp87_m", float(max(d["sat_r"], d["tm_r"])), "m")
     record_number("multistep.full_1d_g_susp_rel", [d["sat_a_dragfree"], d["tm_a_suspension"]])
     # the yardstick: DP87 at 50 s against DP87 at 25 s (measured 3.3e-16 m; bound 3e-15 m)
-    dp, _ = _rows("tianqin", ["run.duration=1d"])
-    fine, _ = _rows("tianqin", ["run.duration=1d", "integrator.step=25", "run.output_every=2"])
+    dp, _ = _rows("tianqin", ["run.duration=1d", *DP])
+    fine, _ = _rows("tianqin", ["run.duration=1d", *DP, "integrator.step=25", "run.output_every=2"])
     floor = float(_dd_dist(dp.sat_r, fine.sat_r).max())
     record_number("multistep.full_1d_dp87_50_vs_25_m", floor, "m")
     assert floor < 3e-15
@@ -292,7 +295,7 @@ def test_coupled_float64_mode():
     against the dd DP87 run: 5.5e-8 m (measured; DP87 in float64: 2.9e-8 m,
     the rounding of a 1e8 m state, ulp 1.5e-8 m).  Bound 3e-7 m."""
     ms, _ = _rows("tianqin", ["run.duration=1d", *MS], precision="float64")
-    dp, _ = _rows("tianqin", ["run.duration=1d"])
+    dp, _ = _rows("tianqin", ["run.duration=1d", *DP])
     d = _dd_dist(ms.sat_r, dp.sat_r).max()
     print(f"\ncoupled float64 multistep vs dd DP87, 1 day: {d:.2e} m")
     assert 1e-10 < d < 3e-7
@@ -309,8 +312,8 @@ def test_coupled_smooth_model_ninety_days_acceptance(record_number):
     1e-13 m, 5e-15."""
     d, _ = _compare("tianqin", SMOOTH, "90d")
     print(f"\nsmooth coupled model, 90 days, multistep vs DP87: {d}")
-    dp, _ = _rows("tianqin", ["run.duration=90d", *SMOOTH])
-    fine, _ = _rows("tianqin", ["run.duration=90d", *SMOOTH, "integrator.step=25", "run.output_every=2"])
+    dp, _ = _rows("tianqin", ["run.duration=90d", *SMOOTH, *DP])
+    fine, _ = _rows("tianqin", ["run.duration=90d", *SMOOTH, *DP, "integrator.step=25", "run.output_every=2"])
     floor = _dd_dist(dp.sat_r, fine.sat_r).max()
     print(f"DP87 50 s vs 25 s: {floor:.2e} m")
     record_number("multistep.coupled_smooth_90d", {**d, "dp87_50s_vs_25s": floor},
@@ -333,8 +336,8 @@ def test_coupled_full_model_ninety_days_against_dp87_reproducibility(record_numb
     4.0e-15 relative (acceptance 1e-6).  Bounds: 2e-12 m, DP87 vs DP87
     2e-12 m, 2e-14 relative."""
     ms, _ = _rows("tianqin", ["run.duration=90d", *MS])
-    dp, _ = _rows("tianqin", ["run.duration=90d"])
-    fine, _ = _rows("tianqin", ["run.duration=90d", "integrator.step=25", "run.output_every=2"])
+    dp, _ = _rows("tianqin", ["run.duration=90d", *DP])
+    fine, _ = _rows("tianqin", ["run.duration=90d", *DP, "integrator.step=25", "run.output_every=2"])
     floor = _dd_dist(dp.sat_r, fine.sat_r).max()
     d = {name: _dd_dist(getattr(ms, name), getattr(dp, name)).max() for name in ("sat_r", "tm_r")}
     for f in ("sat_a_dragfree", "tm_a_suspension"):
@@ -359,8 +362,8 @@ def test_lisa_coupled_ten_years_vs_dp87(record_number):
     positions: DP87 at 6 h and at 3 h differ by 8.6e-7 m (ratio 1.02;
     bound 3); bound on the distance 3e-6 m."""
     ms, res = _rows("lisa", ["run.duration=3652.5d", *MS])
-    dp, _ = _rows("lisa", ["run.duration=3652.5d"])
-    fine, _ = _rows("lisa", ["run.duration=3652.5d", "integrator.step=10800", "run.output_every=2"])
+    dp, _ = _rows("lisa", ["run.duration=3652.5d", *DP])
+    fine, _ = _rows("lisa", ["run.duration=3652.5d", *DP, "integrator.step=10800", "run.output_every=2"])
     d = _dd_dist(ms.sat_r, dp.sat_r).max()
     floor = _dd_dist(dp.sat_r, fine.sat_r).max()
     print(f"\nLISA coupled, 10 years: multistep vs DP87 {d:.2e} m; DP87 6 h vs 3 h {floor:.2e} m")
@@ -452,7 +455,7 @@ def test_light_path_dense_output_vs_direct_propagation(corrector, record_number)
         step = (Decimal(mpmath.nstr(te, 40, min_fixed=-1, max_fixed=50)) / m).quantize(Decimal("1e-28"))
         duration = step * m
     direct = dynamics.propagate(load_scenario("tianqin-kepler", [f"run.duration={duration}",
-                                                                 f"integrator.step={step}"]))
+                                                                 f"integrator.step={step}", *DP]))
     y = direct.y_final[ln.emitter.index]
     with mpmath.workdps(40):
         worst = max(float(abs(mp_from_pair(*y[q]) - mp_from_pair(res.r_emit[0][k, ln.index, q],
@@ -472,7 +475,7 @@ def test_light_paths_of_coupled_rows_match_dp87():
     from tqdyn import lightpath as LP
 
     ms, _ = _rows("tianqin", ["run.duration=1d", *MS])
-    dp, _ = _rows("tianqin", ["run.duration=1d"])
+    dp, _ = _rows("tianqin", ["run.duration=1d", *DP])
     a = LP.light_travel_times(ms.t, ms.tm_r, ms.tm_v, ms.tm_a)
     b = LP.light_travel_times(dp.t, dp.tm_r, dp.tm_v, dp.tm_a)
     rows_diff = _dd_dist(ms.tm_r, dp.tm_r).max()

@@ -13,6 +13,7 @@ steps.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tqdyn.od import coupled, problem as odp
 from tqdyn.od.parameters import OrbitParameters
@@ -26,12 +27,23 @@ SCEN = "tianqin"
 INJECTED = (0.0, 1e-10, 0.0)
 
 
+@pytest.fixture(scope="module")
+def coupled_partials():
+    """The coupled tianqin partials over 12 h (every 3 h, difference runs at 600 s steps, the default
+    difference steps): (times [s], coupled.propagate_with_partials result), shared by two tests."""
+    t = np.arange(0.0, DAY / 2 + 1.0, 10800.0)
+    return t, coupled.propagate_with_partials(load_scenario(SCEN), None, t, step=600.0)
+
+
+@pytest.mark.slow  # ~100 coupled one-day runs for the differences: ~10 s
 def test_recovery_of_common_self_gravity(record_number):
     """GNSS + SLR + ISR on the coupled tianqin run over 1 day every 1800 s, 1e-10 m/s^2 along
     Y_S injected on each satellite; state and common self-gravity estimated: every estimated
     value within 4.5 sigma of the truth (N(0, 1) errors: a 4.5-sigma miss among 27 has a chance
     ~2e-4).  Sat1's Y_S sigma (measured 8.5e-12 m/s^2; 12 h give ~9e-11, too little to see
-    1e-10, hence one day) is bounded at 3e-11 m/s^2."""
+    1e-10, hence one day) is bounded at 3e-11 m/s^2.  The default suite checks the same recovery
+    and bound through the command line (tests/test_od_chain.py::test_coupled_run_simulate_then_fit:
+    the same plan and injection, another noise seed)."""
     scen = load_scenario(SCEN)
     tr = odp.Tracking(("gnss", "slr", "isr"), DAY, 1800.0, estimate=("state", "self_gravity_common"))
     nom = odp.nominal_parameters(scen)
@@ -48,17 +60,15 @@ def test_recovery_of_common_self_gravity(record_number):
     assert sig_y < 3e-11
 
 
-def test_coupled_sensitivity_matches_point_mass_s_frame(record_number):
+def test_coupled_sensitivity_matches_point_mass_s_frame(coupled_partials, record_number):
     """The position sensitivity of the coupled (drag-free, global pointing) tianqin orbits to
     their TMs' common self-gravity equals the point-mass sensitivity of tianqin-gravity (same
     initial states) to the S-frame constant acceleration: the drag-free control hands the TMs'
     DC acceleration on to the orbit.  Largest difference over the 9 x 9 position blocks at 3, 6,
     9, 12 h relative to the largest point-mass sensitivity at that time: measured 1.5e-9 (the
     coupled run's Table IV self-gravity and attitude), bounded at 1e-8."""
-    scen = load_scenario(SCEN)
-    nom = odp.nominal_parameters(scen)
-    t = np.arange(0.0, DAY / 2 + 1.0, 10800.0)
-    pc = coupled.propagate_with_partials(scen, None, t, step=600.0)
+    nom = odp.nominal_parameters(load_scenario(SCEN))
+    t, pc = coupled_partials
     pp = propagate_with_partials(load_scenario("tianqin-gravity"), OrbitParameters(y0=nom.y0), t, step=600.0)
     sp = np.concatenate([pp.sensitivities_full[:, :, 12 * b:12 * b + 3] for b in range(3)], axis=2)
     pos = [6 * b + i for b in range(3) for i in range(3)]
@@ -69,14 +79,12 @@ def test_coupled_sensitivity_matches_point_mass_s_frame(record_number):
     assert rel < 1e-8
 
 
-def test_difference_steps(record_number):
+def test_difference_steps(coupled_partials, record_number):
     """Halving every difference step (1 m, 2^-13 m/s, 2^-30 m/s^2) changes the coupled partials
     over 12 h (every 3 h) by less than 1e-15 of each column's largest value (measured 2.2e-16:
     truncation and round-off both at the float64 level)."""
-    scen = load_scenario(SCEN)
-    t = np.arange(0.0, DAY / 2 + 1.0, 10800.0)
-    a = coupled.propagate_with_partials(scen, None, t, step=600.0)
-    b = coupled.propagate_with_partials(scen, None, t, step=600.0,
+    t, a = coupled_partials
+    b = coupled.propagate_with_partials(load_scenario(SCEN), None, t, step=600.0,
                                         steps=(coupled.STEP_POSITION / 2, coupled.STEP_VELOCITY / 2,
                                                coupled.STEP_COMMON / 2))
     fa = np.concatenate([a.stm_full, a.sensitivities_full], axis=2)

@@ -426,9 +426,7 @@ def test_writer_segments_one_object_per_file(esa, tmp_path):
     assert len(OrbitEphemerisMessage.open(p).segments) == 2
     with pytest.raises(ValueError) as ei:  # record 600 follows record 599 a step later: a gap, not one trajectory
         ro.read_oem(p)
-    assert ("segments 1 (2036-12-09T00:00:00.000000940 .. 2042-06-13T14:04:41.723110970 TDB) and 2 "
-            "(2042-06-16T22:57:49.820945880 .. 2047-09-09T13:04:48.000001110 TDB) are not continuous: a gap of "
-            "291188.098 s (3.37023 d)") in _one_line_error(ei, p)
+    assert "segments 1 and 2 are not continuous: a gap of 291188.098 s (3.37023 d)" in _one_line_error(ei, p)
     with pytest.raises(ValueError, match="segments must follow each other"):
         fo.write_oem(tmp_path / "x.oem", [s2, s1])
     sats = [fo.OemSegment.heliocentric(f"LISA{i + 1}", t.jd1, t.jd2, t.r, t.v) for i, t in enumerate(esa)]
@@ -544,12 +542,12 @@ def test_unsupported_frame_and_time_system(tmp_path):
     with pytest.raises(ValueError) as ei:
         ro.read_oem(p)
     msg = _one_line_error(ei, p)
-    assert "REF_FRAME = 'ITRF' is not supported (allowed: EME2000, ICRF, GCRF)" in msg
+    assert "REF_FRAME = 'ITRF' is not supported (did you mean 'ICRF'?) (allowed: EME2000, ICRF, GCRF)" in msg
     p = _edit(tmp_path, "TIME_SYSTEM          = TDB", "TIME_SYSTEM          = UTC", "utc.oem")
     with pytest.raises(ValueError) as ei:
         ro.read_oem(p)
     msg = _one_line_error(ei, p)
-    assert "TIME_SYSTEM = 'UTC' is not supported (allowed: TDB, TCB, TT)" in msg
+    assert "TIME_SYSTEM = 'UTC' is not supported (allowed: TDB, TCB, TT)" in msg  # no name is close to it
 
 
 def test_non_monotonic_epochs(tmp_path):

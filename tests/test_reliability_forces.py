@@ -166,7 +166,8 @@ def test_heliocentric_default_every(tmp_path, capsys, monkeypatch):
 
 def test_plot_write_failure_is_atomic(tmp_path, capsys, monkeypatch):
     """A failure while the figure is written (a full disk, simulated: savefig writes part of the file and raises
-    ENOSPC) leaves the existing file untouched and no temporary file; one line, exit 2."""
+    ENOSPC) leaves the existing file untouched and no temporary file; one line, exit 3 (a failed write,
+    docs/reliability.md)."""
     import matplotlib.figure
 
     monkeypatch.chdir(tmp_path)
@@ -180,9 +181,9 @@ def test_plot_write_failure_is_atomic(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", full_disk)
     status, out, err = run_cli(["forces", "tianqin-kepler", "--duration", "1h", "--plot", "budget.png"], capsys)
     lines = err.splitlines()
-    assert status == 2
-    assert lines[-1].startswith("tqdyn: error: --plot: 'budget.png' could not be written") and "; allowed: " in lines[-1]
-    assert "No space left" in lines[-1] and "Traceback" not in err
+    assert status == 3
+    assert lines[-1].startswith("tqdyn: error: --plot: cannot write the figure") and "budget.png" in lines[-1]
+    assert "No space left" in lines[-1] and "nothing was written there" in lines[-1] and "Traceback" not in err
     assert _files(tmp_path) == ["budget.png"] and (tmp_path / "budget.png").read_bytes() == KEEP
 
 

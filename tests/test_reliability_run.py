@@ -62,6 +62,41 @@ def _warm_jit_cache(tmp_path_factory):
     assert status == 0, err
 
 
+def _here(args) -> tuple[int, str]:
+    """`tqdyn ARGS` in this process (where the test is not about the process): (exit status, stderr)."""
+    import contextlib
+    import io as text_io
+
+    from tqdyn import cli
+
+    err = text_io.StringIO()
+    with contextlib.redirect_stdout(text_io.StringIO()), contextlib.redirect_stderr(err):
+        try:
+            status = cli.main(list(args))
+        except SystemExit as exc:
+            status = exc.code
+    return status, err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    """uninterrupted(args, path): the file of an uninterrupted `tqdyn ARGS` run (in this process, once per
+    module for each ``args``: the tests that interrupt the same run compare with one reference) copied to
+    ``path``."""
+    done: dict = {}
+
+    def copy_to(args, path: Path):
+        key = tuple(args)
+        if key not in done:
+            ref = tmp_path_factory.mktemp("reference") / "ref.h5"
+            status, err = _here([*args, "-o", str(ref)])
+            assert status == 0, err
+            done[key] = ref
+        shutil.copyfile(done[key], path)
+
+    return copy_to
+
+
 def _one_error_line(err: str) -> str:
     """The only `tqdyn: error:` line of stderr (besides the banner / warnings); no traceback."""
     assert "Traceback" not in err, err
@@ -100,15 +135,13 @@ def test_file_size_limit_without_checkpoint(tmp_path):
     assert _listing(tmp_path) == ["out.h5"] and out.read_bytes() == b"previous result"
 
 
-def test_file_size_limit_checkpoint_resumes(tmp_path):
+def test_file_size_limit_checkpoint_resumes(tmp_path, uninterrupted):
     """The limit is hit after a checkpoint: exit 3, the checkpoint and its
     partial trajectory are kept, a `--resume` under the same limit fails the
     same way, and once the limit is lifted `--resume` finishes to the same
     data as an uninterrupted run."""
     args = KEPLER + ["--duration", "6d", "--checkpoint-every", "1000"]
     ref, out = tmp_path / "ref.h5", tmp_path / "out.h5"
-    status, _, err = _finish(_child(args + ["-o", str(ref)]))
-    assert status == 0, err
     status, _, err = _finish(_child(args + ["-o", str(out)], limit=2_500_000))
     line = _one_error_line(err)
     assert status == 3 and "--resume" in line and "out.h5.checkpoint" in line, err
@@ -117,8 +150,9 @@ def test_file_size_limit_checkpoint_resumes(tmp_path):
     assert len([n for n in left if n.startswith(".out.h5.") and n.endswith(".tmp")]) == 1
     status, _, err = _finish(_child(args + ["-o", str(out), "--resume"], limit=2_500_000))
     assert status == 3 and "--resume" in _one_error_line(err)
-    status, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
+    status, err = _here(args + ["-o", str(out), "--resume"])  # the limit lifted
     assert status == 0, err
+    uninterrupted(args, ref)
     _same_data(ref, out)
     assert _listing(tmp_path) == ["out.h5", "ref.h5"]
 
@@ -191,18 +225,18 @@ def _wait_for(path: Path, p: subprocess.Popen, timeout=120):
         time.sleep(0.05)
 
 
-def _resume_matches_uninterrupted(tmp_path, args, out, ref):
-    """`--resume` of the interrupted run finishes; its data equal an uninterrupted run's; nothing else left."""
-    code, _, err = _finish(_child(args + ["-o", str(out), "--resume"]))
+def _resume_matches_uninterrupted(tmp_path, args, out, ref, uninterrupted):
+    """`--resume` of the interrupted run finishes; its data equal an uninterrupted run's; nothing else left.
+    Neither is about the process: both run in this one (the reference once per ``args``)."""
+    code, err = _here(args + ["-o", str(out), "--resume"])
     assert code == 0, err
-    code, _, err = _finish(_child(args + ["-o", str(ref)]))
-    assert code == 0, err
+    uninterrupted(args, ref)
     _same_data(ref, out)
     assert _listing(tmp_path) == ["out.h5", "ref.h5"]
 
 
 @pytest.mark.parametrize("sig, status", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)], ids=["SIGTERM", "SIGHUP"])
-def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
+def test_signal_keeps_checkpoint_and_resumes(tmp_path, uninterrupted, sig, status):
     """SIGTERM / SIGHUP after a checkpoint: like Ctrl-C (checkpoint and its
     partial file kept, no output file), exit 128 + signal, one line;
     `--resume` finishes to the data of an uninterrupted run."""
@@ -218,7 +252,7 @@ def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     left = _listing(tmp_path)
     assert "out.h5" not in left and "out.h5.checkpoint" in left
     assert len([n for n in left if n.endswith(".tmp")]) == 1  # the partial trajectory, as after Ctrl-C
-    _resume_matches_uninterrupted(tmp_path, args, out, ref)
+    _resume_matches_uninterrupted(tmp_path, args, out, ref, uninterrupted)
 
 
 @pytest.mark.parametrize("options", [
@@ -227,7 +261,7 @@ def test_signal_keeps_checkpoint_and_resumes(tmp_path, sig, status):
     # interval; where it falls does not change the steps
     ["--duration", "40d", "--checkpoint-every", "0", "--checkpoint-interval", "0.001"],
 ], ids=["every-500-steps", "wall-clock-interval"])
-def test_kill_9_after_a_checkpoint_resumes(tmp_path, options):
+def test_kill_9_after_a_checkpoint_resumes(tmp_path, uninterrupted, options):
     """kill -9 (no handler can run): the last checkpoint and its partial file
     are what is left, nothing at the output path; `--resume` finishes to the
     data of an uninterrupted run."""
@@ -240,7 +274,7 @@ def test_kill_9_after_a_checkpoint_resumes(tmp_path, options):
     assert code == -signal.SIGKILL
     left = _listing(tmp_path)
     assert "out.h5" not in left and "out.h5.checkpoint" in left
-    _resume_matches_uninterrupted(tmp_path, args, out, ref)
+    _resume_matches_uninterrupted(tmp_path, args, out, ref, uninterrupted)
 
 
 def test_sigterm_without_checkpoint_leaves_nothing(tmp_path):

@@ -158,7 +158,7 @@ def test_temperature_and_series_models():
     assert np.max(np.abs(s.coefficient("distant_eta", "21", t) - (1e-3 + 1e-7 * t - 3e-15 * t ** 3))) < 1e-15
     with pytest.raises(ValueError, match=r"ttl.temperature: covers t = 0.0 .. 10000.0 s; needed"):
         c.coefficient("local_phi", "12", np.array([2e4]))
-    with pytest.raises(ValueError, match=r"ttl.series: unknown key 'local_psi'"):
+    with pytest.raises(ValueError, match=r"ttl.series: 'local_psi' is not a key \(did you mean 'local_phi'\?\)"):
         TimeVaryingTTLCoefficients.from_series(ts, {"local_psi": {}})
     with pytest.raises(ValueError, match=r"ttl.rate\['12'\] = nan"):
         TimeVaryingTTLCoefficients.drifting(base, {m: (math.nan if m == "12" else 0.0) for m in MOSAS})
@@ -310,9 +310,9 @@ def test_export_ttl_writes_the_file(closed_loop_file, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, pattern", [
-    (["--coefficients", "BAD.toml"], r"c.toml: unknown key 'local_psi'"),
+    (["--coefficients", "BAD.toml"], r"c.toml: 'local_psi' is not a key \(did you mean 'local_phi'\?\)"),
     (["--coefficients", "NAN.json"], r"ttl.local_phi\['13'\] = nan: must be a finite number"),
-    (["--coefficients", "KEY.json"], r"ttl.distant_eta: unknown key '14'"),
+    (["--coefficients", "KEY.json"], r"ttl.distant_eta: '14' is not a key"),
     (["--coefficients", "random"], r"--seed: required with --coefficients random"),
     (["--seed", "3"], r"--seed: applies to --coefficients random only"),
     (["--drift", "fast"], r"--drift = 'fast': must be a finite number \(m/rad per day\) or lpf"),

@@ -1,4 +1,4 @@
-"""Fill the measured numbers of README.md and docs/*.md from their JSON records.
+"""Fill the measured numbers of README.md, CHANGELOG.md and docs/*.md from their JSON records.
 
 Usage:
     python tools/render_docs.py            # rewrite the pages whose numbers changed
@@ -231,31 +231,31 @@ def gen_readme_bench(records, arg=None) -> str:
     cr = co["runs"]
     rows = ["| run | tqdyn dd | tqdyn float64 | peer |", "| --- | ---: | ---: | ---: |"]
     hey = kr.get("heyoka real128")
-    rows.append(f"| Kepler, 3 satellites, {_span(k)} at {k['step_s']:g} s (`--model kepler`) | "
+    rows.append(f"| Kepler, 3 satellites, DP87, {_span(k)} at {k['step_s']:g} s (`--model kepler`) | "
                 f"{_f(kr['tqdyn dd']['wall_s'], '.2f')} s (error {_f(kr['tqdyn dd']['err_vs_analytic_m'], '.1e')} m) | "
                 f"{_f(kr['tqdyn float64']['wall_s'], '.2f')} s ({_f(kr['tqdyn float64']['err_vs_analytic_m'], '.1e')} m) | "
                 + (f"heyoka real128: {_f(hey['wall_s'], '.2f')} s ({_f(hey['err_vs_analytic_m'], '.1e')} m) |"
                    if hey else "- |"))
     red_hey = fr.get("reduced model, heyoka real128")
-    rows.append(f"| full force model, pure gravity, {_span(fu)} (`--model full`) | "
+    rows.append(f"| full force model, pure gravity, DP87, {_span(fu)} (`--model full`) | "
                 f"{_f(fr['full model, dd']['wall_s'], '.3g')} s | {_f(fr['full model, float64']['wall_s'], '.3g')} s | "
                 f"reduced model (Earth 12x12 + Sun + Moon): tqdyn {_f(fr['reduced model, dd']['wall_s'], '.3g')} s"
                 + (f", heyoka real128 {_f(red_hey['wall_s'], '.3g')} s |" if red_hey else " |"))
     cd, cf = cr["coupled, dd"], cr["coupled, float64"]
-    rows.append(f"| coupled: full model + attitude + drag-free control, {_span(co)} (`--model coupled`) | "
+    rows.append(f"| coupled: full model + attitude + drag-free control, DP87, {_span(co)} (`--model coupled`) | "
                 f"{_f(cd['wall_s'], '.3g')} s ({_f(cd['peak_rss_mb'], '.0f')} MB; "
                 f"{_f(co['dd_over_kepler_float64'], '.0f')}x the Kepler float64 run of the same invocation; "
                 f"CPU per simulated day {_f(cd['cpu_inputs_per_day_s'], '.2f')} s of time-only inputs + "
                 f"{_f(cd['cpu_loop_per_day_s'], '.2f')} s of compiled loop) | {_f(cf['wall_s'], '.3g')} s | - |")
     md, mf = cr.get("coupled, dd, multistep"), cr.get("coupled, float64, multistep")
     if md and mf:  # records written before the multistep method have no such runs
-        rows.append(f"| the same with `integrator.method = \"multistep\"` ({co['multistep']}), {_span(co)} "
+        rows.append(f"| the same with the multistep method ({co['multistep']}; the default), {_span(co)} "
                     f"(`--model coupled`) | {_f(md['wall_s'], '.3g')} s ({_f(md['peak_rss_mb'], '.0f')} MB; "
                     f"{_f(co['multistep_dd_over_kepler_float64'], '.0f')}x the Kepler float64 run; DP87 takes "
                     f"{_f(co['dp87_over_multistep_dd'], '.1f')}x as long; CPU per simulated day "
                     f"{_f(md['cpu_inputs_per_day_s'], '.2g')} s of time-only inputs + "
                     f"{_f(md['cpu_loop_per_day_s'], '.2g')} s of compiled loop) | {_f(mf['wall_s'], '.3g')} s | - |")
-    rows.append(f"| coupled TianQin, {_span(t5)} (`--model tianqin-5y`: `{t5['command']}`, "
+    rows.append(f"| coupled TianQin, DP87, {_span(t5)} (`--model tianqin-5y`: `{t5['command']}`, "
                 f"{_f(t5.get('n_steps'), ',d')} steps, {_f(t5['file_mb'], '.2g')} MB file) | "
                 f"{_f(t5['wall_s'], '.0f')} s" + (f" ({_f(t5['wall_s'] / 60, '.0f')} min)" if t5["wall_s"] > 120 else "")
                 + f", {_f(t5['peak_rss_mb'], '.0f')} MB "
@@ -529,8 +529,9 @@ def differences(text: str, rendered: str) -> list[tuple[str, str, str]]:
 
 
 def pages(root: Path = ROOT) -> list[Path]:
-    """README.md and every docs/*.md."""
-    return [root / "README.md"] + sorted((root / "docs").glob("*.md"))
+    """README.md, CHANGELOG.md (if present) and every docs/*.md."""
+    top = [root / "README.md"] + [p for p in (root / "CHANGELOG.md",) if p.exists()]
+    return top + sorted((root / "docs").glob("*.md"))
 
 
 def main(argv=None) -> int:

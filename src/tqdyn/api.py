@@ -101,7 +101,7 @@ def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, ob
     scen = load_scenario(scenario, overrides)
     model = dynamics.check_inputs(scen)
     # compile (or load the cached kernels) outside the timed propagation
-    dynamics.warm_up(scen.run.precision, scen.integrator.method)
+    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
     blocks: list = []
     bar = None
     if progress:
@@ -191,12 +191,12 @@ def closed_loop_model(trajectory: Trajectory, config=None, validate: bool = True
     return f(trajectory, config, validate)
 
 
-def closed_loop_budget(model, f=None, dt: float | None = None):
-    """The noise budget, margins and dominant sources as an ``xarray.Dataset``:
-    :func:`tqdyn.analysis.closed_loop.closed_loop_budget`."""
+def closed_loop_budget(model, f=None, dt: float | None = None, per_source: bool = True):
+    """The noise budget, margins and dominant sources as an ``xarray.Dataset`` (``per_source``: with the ASD of
+    every output from every source): :func:`tqdyn.analysis.closed_loop.closed_loop_budget`."""
     from .analysis.closed_loop import closed_loop_budget as g
 
-    return g(model, f, dt)
+    return g(model, f, dt, per_source=per_source)
 
 
 def closed_loop_timeseries(model, duration_s: float | None = None, fs: float | None = None, seed: int | None = None,

@@ -21,72 +21,125 @@ import math
 
 import numpy as np
 
-from ..closedloop.budget import dominant_sources, loop_margins, noise_budget
-from ..closedloop.loop import OUTPUTS, output_names
+from ..closedloop import frequency
+from ..closedloop.budget import grid_margins, loop_gains, noise_budget
+from ..closedloop.loop import OUTPUTS, SOURCES, output_names
 from ..closedloop.missions import requirement
 from ..closedloop.model import ClosedLoopError, ClosedLoopModel, closed_loop_model
 from ..closedloop.simulate import MemorySink, Sink, simulate
+from ..scenario.closed_loop import DEFAULT_SERIES_S
 
 __all__ = ["ClosedLoopError", "ClosedLoopModel", "closed_loop_budget", "closed_loop_model", "closed_loop_timeseries",
-           "BANDS"]
+           "BANDS", "MARGIN_GRID", "default_series_s"]
 
 #: Bands [Hz] of the dominant-source summary.
 BANDS = ((1e-4, 1e-3), (1e-3, 1e-2), (1e-2, 1e-1), (1e-1, 1.0))
 
 
-def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, progress=None):
+#: The grid of the loop gains whose crossovers give the margins: [Hz], [Hz], points (log-spaced).
+MARGIN_GRID = (1e-6, 10.0, 1500)
+#: Loops evaluated together (bounds the memory of the evaluation).
+_GROUP = 8
+
+
+def _margins(model: ClosedLoopModel, idx, fm) -> dict:
+    """:func:`tqdyn.closedloop.budget.grid_margins` of the loops ``idx`` (satellite-major indices)."""
+    if model.stack is not None:
+        L = frequency.loop_gains(model.stack, idx, fm)
+    else:
+        n_seg = len(model.loops[0])
+        L = np.array([loop_gains(model.loops[j // n_seg][j % n_seg][1], fm)[1] for j in idx])
+    return grid_margins(L, fm)
+
+
+def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, progress=None,
+                       per_source: bool = True):
     """The noise budget as an ``xarray.Dataset``: ``asd`` (segment, sat, output, source, frequency) one-sided
-    [output unit/Hz^1/2]; ``total`` (segment, sat, output, frequency); ``requirement`` (frequency) the
-    mission's TM acceleration requirement [m/s^2/Hz^1/2]; ``dominant`` (segment, sat, output, band) the
-    largest source per band (:data:`BANDS`); ``gain_margin`` [1] and ``phase_margin`` [deg] and
-    ``crossover`` [Hz] per (segment, sat, channel).  ``dt`` [s]: the zero-order-hold discretised loops'
-    budget (a sampled loop on held noise; the time series realise the continuous budget).  ``progress``: called with 1 after each (segment, satellite) loop
-    (segments x satellites calls).  Coordinates carry units and frames (attrs)."""
+    [output unit/Hz^1/2] (only with ``per_source``); ``total`` (segment, sat, output, frequency) the sources
+    summed in power; ``requirement`` (frequency) the mission's TM acceleration requirement [m/s^2/Hz^1/2];
+    ``dominant`` (segment, sat, output, band) the largest source per band (:data:`BANDS`); per (segment, sat,
+    channel) the margins of the loop-at-a-time gains (:func:`tqdyn.closedloop.budget.grid_margins` on
+    :data:`MARGIN_GRID`): ``gain_margin`` [1] the lower gain margin (the factor the gain may fall by; 0: none),
+    ``gain_margin_lower`` (the same), ``gain_margin_upper`` (the factor it may rise by; inf: none),
+    ``phase_margin`` [deg] and ``crossover`` [Hz].  Every loop of the model is evaluated in the frequency
+    domain at once (:mod:`tqdyn.closedloop.frequency`; loops without their blocks: each state space by
+    :func:`tqdyn.closedloop.budget.noise_budget`).  ``dt`` [s]: the zero-order-hold discretised loops' budget
+    (a sampled loop on held noise; the time series realise the continuous budget:
+    :mod:`tqdyn.closedloop.synthesis`; one state space at a time).  ``progress``: called with 1 after each
+    (segment, satellite) loop.  Coordinates carry units and frames (attrs)."""
     import xarray as xr
 
     s = model.settings
     f = np.logspace(math.log10(s["f_min"]), math.log10(s["f_max"]), s["n_freq"]) if f is None else np.asarray(f)
     outs = output_names()
-    n_seg = len(model.loops[0])
-    asd = None
-    margins = []
-    for k in range(n_seg):
-        per_sat, msat = [], []
-        for i in range(len(model.loops)):
-            b, sources = noise_budget(model.loops[i][k][1], model.noise, f, dt=dt)
-            per_sat.append(b)
-            msat.append(loop_margins(model.loops[i][k][1]))
-            if progress is not None:
+    n_sat, n_seg = len(model.loops), len(model.loops[0])
+    sources = [x for x in SOURCES if x in model.noise]
+    fast = dt is None and model.stack is not None
+    asd = np.empty((n_seg, n_sat, len(outs), len(sources), len(f))) if per_source else None
+    total = np.empty((n_seg, n_sat, len(outs), len(f)))
+    bands = [(f >= lo) & (f <= hi) for lo, hi in BANDS]
+    band_power = np.zeros((n_seg, n_sat, len(outs), len(sources), len(BANDS)))
+    fm = np.logspace(math.log10(MARGIN_GRID[0]), math.log10(MARGIN_GRID[1]), MARGIN_GRID[2])
+    margins = {}
+    order = np.arange(n_sat * n_seg)
+    for a in range(0, len(order), _GROUP):
+        idx = order[a:a + _GROUP]
+        if fast:
+            b, _src = frequency.noise_asd(model.stack, idx, model.noise, f)
+        else:
+            b = np.array([noise_budget(model.loops[j // n_seg][j % n_seg][1], model.noise, f, dt=dt)[0] for j in idx])
+        sat, seg = idx // n_seg, idx % n_seg
+        b2 = b ** 2
+        total[seg, sat] = np.sqrt(np.sum(b2, axis=2))
+        for m, mask in enumerate(bands):
+            if np.any(mask):
+                band_power[seg, sat, :, :, m] = np.mean(b2[..., mask], axis=-1)
+        if per_source:
+            asd[seg, sat] = b
+        del b, b2
+        for key, v in _margins(model, idx, fm).items():
+            margins.setdefault(key, np.empty((n_seg, n_sat) + v.shape[1:]))[seg, sat] = v
+        if progress is not None:
+            for _ in idx:
                 progress(1)
-        asd = np.zeros((n_seg, len(model.loops)) + per_sat[0].shape) if asd is None else asd
-        asd[k] = np.array(per_sat)
-        margins.append(msat)
-    total = np.sqrt(np.sum(asd ** 2, axis=3))
-    dom = np.array([[dominant_sources(asd[k, i], sources, f, BANDS) for i in range(asd.shape[1])]
-                    for k in range(n_seg)])
-    chans = [m.channel for m in margins[0][0]]
-    gm = np.array([[[m.gain_margin for m in ms] for ms in seg] for seg in margins])
-    pm = np.array([[[m.phase_margin for m in ms] for ms in seg] for seg in margins])
-    fc = np.array([[[m.f_phase_margin for m in ms] for ms in seg] for seg in margins])
+    names = np.array(sources + [""], dtype=object)
+    dom = names[np.where(np.array([np.any(m) for m in bands]), np.argmax(band_power, axis=3), len(sources))]
+    chans = list(model.loops[0][0][1].channel_names)
+    dims_m = ("segment", "sat", "channel")
+    data = {"total": (("segment", "sat", "output", "frequency"), total),
+            "requirement": (("frequency",), requirement(model.mission).asd(f)),
+            "dominant": (("segment", "sat", "output", "band"), dom.astype(str)),
+            "gain_margin": (dims_m, margins["gain_margin_lower"]),
+            "gain_margin_lower": (dims_m, margins["gain_margin_lower"]),
+            "gain_margin_upper": (dims_m, margins["gain_margin_upper"]),
+            "phase_margin": (dims_m, margins["phase_margin"]),
+            "crossover": (dims_m, margins["crossover"])}
+    if per_source:
+        data = {"asd": (("segment", "sat", "output", "source", "frequency"), asd), **data}
     ds = xr.Dataset(
-        {"asd": (("segment", "sat", "output", "source", "frequency"), asd),
-         "total": (("segment", "sat", "output", "frequency"), total),
-         "requirement": (("frequency",), requirement(model.mission).asd(f)),
-         "dominant": (("segment", "sat", "output", "band"), dom),
-         "gain_margin": (("segment", "sat", "channel"), gm),
-         "phase_margin": (("segment", "sat", "channel"), pm),
-         "crossover": (("segment", "sat", "channel"), fc)},
-        coords={"segment": [lp[0] for lp in model.loops[0]], "sat": np.arange(1, len(model.loops) + 1),
+        data,
+        coords={"segment": [lp[0] for lp in model.loops[0]], "sat": np.arange(1, n_sat + 1),
                 "sat_name": ("sat", list(model.satellite_names)), "output": outs, "source": sources,
                 "frequency": f, "band": [f"{lo:g}-{hi:g} Hz" for lo, hi in BANDS], "channel": chans,
                 "unit": ("output", [OUTPUTS[o][0] for o in outs]), "frame": ("output", [OUTPUTS[o][1] for o in outs])},
         attrs={"mission": model.mission, "asd": "one-sided", "frequency_unit": "Hz",
                "segment_unit": "s since the epoch (start of each frozen-coefficient segment)",
                "discretised_dt": float(dt) if dt is not None else 0.0})
-    ds["asd"].attrs["units"] = "output unit/Hz^1/2"
+    if per_source:
+        ds["asd"].attrs["units"] = "output unit/Hz^1/2"
+    ds["total"].attrs["units"] = "output unit/Hz^1/2"
+    for k in ("gain_margin", "gain_margin_lower", "gain_margin_upper"):
+        ds[k].attrs["units"] = "1"
     ds["phase_margin"].attrs["units"] = "deg"
     ds["crossover"].attrs["units"] = "Hz"
     return ds
+
+
+def default_series_s(model: ClosedLoopModel) -> float:
+    """The time series' length [s] when none is asked for: the run's first day
+    (:data:`tqdyn.scenario.closed_loop.DEFAULT_SERIES_S`), its span if shorter."""
+    span = model.t_span[1] - model.t_span[0]
+    return min(DEFAULT_SERIES_S, span) if span > 0 else DEFAULT_SERIES_S
 
 
 def closed_loop_timeseries(model: ClosedLoopModel, duration_s: float | None = None, fs: float | None = None,
@@ -94,10 +147,10 @@ def closed_loop_timeseries(model: ClosedLoopModel, duration_s: float | None = No
     """Seeded time series of every output (:func:`tqdyn.closedloop.simulate.simulate`) from the run's first
     time on.  With ``sink`` None: an ``xarray.Dataset`` ``values`` (time, sat, output) [output units];
     with a sink (e.g. a file writer): the sink, after ``close``.  ``duration_s`` [s] (default: the
-    settings' duration, else the run's span), ``fs`` [Hz] and ``seed`` override the settings."""
+    settings' duration, else :func:`default_series_s`), ``fs`` [Hz] and ``seed`` override the settings."""
     s = model.settings
     fs = float(fs if fs is not None else s["fs"])
-    dur = duration_s if duration_s is not None else (s["duration"] or (model.t_span[1] - model.t_span[0]))
+    dur = duration_s if duration_s is not None else (s["duration"] or default_series_s(model))
     if not (isinstance(dur, (int, float)) and math.isfinite(dur) and dur > 0):
         raise ClosedLoopError(f"closed_loop.duration: {dur!r} is not a positive duration; allowed: > 0 s")
     n = int(round(float(dur) * fs))

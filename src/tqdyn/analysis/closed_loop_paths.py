@@ -29,8 +29,8 @@ import numpy as np
 
 from ..closedloop.budget import closed_loop_response, loop_margins, noise_budget
 from ..closedloop.loop import SOURCES, build_closed_loop, output_names, source_inputs
-from ..closedloop.missions import (MISSIONS, default_controllers, default_noise, default_plant, representative_plant,
-                                   representative_working_point)
+from ..closedloop.missions import (CONSTELLATION_MISSIONS, default_controllers, default_noise, default_plant,
+                                   representative_plant, representative_working_point)
 from ..closedloop.plant import PlantParameters, WorkingPoint, sensitive_basis
 
 __all__ = ["DC_SUSPENSION_LIMIT", "dc_paths", "design_numbers"]
@@ -47,7 +47,7 @@ def design_numbers(freqs=(1e-3, 1e-2)) -> dict:
     i_acc = output_names().index("tm1_acceleration")
     i_rel = output_names().index("tm1_relative_acceleration")
     i_x = output_names().index("tm1_sc_jitter")
-    for mission in MISSIONS:
+    for mission in CONSTELLATION_MISSIONS:
         wp = representative_working_point(mission)
         ctl = default_controllers(mission)
         noise = default_noise(mission)

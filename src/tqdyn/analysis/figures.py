@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._choices import MAX_LISTED, allowed as allowed_names, did_you_mean
 from ..constellation.indices import Sat
 from . import spectra
 from .metrics import BREATHING_BAND_DEG, AsdResult, common_rows, times_s
@@ -111,13 +112,17 @@ def check_figure_path(path, option: str = "--plot", formats: Sequence[str] | Non
     path = Path(path)
     allowed = tuple(formats) if formats is not None else figure_extensions()
     ext = path.suffix[1:].lower()
+    exts = sorted(allowed)
+    if len(", ".join(f".{e}" for e in exts)) > MAX_LISTED:  # too many to give whole: the usual ones first
+        common = ("png", "pdf", "svg")
+        exts.sort(key=lambda e: (e not in common, common.index(e) if e in common else 0, e))
+    endings = allowed_names([f".{e}" for e in exts], noun="extensions")
     if str(path) in ("", ".") or path.is_dir():
-        raise ValueError(f"{option}: {shown} is a directory, not a file name; allowed: a file name ending in "
-                         + ", ".join(f".{e}" for e in allowed))
+        raise ValueError(f"{option}: {shown} is a directory, not a file name; allowed: a file name ending in {endings}")
     if ext not in allowed:
-        problem = "has no file extension" if not ext else f"has an unsupported extension .{path.suffix[1:]}"
-        raise ValueError(f"{option}: {shown} {problem}; allowed: a file name ending in "
-                         + ", ".join(f".{e}" for e in allowed))
+        problem = "has no file extension" if not ext else (f"has an unsupported extension .{path.suffix[1:]}"
+                                                            + did_you_mean(ext, allowed, quote=lambda e: f"'.{e}'"))
+        raise ValueError(f"{option}: {shown} {problem}; allowed: a file name ending in {endings}")
     parent = path.parent
     if not parent.exists():
         raise ValueError(f"{option}: {shown} is in a directory that does not exist ({str(parent)!r}); "
@@ -147,19 +152,14 @@ def _open_temporary(path: Path) -> tuple[int, Path]:
 
 
 def _savefig_atomic(fig, path: Path, fmt: str, **kwargs) -> None:
-    """``fig.savefig`` to a temporary file next to ``path``, then rename it over ``path``;
-    on any failure the temporary file is removed and ``path`` left as it was."""
-    fd, tmp = _open_temporary(path)
-    os.close(fd)
-    try:
+    """``fig.savefig`` to a temporary file next to ``path``, then rename it over ``path``
+    (:func:`tqdyn.formats.atomic.replacing`); on any failure the temporary file is removed and
+    ``path`` left as it was; a failed write (a full disk) raises
+    :class:`tqdyn.formats.trajectory.OutputIOError` (one line)."""
+    from ..formats.atomic import replacing
+
+    with replacing(Path(path), "the figure") as tmp:
         fig.savefig(tmp, format=fmt, **kwargs)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def _save(fig, out_dir: Path, stem: str) -> list[Path]:

@@ -109,6 +109,7 @@ from dataclasses import dataclass
 import numpy as np
 from mpmath import mp, mpf
 
+from .._choices import did_you_mean
 from .constants import AU_M, J2000_JD
 from .elements import _mp, _solve_kepler, _wrap, elements_to_state, state_to_dd
 
@@ -362,8 +363,8 @@ def keplerian_constellation(L, displacement_deg, sense, epoch=None, *, a=AU, gm=
             raise ValueError(f"L: {mp.nstr(L, 6)} m = {mp.nstr(L / a, 4)} a; allowed: 0 < L <= {MAX_L_OVER_A} a "
                              f"({mp.nstr(mpf(MAX_L_OVER_A) * a, 6)} m; the design expands in alpha = L / (2 a))")
         if sense not in SENSES:
-            raise ValueError(f"sense: {sense!r}; allowed: {' or '.join(repr(s) for s in SENSES)} "
-                             "(apparent rotation seen from the Sun)")
+            raise ValueError(f"sense: {sense!r}{did_you_mean(sense, SENSES)}; allowed: "
+                             f"{' or '.join(repr(s) for s in SENSES)} (apparent rotation seen from the Sun)")
         if gm is None:
             from .ephemeris import planetary_gm
 

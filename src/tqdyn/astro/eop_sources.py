@@ -65,6 +65,7 @@ import warnings
 import erfa
 import numpy as np
 
+from .._choices import did_you_mean
 from ..readers.eop_c04 import EopSeries, iers_data_version, read_eop_c04, read_eop_c04_20
 from ..readers.eop_finals import read_finals2000a
 from .constants import MJD_JD0
@@ -107,7 +108,7 @@ def normalize_eop_source(value) -> str:
         return "off"
     if isinstance(value, str) and value.strip().lower() in EOP_SOURCES:
         return value.strip().lower()
-    raise ValueError(f"{value!r} is not an EOP source; allowed: {EOP_SOURCES_ALLOWED}")
+    raise ValueError(f"{value!r} is not an EOP source{did_you_mean(value, EOP_SOURCES)}; allowed: {EOP_SOURCES_ALLOWED}")
 
 
 def _iso(mjd: float) -> str:
@@ -306,10 +307,10 @@ def check_coverage(eop: EOP | None, source: str, mjd0: float, mjd1: float, field
     if model:
         allowed = f"a run within {_iso(lo)}..{_iso(hi)}, or false (no EOP)"
     else:
-        allowed = (f'a run within that span, or "auto" (measured, predicted, then the long-term model: '
-                   f'{_iso(lo)}..{_iso(LONG_TERM_LAST_MJD)})')
+        allowed = f'a run within that span, or "auto" (up to {_iso(LONG_TERM_LAST_MJD)})'
+    where = "start" if bad == mjd0 else "end"
     raise EopSpanError(f'{field}: "{source}" covers {_iso(lo)}..{_iso(hi)} ({what}), not {_iso(bad)} '
-                       f"(the run spans {_iso(mjd0)}..{_iso(mjd1)} UTC); allowed: {allowed}", bad, (lo, hi), eop)
+                       f"(the run's {where}, UTC); allowed: {allowed}", bad, (lo, hi), eop)
 
 
 def long_term_warning(eop: EOP | None, mjd0: float, mjd1: float) -> str | None:

@@ -53,6 +53,7 @@ import erfa
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.pck import shipped_gm
 from .constants import DAY_S, J2000_JD
@@ -370,9 +371,8 @@ class Ephemeris:
             if not (math.isfinite(j1) and math.isfinite(j2)):
                 raise ValueError(f"ephemeris {self.name}: date is not finite (jd1={j1}, jd2={j2})")
             raise ValueError(
-                f"ephemeris {self.name} ({self.path}): date {_calendar(j1, j2)} TDB "
-                f"(JD {j1 + j2:.6f}) is outside its span {_calendar(lo, 0.0)} .. {_calendar(hi, 0.0)} TDB "
-                f"(JD {lo} .. {hi})")
+                f"ephemeris {self.name} ({self.path}): date {_calendar(j1, j2)} TDB is outside its span "
+                f"{_calendar(lo, 0.0).removesuffix('T00:00:00')} .. {_calendar(hi, 0.0).removesuffix('T00:00:00')} TDB")
 
     def validate_bodies(self, bodies) -> tuple[str, ...]:
         """Lower-cased body names, checked against :data:`BODIES` (and
@@ -383,7 +383,7 @@ class Ephemeris:
         for b in bodies:
             key = str(b).lower()
             if key not in _CHAIN:
-                raise ValueError(f"ephemeris: unknown body {b!r}; known: {', '.join(BODIES)} (and 'pluto')")
+                raise ValueError(unknown("ephemeris", b, [*BODIES, "pluto"], problem="is not a body", noun="bodies"))
             if key not in self.bodies:
                 raise ValueError(f"ephemeris {self.name} ({self.path}) holds no segments for {b!r}; "
                                  f"available: {', '.join(self.bodies)}")
@@ -460,7 +460,8 @@ class Ephemeris:
         names = tuple(str(b).lower() for b in bodies)
         for b in names:
             if b not in HELIOCENTRIC_BODIES:
-                raise ValueError(f"ephemeris: unknown heliocentric body {b!r}; known: {', '.join(HELIOCENTRIC_BODIES)}")
+                raise ValueError(unknown("ephemeris", b, HELIOCENTRIC_BODIES, problem="is not a heliocentric body",
+                                         noun="bodies"))
         self.validate_bodies(tuple(b for b in names if b != "earth") + ("sun",))
         shape, j1, j2 = self._flat_dates(jd1, jd2)
         n = j1.shape[0]

@@ -53,6 +53,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.pck import IauMoonElements, LunarPaKernel, load_lunar_pa_kernel, read_iau_moon_elements
 from .constants import ARCSEC_RAD, J2000_JD
@@ -256,4 +257,4 @@ def lunar_pa_rotation(jd1, jd2, libration: str = "de421", kernel=None) -> np.nda
         return _pa_angles_and_matrix(jd1, jd2, kernel)[1]
     if libration == "iau":
         return _iau_matrix(jd1, jd2, None, T_PA_ME_DE421)
-    raise ValueError(f"lunar orientation: libration {libration!r} is not one of {LIBRATIONS}")
+    raise ValueError(unknown("lunar orientation: libration", libration, LIBRATIONS))

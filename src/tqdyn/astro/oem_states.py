@@ -67,7 +67,8 @@ import weakref
 import erfa
 import numpy as np
 
-from ..readers.oem import JOIN_RULE, OemTrajectory, epoch_text, require_center
+from .._choices import allowed, did_you_mean
+from ..readers.oem import OemTrajectory, epoch_text, require_center
 from .constants import DAY_S, L_B
 from .timescales import tcb_to_tdb
 
@@ -110,9 +111,10 @@ def _method(where: str, file_method, file_degree, method, degree) -> tuple[str, 
     """(method, degree, records per window): the file's unless given."""
     m = (method or file_method or "").upper()
     if not m:
-        raise ValueError(f"{where}: the file gives no INTERPOLATION (allowed: {', '.join(INTERPOLATIONS)})")
+        raise ValueError(f"{where}: the file gives no INTERPOLATION (allowed: {allowed(INTERPOLATIONS)})")
     if m not in INTERPOLATIONS:
-        raise ValueError(f"{where}: INTERPOLATION = {m!r} is not supported (allowed: {', '.join(INTERPOLATIONS)})")
+        raise ValueError(f"{where}: INTERPOLATION = {m!r} is not supported{did_you_mean(m, INTERPOLATIONS)} "
+                         f"(allowed: {allowed(INTERPOLATIONS)})")
     deg = degree if degree is not None else (file_degree if method is None or m == file_method else None)
     if deg is None:
         if m != "LINEAR":
@@ -181,8 +183,7 @@ def _outside(traj: OemTrajectory, q1, q2) -> None:
     after = _dsec(q1, q2, *traj.stop) > 0
     if np.any(before | after):
         i = int(np.flatnonzero(before | after)[0])
-        raise ValueError(f"{traj.source}: epoch {epoch_text(q1[i], q2[i])} {traj.time_system} "
-                         f"(JD {float(q1[i])!r} + {float(q2[i])!r}) is outside the span "
+        raise ValueError(f"{traj.source}: epoch {epoch_text(q1[i], q2[i])} {traj.time_system} is outside the span "
                          f"{epoch_text(*traj.start)} .. {epoch_text(*traj.stop)} {traj.time_system} of the file")
 
 
@@ -319,10 +320,10 @@ def require_continuous(traj: OemTrajectory, *, method: str | None = None, degree
         tol_r = math.sqrt(3) / 2 * (spans[j].r_unit + spans[k].r_unit) + max(e[0] for e in misses)
         tol_v = math.sqrt(3) / 2 * (spans[j].v_unit + spans[k].v_unit) + max(e[1] for e in misses)
         if not (dr <= tol_r and dv <= tol_v):
-            raise ValueError(f"{traj.source}: segments {j + 1} ({spans[j].label}) and {k + 1} ({spans[k].label}) "
-                             f"are not continuous: at {text} their positions differ by {dr:.4g} m and their "
-                             f"velocities by {dv:.4g} m/s, more than the {tol_r:.4g} m and {tol_v:.4g} m/s of the "
-                             f"printed digits and the interpolation error there; allowed: {JOIN_RULE}")
+            bad = [(f"positions by {dr:.4g} m", f"{tol_r:.4g} m")] if not dr <= tol_r else []
+            bad += [(f"velocities by {dv:.4g} m/s", f"{tol_v:.4g} m/s")] if not dv <= tol_v else []
+            raise ValueError(f"{traj.source}: segments {j + 1} and {k + 1} differ where they meet ({text}): "
+                             f"{', '.join(b[0] for b in bad)}; allowed: <= {', '.join(b[1] for b in bad)}")
     if method is None and degree is None:
         _CONTINUOUS.add(traj)
     return traj

@@ -54,6 +54,7 @@ from typing import NamedTuple
 import erfa
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from ..numerics.dd import np_dd_add_d, np_fast_two_sum, np_two_prod, np_two_sum
 from ..numerics.lagrange import MARGIN, grid_interp
 from ..readers.leap_seconds import LeapSeconds, read_leap_seconds
@@ -457,7 +458,8 @@ def tcb_origin_offset(origin: str, epoch: Epoch, t_first: float) -> float:
     (:func:`unix_of_tcb`), the following ones TCB seconds after it.
     """
     if origin not in TCB_ORIGINS:
-        raise ValueError(f"time origin {origin!r} is not allowed; allowed: {', '.join(TCB_ORIGINS)}")
+        raise ValueError(f"time origin {origin!r} is not allowed{did_you_mean(origin, TCB_ORIGINS)}; "
+                         f"allowed: {allowed(TCB_ORIGINS)}")
     if origin == "epoch":
         return 0.0
     c1, c2 = tcb_jd_of_epoch(epoch)

@@ -4,7 +4,8 @@ The click group and the entry point :func:`main`; every command lives in its
 own module (:mod:`.run`, :mod:`.forces`, :mod:`.info`, :mod:`.bench`,
 :mod:`.export`, :mod:`.sweep`, :mod:`.report`, :mod:`.closed_loop`, :mod:`.od`) and only composes library
 calls.  Bad input exits with status 2 and one line on stderr (no traceback,
-no partial output file).
+no partial output file); every command runs in :func:`._common.guarded` (Ctrl-C, SIGTERM, SIGHUP,
+a full disk: docs/reliability.md, "Fault classes").
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import click
 
 from .._version import __version__
 from ..workflows.heap import bound_heap_retention
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail, guarded as _guarded
 from .bench import bench as _bench_command
 from .closed_loop import closed_loop as _closed_loop_command
 from .export import export as _export_command
@@ -27,7 +28,16 @@ from .sweep import sweep as _sweep_command
 __all__ = ["main"]
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _GuardedGroup(click.Group):
+    """The command group; every command runs in :func:`._common.guarded` (inside click's own
+    handling, which would print an empty line for a KeyboardInterrupt reaching it)."""
+
+    def invoke(self, ctx):
+        with _guarded():
+            return super().invoke(ctx)
+
+
+@click.group(cls=_GuardedGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="tqdyn")
 def cli():
     """tqdyn -- coupled dynamics of drag-free gravitational-wave constellations

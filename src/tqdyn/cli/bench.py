@@ -16,13 +16,13 @@ from pathlib import Path
 
 import click
 
-from ._common import fail as _fail
+from ._common import Choice, fail as _fail, guarded
 
 __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
 #: Every model, in the order they run.
 MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels", "default-run", "startup", "tianqin-5y",
-          "tianqin-5y-multistep", "lisa-10y", "closed-loop")
+          "tianqin-5y-multistep", "lisa-10y", "closed-loop", "closed-loop-budget-90d", "closed-loop-budget-lisa-1y")
 #: What ``--model all`` runs (the mission-length commands are asked for by name).
 ALL_MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels")
 
@@ -50,20 +50,24 @@ def _check_json_path(path) -> Path:
 @click.option("--duration", default=None,
               help="Propagated span [default: 90d; lisa: 3652.5d = 10 years; lisa-coupled: 365d; rounded up to "
                    "whole 6 h steps; default-run: the scenario's 10 d; tianqin-5y(-multistep): 1826d; lisa-10y: 3653d; "
-                   "closed-loop: the time series, 3d].")
+                   "closed-loop: the time series, 3d; closed-loop-budget-90d: 90d; closed-loop-budget-lisa-1y: "
+                   "365d].")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s] of the kepler model.")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
-@click.option("--model", "which", type=click.Choice(MODELS + ("all",)), multiple=True,
+@click.option("--model", "which", type=Choice(MODELS + ("all",), doc="docs/commands.md#tqdyn-bench"), multiple=True,
               help="kepler: monopole only; full: the full force model, pure gravity (and the reduced model vs "
                    "heyoka); coupled: the full coupled run (attitude + drag-free control); lisa: the heliocentric "
                    "lisa-esa scenario (ESA's orbits and force model, point masses); lisa-coupled: the coupled "
                    "lisa scenario (LISA architecture and drag-free scheme, one year); kernels: the time-only inputs "
                    "of one chunk, term by term, and the compiled kernels per evaluation; default-run: the command "
-                   "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with an empty kernel cache, then "
-                   "with it filled; tianqin-5y: `tqdyn run tianqin` for five years; tianqin-5y-multistep: the same "
+                   "`tqdyn run` (10 days); startup: `tqdyn run --duration 1h` with each integrator (DP87, "
+                   "multistep), first with an empty kernel cache (compilation clocked), then with it filled; tianqin-5y: `tqdyn run tianqin` for five years with DP87; "
+                   "tianqin-5y-multistep: the same "
                    "with the multistep method; lisa-10y: `tqdyn run "
                    "lisa` for ten years; closed-loop: the closed-loop time series of 3 TianQin spacecraft, "
-                   "3 days at 4 Hz, streamed to a file; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
+                   "3 days at 4 Hz, streamed to a file; closed-loop-budget-90d / closed-loop-budget-lisa-1y: "
+                   "tqdyn closed-loop's model, budget and file of a 90-day TianQin / one-year LISA run (made "
+                   "first, not timed), time and peak memory; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
 @click.option("--json", "json_path", metavar="PATH",
               help="Also write the results to this JSON record: the entries of the models run are replaced, "
                    "the others kept (docs/numbers.md).")
@@ -116,22 +120,34 @@ def bench(duration, step, no_heyoka, which, json_path):
     }
     runners["closed-loop"] = lambda: (_closed_loop.closed_loop_benchmark(duration),
                                       _closed_loop.format_closed_loop_report)
+    for name in _closed_loop.BUDGET_RUNS:
+        runners[name] = lambda name=name: (_closed_loop.closed_loop_budget_benchmark(name, duration),
+                                           _closed_loop.format_budget_report)
     runners["startup"] = lambda: (_mission.startup_benchmark(duration), _mission.format_startup_report)
     for name in _mission.MISSION_RUNS:
         runners[name] = lambda name=name: (_mission.mission_benchmark(name, duration), _mission.format_mission_report)
+    done: list[str] = []
+
+    def note(exc) -> str:
+        if path is None:
+            return "no output file written"
+        return (f"the record {path} holds the models that finished ({', '.join(done)})" if done else
+                f"the record {path} is as it was")
+
     for model in models:
         prov = _numbers.provenance("tqdyn bench", command(model))
-        try:
-            result, fmt = runners[model]()
-        except (ScenarioError, ValueError) as exc:
-            _fail(str(exc))
-        except RuntimeError as exc:
-            _fail(str(exc), 1)
-        click.echo(fmt(result))
-        if path is not None:
-            entry = {**prov, "model": model, "result": result}
-            entry.pop("written_by")
-            _numbers.merge_section(path, "models", {model: entry},
-                                   {"written_by": "tqdyn bench",
-                                    "description": "results of tqdyn bench --json, one entry per model, each with "
-                                                   "the command, date, machine and library versions of its run"})
+        with guarded(note, bad_input=(ScenarioError, ValueError)):
+            try:
+                result, fmt = runners[model]()
+            except RuntimeError as exc:
+                _fail(str(exc), 1)
+            click.echo(fmt(result))
+            if path is not None:
+                entry = {**prov, "model": model, "result": result}
+                entry.pop("written_by")
+                _numbers.merge_section(path, "models", {model: entry},
+                                       {"written_by": "tqdyn bench",
+                                        "description": "results of tqdyn bench --json, one entry per model, each "
+                                                       "with the command, date, machine and library versions of its "
+                                                       "run"})
+        done.append(model)

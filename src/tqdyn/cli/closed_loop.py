@@ -1,11 +1,13 @@
-"""Command line: ``tqdyn closed-loop RUN.h5 --output CL.h5 [--duration D] [--fs HZ] [--seed N] [--set ...]``.
+"""Command line: ``tqdyn closed-loop RUN.h5 --output CL.h5 [--duration D] [--fs HZ] [--seed N] [--set ...]
+[--per-source]``, or ``tqdyn closed-loop --mission NAME --output CL.h5 [...]`` (a mission's static working
+point, no run).
 
 Registered in :mod:`tqdyn.cli`.  It only composes :mod:`tqdyn.workflows.closed_loop`: the inputs are
 resolved and checked first (bad input: status 2, one line, nothing written), then the budget and the
 time series are written to the closed-loop file (docs/closed-loop-file.md) with progress bars (the
-budget's loops, then the samples); a failed write exits with status 3, Ctrl-C with 130, and neither
-leaves a file at the output path (an existing file there is replaced only by a complete one, as
-``tqdyn run`` does).
+budget's loops, then the samples); a failed write exits with status 3, Ctrl-C with 130, SIGTERM with
+143 (:func:`._common.guarded`), and none leaves a file at the output path (an existing file there is
+replaced only by a complete one, as ``tqdyn run`` does).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ import sys
 
 import click
 
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, fail as _fail
+from ._common import guarded
 
 __all__ = ["closed_loop"]
 
@@ -43,49 +45,45 @@ class _Bars:
 
 
 @click.command("closed-loop")
-@click.argument("run_file", metavar="RUN.h5")
+@click.argument("run_file", metavar="[RUN.h5]", required=False)
+@click.option("--mission", help="Instead of RUN.h5: the mission's static working point (lpf, tianqin-1, or a "
+                                "constellation mission's representative point; docs/closed-loop.md).")
 @click.option("--output", "-o", required=True, help="Output closed-loop HDF5 file (replaced only by a complete one).")
 @click.option("--duration", help="Length of the time series: seconds, or with a unit: 3d, 6h, 30min, 3600s "
-                                 "[default: closed_loop.duration, else the run's span].")
+                                 "[default: closed_loop.duration, else the run's first day (its span if shorter)].")
 @click.option("--fs", help="Sample rate of the time series [Hz; default: closed_loop.fs, docs/scenarios.md].")
 @click.option("--seed", type=int, help="Root seed of the noise realisations [default: closed_loop.seed].")
 @click.option("--set", "sets", multiple=True, metavar="closed_loop.KEY=VALUE",
               help="Override a closed-loop key of the run's scenario, e.g. --set closed_loop.n_freq=100 or "
                    "--set closed_loop.noise.thruster_force.level=1e-7 (repeatable; docs/scenarios.md).")
+@click.option("--per-source", is_flag=True, help="Also write the ASD of every output from every noise source "
+                                                "(/budget/asd; the totals and dominant sources are always written).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bars.")
-def closed_loop(run_file, output, duration, fs, seed, sets, quiet):
-    """The closed loop of the coupled run RUN.h5 (any mission): the drag-free, suspension, attitude
-    and MOSA loops linearised around the run's working point (docs/closed-loop.md), their noise
-    budget, margins and dominant sources, and seeded time series of every output per spacecraft,
-    streamed to the closed-loop file CL.h5 (docs/closed-loop-file.md)."""
+def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source, quiet):
+    """The closed loop of the coupled run RUN.h5 (any mission), or of a mission's static working point
+    (--mission, e.g. lpf or tianqin-1): the drag-free, suspension, attitude and MOSA loops linearised
+    around the working point (docs/closed-loop.md), their noise budget, margins and dominant sources,
+    and seeded time series of every output per spacecraft, streamed to the closed-loop file CL.h5
+    (docs/closed-loop-file.md)."""
     from tqdm import tqdm
 
     from ..formats import trajectory as io
     from ..workflows import closed_loop as wf
 
-    try:
-        job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets)
-    except (ValueError, FileNotFoundError, io.OutputError) as exc:
-        _fail(" ".join(str(exc).split()))
+    with guarded(bad_input=(ValueError, FileNotFoundError, io.OutputError)):
+        job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets,
+                                          per_source=per_source, mission=mission)
     n = job.attrs["n_samples"]
-    click.echo(f"tqdyn closed-loop: {job.attrs['source_file']}, mission {job.model.mission}, "
+    where = job.attrs["source_file"] or "static working point"
+    click.echo(f"tqdyn closed-loop: {where}, mission {job.model.mission}, "
                f"{len(job.model.loops)} spacecraft x {len(job.model.loops[0])} segment(s); time series "
                f"{job.duration_s:g} s at {job.fs:g} Hz ({n} samples), seed {job.seed}", err=True)
     n_loops = len(job.model.loops) * len(job.model.loops[0])
     bars = _Bars(lambda total, unit, desc: tqdm(total=total, disable=True if quiet else None, unit=unit,
                                                 unit_scale=unit == "sample", file=sys.stderr, dynamic_ncols=True,
                                                 desc=desc), n_loops, n)
-    try:
+    with guarded(bad_input=(ValueError, io.OutputError), cleanup=bars.close):
         summary = wf.closed_loop_to_file(job, progress=bars.samples, budget_progress=bars.loops)
-    except io.OutputIOError as exc:
-        bars.close()
-        _fail(f"{exc}; no output file written", _EXIT_IO)
-    except (ValueError, io.OutputError) as exc:
-        bars.close()
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        bars.close()
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     bars.close()
     click.echo(f"budget: {summary.budget_s:.2f} s; time series: {summary.n_samples} samples x {summary.n_sat} "
                f"spacecraft in {summary.timeseries_s:.2f} s")

@@ -6,8 +6,9 @@ A click command registered by :mod:`tqdyn.cli` (``cli.add_command(export)``).
 It only composes library calls (:func:`tqdyn.workflows.export.export_lisa`,
 :func:`tqdyn.workflows.export_oem.export_oem`, :func:`tqdyn.workflows.export_ttl.export_ttl`,
 :func:`tqdyn.workflows.export_injection.export_lisa_injection`).  As
-everywhere in the CLI, bad input exits with status 2 and one line
-``tqdyn: error: ...`` on stderr, and no output file is left behind.
+everywhere in the CLI, bad input (an output that is one of the inputs among it) exits with status 2
+and one line ``tqdyn: error: ...`` on stderr, a failed write with 3, Ctrl-C / SIGTERM with 130 / 143
+(:func:`._common.guarded`), and no output file is left behind.
 
 Formats are registered in :data:`_EXPORTERS` (name -> function(run_file,
 out_file, options) returning the lines to print); a new format adds one
@@ -20,7 +21,8 @@ from __future__ import annotations
 
 import click
 
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from .._choices import unknown
+from ._common import Choice, fail as _fail, guarded
 
 __all__ = ["FORMATS", "export"]
 
@@ -136,13 +138,13 @@ closed loop's tilt-to-length (both from a closed-loop file)."""
 @click.option("--shapiro/--no-shapiro", default=None,
               help="lisa: include the Shapiro delay in the light travel times (GCRS: the Earth's; BCRS: the Sun's, "
                    "and the Earth's for a geocentric run).  Default: on for heliocentric runs, off for geocentric.")
-@click.option("--frame", type=click.Choice(["gcrs", "bcrs"]), default=None,
+@click.option("--frame", type=Choice(["gcrs", "bcrs"]), default=None,
               help="lisa: gcrs = the run's geocentric GCRS and TT (default for geocentric runs); bcrs = barycentric "
                    "BCRS with TCB as coordinate time (default, and the only choice, for heliocentric runs).")
-@click.option("--axes", type=click.Choice(["icrf", "ecliptic"]), default=None,
+@click.option("--axes", type=Choice(["icrf", "ecliptic"]), default=None,
               help="lisa, bcrs only: the axes of the vectors, icrf (default) or the J2000 mean ecliptic of "
                    "lisaorbits' files.")
-@click.option("--time-origin", "time_origin", type=click.Choice(["epoch", "j2000", "unix"]), default=None,
+@click.option("--time-origin", "time_origin", type=Choice(["epoch", "j2000", "unix"]), default=None,
               help="lisa, bcrs only: t = TCB seconds since the run's epoch (default), since J2000.0 TCB, or t0 = the "
                    "Unix time of the first sample (as lisaorbits' OEM orbits).")
 @click.option("--coefficients", default=None, metavar="worst-case|random|FILE",
@@ -194,16 +196,12 @@ def export(run_file, out_file, fmt, shapiro, frame, axes, time_origin, coefficie
     if fmt is None:
         _fail(f"--format is required; allowed: {', '.join(FORMATS)}")
     if fmt not in FORMATS:
-        _fail(f"--format: {fmt!r} is not allowed; allowed: {', '.join(FORMATS)}")
+        _fail(unknown("--format", fmt, FORMATS))
     from ..formats import trajectory as io
 
     opts = {"shapiro": shapiro, "frame": frame, "axes": axes, "time_origin": time_origin,
             "coefficients": coefficients, "seed": seed, "drift": drift, "step": step, "run": run,
             "tm_acceleration": tm_acceleration}
-    try:
+    with guarded(bad_input=(FileNotFoundError, ValueError, io.OutputError)):
         lines = _EXPORTERS[fmt](run_file, out_file, opts)
-    except (FileNotFoundError, ValueError, io.OutputError) as exc:
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     click.echo("\n".join(lines))

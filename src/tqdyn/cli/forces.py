@@ -12,7 +12,7 @@ from decimal import Decimal, InvalidOperation
 
 import click
 
-from ._common import _overrides, fail as _fail
+from ._common import _overrides, fail as _fail, fail_io
 
 __all__ = ["forces"]
 
@@ -83,6 +83,7 @@ def forces(scenario, duration, every, plot_path, sets):
     status 2 and one line on stderr, and no file is written."""
     from .. import dynamics
     from ..analysis.budget import force_budget
+    from ..formats.trajectory import OutputError
     from ..scenario import ScenarioError, load_scenario
 
     try:
@@ -94,8 +95,12 @@ def forces(scenario, duration, every, plot_path, sets):
             from ..analysis.figures import check_figure_path
 
             check_figure_path(plot_path)
+            from ..formats.atomic import check_output
+            from ..workflows.run import scenario_inputs
+
+            check_output(plot_path, "--plot", scenario_inputs(scenario, scen))
         model = dynamics.check_inputs(scen)
-    except (ScenarioError, ValueError, FileNotFoundError) as exc:
+    except (ScenarioError, ValueError, FileNotFoundError, OutputError) as exc:
         _fail(str(exc))
     except ImportError as exc:
         _fail(f"--plot: {plot_path!r} cannot be drawn ({exc}); allowed: no --plot, or install matplotlib")
@@ -121,11 +126,15 @@ def forces(scenario, duration, every, plot_path, sets):
     if plot_path is not None:
         from ..analysis.figures import plot_force_budget
 
+        from ..formats.trajectory import OutputIOError
+
         try:
             plot_force_budget(budget, t_hi + t_lo, plot_path, title=f"force budget, {scen.name}")
         except ValueError as exc:  # the path changed since it was checked
             _fail(str(exc))
-        except (OSError, RuntimeError) as exc:  # a full disk, a missing LaTeX for .pgf, ...
+        except OutputIOError as exc:  # a full disk: status 3
+            fail_io(f"--plot: {exc}; nothing was written there")
+        except (OSError, RuntimeError) as exc:  # a missing LaTeX for .pgf, ...
             _fail(f"--plot: {plot_path!r} could not be written ({exc}); nothing was written there; "
                   "allowed: a writable file with space for the figure")
         click.echo(f"plot: {plot_path}")

@@ -25,7 +25,7 @@ def info():
     from ..forces.model import describe_terms
     from ..numerics.dp87 import CORRECTED_TABLEAU_PROVENANCE
     from ..numerics.multistep import CORRECTORS, ORDERS
-    from ..scenario import builtin_scenarios
+    from ..scenario import DEFAULT_METHOD, builtin_scenarios
 
     def version(mod):
         try:
@@ -41,11 +41,11 @@ def info():
              "reference systems (scenario.central_body):",
              *(f"  {r.central_body:<6} {r.frame}, t in {r.time_scale}: {r.description}" for r in REFERENCE_SYSTEMS),
              "precision: dd (compiled double-double, ~32 digits, FMA two-product) | float64",
-             "integrator: Prince-Dormand RK8(7)13M, fixed step or adaptive (embedded 7th order), "
-             "Hermite dense output",
-             f"  tableaux: corrected (default; {CORRECTED_TABLEAU_PROVENANCE}) | published "
+             f"integrator (integrator.method; not given: {DEFAULT_METHOD} with a fixed step, dp87 adaptive):",
+             "  dp87: Prince-Dormand RK8(7)13M, fixed step or adaptive (embedded 7th order), Hermite dense output",
+             f"    tableaux: corrected (default; {CORRECTED_TABLEAU_PROVENANCE}) | published "
              "(GSL rk8pd.c / GMAT rationals, order conditions hold to ~6.5e-18)",
-             "  or (integrator.method = \"multistep\") Gauss-Jackson / summed Adams, fixed step, order "
+             "  multistep: Gauss-Jackson / summed Adams, fixed step, order "
              f"{ORDERS[0]}..{ORDERS[-1]}, {' | '.join(CORRECTORS)}, DP87 start-up",
              "force models:"]
     for name, description, source in describe_terms():

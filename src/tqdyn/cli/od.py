@@ -7,7 +7,8 @@ arc, an output path that is an input, an unobservable fit, a ``--figure`` that i
 considered group without an a priori sigma, an ``--sp3`` file that is missing, malformed, too short
 for the arc or other than the one a TDM was simulated with) exits with status 2 and one line,
 nothing written;
-Ctrl-C exits with 130 and leaves no file (the files are written atomically).  The stages show as a
+a failed write (disk full) exits with 3, Ctrl-C with 130, SIGTERM with 143, and none leaves a file
+(the files are written atomically).  The stages show as a
 progress bar on stderr (``--quiet``: none).
 """
 
@@ -17,7 +18,7 @@ import sys
 
 import click
 
-from ._common import EXIT_INTERRUPTED as _EXIT_INTERRUPTED, fail as _fail
+from ._common import guarded
 
 __all__ = ["od"]
 
@@ -49,18 +50,13 @@ class _Stages:
 
 
 def _run(job, stages: _Stages):
-    """Run ``job()``: bad input -> status 2, Ctrl-C -> 130 (no file is left: writes are atomic)."""
+    """Run ``job()`` in :func:`._common.guarded`: bad input -> status 2, a failed write -> 3, Ctrl-C ->
+    130, SIGTERM -> 143 (no file is left: writes are atomic)."""
     from ..formats import trajectory as io
     from ..scenario import ScenarioError
 
-    try:
+    with guarded(bad_input=(ValueError, FileNotFoundError, ScenarioError, io.OutputError), cleanup=stages.bar.close):
         out = job()
-    except (ValueError, FileNotFoundError, ScenarioError, io.OutputError) as exc:
-        stages.bar.close()
-        _fail(" ".join(str(exc).split()))
-    except KeyboardInterrupt:
-        stages.bar.close()
-        _fail("interrupted; no output file written", _EXIT_INTERRUPTED)
     stages.close()
     return out
 

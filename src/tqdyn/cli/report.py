@@ -20,8 +20,12 @@ composes :mod:`tqdyn.workflows.report` and :mod:`tqdyn.workflows.studies`:
   source), ``DIR/summary.md`` and ``DIR/summary.json``.
 
 Bad input (a missing file, a file that is not a tqdyn trajectory, an unknown
-study, bad overrides, conflicting options) exits with status 2 and one line
-``tqdyn: error: ...`` on stderr, before anything is run or written.
+study, bad overrides, conflicting options, an input that the report would
+replace) exits with status 2 and one line ``tqdyn: error: ...`` on stderr,
+before anything is run or written.  The report's files are written into a
+hidden temporary directory and moved into DIR when complete
+(:func:`tqdyn.formats.atomic.replacing_directory`): a full disk (status 3),
+Ctrl-C (130) or SIGTERM (143) leave DIR as it was (:func:`._common.guarded`).
 Progress goes to stderr, the summary table to stdout.  Exit status 1 if a
 study run failed (the report of the others is still written).
 """
@@ -33,8 +37,8 @@ import sys
 import click
 
 from .._version import __version__
-from ._common import EXIT_FAILED as _EXIT_RUN_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
-from ._common import fail as _fail
+from ._common import EXIT_FAILED as _EXIT_RUN_FAILED
+from ._common import Choice, fail as _fail, guarded
 
 __all__ = ["report"]
 
@@ -50,7 +54,7 @@ __all__ = ["report"]
               help="The default closed-loop designs of the three missions at the working points of short coupled "
                    "runs: budget stacks, loop gains with margins, residual TM acceleration (docs/closed-loop.md), "
                    "single-link TTL budgets (docs/tilt-to-length.md).")
-@click.option("--mission", type=click.Choice(["tianqin", "lisa"]), default=None,
+@click.option("--mission", type=Choice(["tianqin", "lisa"]), default=None,
               help="With --studies: the study set, tianqin (the paper's section V, default) or lisa (the same "
                    "studies on LISA and Taiji, one-year runs).")
 @click.option("--runs-dir", metavar="DIR", help="With --studies: directory of the study runs (default: OUT/runs).")
@@ -104,30 +108,68 @@ def report(runs, out, studies, closed_loop, mission, runs_dir, quick, duration_s
     from ..formats import trajectory as io
     from ..workflows import report as rp
 
-    try:
-        rep = rp.report_runs(runs, out or "tqdyn-report", progress=say)
-    except (FileNotFoundError, io.TrajectoryFormatError, ValueError, ImportError) as exc:
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        _fail("interrupted", _EXIT_INTERRUPTED)
-    rp.write_summary_json(rep, " ".join(["tqdyn report", *runs] + (["--out", out] if out else [])),
-                          runs={str(r): _file_facts(r) for r in runs})
+    def make(stage):
+        rep = rp.report_runs(runs, stage, progress=say)
+        rp.write_summary_json(rep, " ".join(["tqdyn report", *runs] + (["--out", out] if out else [])),
+                              runs={str(r): _file_facts(r) for r in runs})
+        return rep
+
+    with guarded(bad_input=(FileNotFoundError, io.TrajectoryFormatError, ValueError, ImportError)):
+        _check_report_inputs(runs, out or "tqdyn-report")
+        rep = _staged(out or "tqdyn-report", make)
     _print_report(rep)
+
+
+#: the names of the files a report writes besides its figures (*.png, *.pdf)
+_REPORT_FILES = ("summary.md", "summary.json")
+
+
+def _check_report_inputs(runs, out) -> None:
+    """Refuse (ValueError, one line) an input RUN.h5 that a report into ``out`` would replace: a file of
+    ``out`` named as a report file (summary.md, summary.json, *.png, *.pdf)."""
+    import os
+
+    from ..formats.atomic import same_file
+
+    for r in runs:
+        parent, name = os.path.dirname(os.path.abspath(r)), os.path.basename(r)
+        if (os.path.isdir(out) and same_file(parent, out)
+                and (name in _REPORT_FILES or name.lower().endswith((".png", ".pdf")))):
+            raise ValueError(f"--out: {out!r} would replace the input RUN.h5 {r!r} (a report writes "
+                             f"{', '.join(_REPORT_FILES)} and *.png, *.pdf there); allowed: another directory")
+
+
+def _staged(out, make):
+    """The report ``make(directory)`` written into a hidden temporary directory and moved into ``out`` when
+    complete (:func:`tqdyn.formats.atomic.replacing_directory`: a fault leaves ``out`` as it was); its
+    paths point into ``out``."""
+    from ..formats.atomic import check_directory, replacing_directory
+
+    final = check_directory(out, "--out")
+    with replacing_directory(final, "--out") as stage:
+        rep = make(stage)
+
+    def moved(p):
+        return None if p is None else final / p.relative_to(stage)
+
+    rep.out_dir, rep.summary_path = final, moved(rep.summary_path)
+    rep.figures = [moved(p) for p in rep.figures]
+    return rep
 
 
 def _run_closed_loop(out, say):
     from ..workflows import report as rp
     from ..workflows.report.closed_loop import RUNS, report_closed_loop
 
-    try:
-        rep = report_closed_loop(out, progress=say)
-    except ValueError as exc:
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        _fail("interrupted", _EXIT_INTERRUPTED)
-    rp.write_summary_json(rep, f"tqdyn report --closed-loop --out {out}",
-                          runs={m: {"scenario": r[0], "overrides": list(r[1]), "description": r[2]}
-                                for m, r in RUNS.items()})
+    def make(stage):
+        rep = report_closed_loop(stage, progress=say)
+        rp.write_summary_json(rep, f"tqdyn report --closed-loop --out {out}",
+                              runs={m: {"scenario": r[0], "overrides": list(r[1]), "description": r[2]}
+                                    for m, r in RUNS.items()})
+        return rep
+
+    with guarded(bad_input=(ValueError,)):
+        rep = _staged(out, make)
     _print_report(rep)
 
 
@@ -151,6 +193,7 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
 
     from tqdm import tqdm
 
+    from ..formats.atomic import check_directory
     from ..workflows import studies as st
     from ..workflows import report as rp
     from ..workflows.sweep.execute import default_workers
@@ -175,7 +218,7 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         if duration_scale is not None:
             st.scaled_duration_s(1.0, duration_scale, 50.0)  # validates the scale
         plan = st.plan_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets, **catalogue)
-        rp.check_out_dir(out)
+        check_directory(out, "--out")
     except (ValueError, FileNotFoundError) as exc:
         _fail(str(exc))
     pending = [p for p in plan if not p.done]
@@ -198,31 +241,14 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
     import time
 
     t0 = time.perf_counter()
-    try:
+    with guarded(lambda exc: "finished runs are kept and reused next time", bad_input=(ValueError, FileNotFoundError),
+                 cleanup=bar.close):
         result = st.run_studies(runs_dir, studies=names, duration_scale=scale, extra_overrides=sets,
                                 workers=workers, progress=progress, plan=plan, **catalogue)
-    except KeyboardInterrupt:
-        bar.close()
-        _fail("interrupted; finished runs are kept and reused next time", _EXIT_INTERRUPTED)
-    except (ValueError, FileNotFoundError) as exc:
-        bar.close()
-        _fail(str(exc))
     bar.close()
     paths = {name: result.path(name) for name in result.outcomes}
     scaled = "" if scale == 1.0 else f" (durations x {scale:.4g})"
     t_runs = time.perf_counter()
-    try:
-        if mission == "lisa":
-            rep = report_lisa_studies(paths, out, studies=names, progress=say,
-                                      title="tqdyn: the paper's studies on LISA and Taiji" + scaled)
-        else:
-            rep = rp.report_studies(paths, out, studies=names, progress=say,
-                                    title="tqdyn: the paper's section V reproduced" + scaled)
-    except ImportError as exc:  # matplotlib missing: the runs are kept
-        _fail(str(exc))
-    except KeyboardInterrupt:
-        _fail("interrupted", _EXIT_INTERRUPTED)
-    t_end = time.perf_counter()
     command = " ".join(["tqdyn report --studies"] + (["--mission", mission] if mission != "tianqin" else [])
                        + (["--quick"] if quick else []) + ([f"--duration-scale {duration_scale:g}"]
                                                            if duration_scale is not None else [])
@@ -235,10 +261,24 @@ def _run_studies(out, runs_dir, quick, duration_scale, only, sets, workers, quie
         runs_info[name] = {"status": o.status, "duration_s": o.run.duration_s, **facts,
                            "file_mb_per_day": facts["file_mb"] / days if facts["file_mb"] and days else None}
     sizes = [r["file_mb"] for r in runs_info.values() if r["file_mb"] is not None]
-    rp.write_summary_json(rep, command, mission=mission, duration_scale=scale, studies=list(result.studies),
-                          timing={"workers": n, "runs_wall_s": t_runs - t0, "report_wall_s": t_end - t_runs,
-                                  "total_wall_s": t_end - t0, "n_runs": len(plan), "n_ran": len(pending)},
-                          runs=runs_info, runs_total_file_mb=sum(sizes) if sizes else None)
+
+    def make(stage):
+        if mission == "lisa":
+            rep = report_lisa_studies(paths, stage, studies=names, progress=say,
+                                      title="tqdyn: the paper's studies on LISA and Taiji" + scaled)
+        else:
+            rep = rp.report_studies(paths, stage, studies=names, progress=say,
+                                    title="tqdyn: the paper's section V reproduced" + scaled)
+        t_end = time.perf_counter()
+        rp.write_summary_json(rep, command, mission=mission, duration_scale=scale, studies=list(result.studies),
+                              timing={"workers": n, "runs_wall_s": t_runs - t0, "report_wall_s": t_end - t_runs,
+                                      "total_wall_s": t_end - t0, "n_runs": len(plan), "n_ran": len(pending)},
+                              runs=runs_info, runs_total_file_mb=sum(sizes) if sizes else None)
+        return rep
+
+    with guarded(lambda exc: "the study runs are kept and reused next time",
+                 bad_input=(ImportError,)):  # matplotlib missing: the runs are kept
+        rep = _staged(out, make)
     _print_report(rep)
     if result.failures:
         for o in result.failures:

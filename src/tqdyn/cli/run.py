@@ -13,76 +13,14 @@ write (disk full, file-size limit) exits with status 3, one line; Ctrl-C
 
 from __future__ import annotations
 
-import contextlib
-import os
-import signal
 import sys
 
 import click
 
 from .._version import __version__
-from ._common import (EXIT_INTERRUPTED as _EXIT_INTERRUPTED, EXIT_IO as _EXIT_IO, EXIT_SIGHUP, EXIT_SIGTERM,
-                      _overrides, fail as _fail)
+from ._common import Choice, _overrides, fail as _fail, guarded
 
 __all__ = ["run"]
-
-
-class _Stopped(KeyboardInterrupt):
-    """SIGTERM / SIGHUP, raised where the run is and handled like Ctrl-C."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
-_SIGNAL_EXIT = {signal.SIGTERM: EXIT_SIGTERM, **({signal.SIGHUP: EXIT_SIGHUP} if hasattr(signal, "SIGHUP") else {})}
-
-
-@contextlib.contextmanager
-def _stop_signals():
-    """While the run goes: SIGTERM and SIGHUP are recorded in the yielded
-    dict (``"signum"``) and :func:`_check_stop` raises :class:`_Stopped` (a
-    KeyboardInterrupt: the checkpoint is kept as after Ctrl-C) at the next
-    chunk of steps.  The handler itself does not raise: an exception raised
-    by a signal handler while Python runs a callback (a weakref's, the
-    garbage collector's) is printed as "Exception ignored ..." and lost.  A
-    second signal is ignored.  No-op outside the main thread."""
-    pending: dict = {}
-
-    def handler(signum, frame):
-        for s in _SIGNAL_EXIT:
-            signal.signal(s, signal.SIG_IGN)
-        pending["signum"] = signum
-
-    try:
-        old = {s: signal.signal(s, handler) for s in _SIGNAL_EXIT}
-    except ValueError:  # not the main thread
-        yield pending
-        return
-    try:
-        yield pending
-    finally:
-        for s, h in old.items():
-            signal.signal(s, h)
-
-
-def _check_stop(pending: dict) -> None:
-    """Raise :class:`_Stopped` if :func:`_stop_signals` recorded a signal."""
-    if "signum" in pending:
-        raise _Stopped(pending["signum"])
-
-
-def _fail_io(message: str):
-    """One line, exit status 3; if HDF5 could not close a file, end without
-    the interpreter's exit handlers (HDF5 would crash in them)."""
-    from ..formats.trajectory import hdf5_poisoned
-
-    if hdf5_poisoned():  # pragma: no cover - the writer avoids it
-        click.echo(f"tqdyn: error: {message}", err=True)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(_EXIT_IO)
-    _fail(message, _EXIT_IO)
 
 
 def _format_state_table(scenario, y_dd) -> list[str]:
@@ -119,7 +57,7 @@ def _checkpoint_interval(text) -> float:
 @click.option("--duration", help="Propagation span: seconds, or with a unit: 90d, 12h, 30min, 3600s.")
 @click.option("--step", help="Integrator step [s] (fixed mode) or output interval (adaptive mode).")
 @click.option("--output", "-o", help="Output HDF5 trajectory file.")
-@click.option("--precision", type=click.Choice(["dd", "float64"]), help="Arithmetic of the propagation.")
+@click.option("--precision", type=Choice(["dd", "float64"]), help="Arithmetic of the propagation.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
               help="Override a scenario value, e.g. --set integrator.mode=adaptive or "
                    "--set satellites.2.nu_deg=151 (repeatable).")
@@ -140,6 +78,8 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     from tqdm import tqdm
 
     from ..formats import trajectory as io
+    from ..formats.atomic import check_output
+    from ..formats.stop import check_stop
     from .. import dynamics
     from ..workflows import run as runner
     from ..scenario import ScenarioError
@@ -148,7 +88,7 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
         interval_s = _checkpoint_interval(checkpoint_interval)
         scen, notes = runner.load_run_scenario(scenario, _overrides(sets, duration, step, output, precision),
                                                writes=True)
-        io.check_writable(scen.run.output)
+        check_output(scen.run.output, "run.output", runner.scenario_inputs(scenario, scen))
         runner.check_checkpoint(scen, resume)
         model = dynamics.check_inputs(scen)
     except (ScenarioError, io.OutputError, ValueError, FileNotFoundError) as exc:
@@ -168,43 +108,43 @@ def run(scenario, duration, step, output, precision, sets, quiet, checkpoint_eve
     for note in notes + [runner.eop_warning(scen, model)]:
         if note:
             click.echo(f"tqdyn: warning: {note}", err=True)
-    state = {"bar": None, "stop": {}}
+    state = {"bar": None}
 
     def progress(n):
-        _check_stop(state["stop"])  # SIGTERM / SIGHUP: stop here, between two chunks of steps
+        check_stop()  # SIGTERM / SIGHUP: stop here, between two chunks of steps
         if state["bar"] is None:
             state["bar"] = tqdm(total=n_total if fixed else float(scen.run.duration_s),
                                 disable=True if quiet else None, unit="step" if fixed else "s",
                                 unit_scale=not fixed, file=sys.stderr, dynamic_ncols=True, desc="propagating")
         state["bar"].update(n)
 
-    try:
-        with _stop_signals() as state["stop"]:
+    def close_bar():
+        if state["bar"] is not None:
+            state["bar"].close()
+
+    def note(exc) -> str:
+        ckpt = getattr(exc, "tqdyn_checkpoint", None)
+        if not ckpt:
+            return "no output file written"
+        if isinstance(exc, io.OutputIOError):
+            return f"the checkpoint {ckpt} is kept: free space, then continue with the same command and --resume"
+        return f"continue with the same command and --resume (checkpoint {ckpt})"
+
+    with guarded(note, cleanup=close_bar, deferred=True):
+        try:
             summary = runner.run_to_file(scen, model=model, progress=progress,
                                          checkpoint_every=checkpoint_every if fixed else 0, resume=resume,
                                          checkpoint_interval_s=interval_s if fixed else 0.0)
-    except io.OutputIOError as exc:
-        if state["bar"] is not None:
-            state["bar"].close()
-        ckpt = getattr(exc, "tqdyn_checkpoint", None)
-        _fail_io(f"{exc}; " + (f"the checkpoint {ckpt} is kept: free space, then continue with the same "
-                               f"command and --resume" if ckpt else "no output file written"))
-    except (ValueError, io.OutputError) as exc:
-        if state["bar"] is not None:
-            state["bar"].close()
-        if hasattr(exc, "tqdyn_checkpoint") and not isinstance(exc, io.OutputError):
-            raise  # a failure inside the propagation, not bad input
-        _fail(str(exc))
-    except KeyboardInterrupt as exc:
-        if state["bar"] is not None:
-            state["bar"].close()
-        ckpt = getattr(exc, "tqdyn_checkpoint", None)
-        what, status = ((f"stopped by {signal.Signals(exc.signum).name}", _SIGNAL_EXIT[exc.signum])
-                        if isinstance(exc, _Stopped) else ("interrupted", _EXIT_INTERRUPTED))
-        _fail(f"{what}; continue with the same command and --resume (checkpoint {ckpt})"
-              if ckpt else f"{what}; no output file written", status)
-    if state["bar"] is not None:
-        state["bar"].close()
+        except io.OutputIOError:
+            raise
+        except (ValueError, io.OutputError) as exc:
+            close_bar()
+            if isinstance(exc, dynamics.NonFiniteStateError):
+                _fail(f"{exc}; no output file written")
+            if hasattr(exc, "tqdyn_checkpoint") and not isinstance(exc, io.OutputError):
+                raise  # a failure inside the propagation, not bad input
+            _fail(str(exc))
+    close_bar()
     result = summary.result
     lines = [
         f"steps: {result.n_steps} accepted" + (f", {result.n_rejected} rejected" if not fixed else "")

@@ -18,8 +18,8 @@ import sys
 import click
 
 from .._version import __version__
-from ._common import EXIT_FAILED as _EXIT_MEMBER_FAILED, EXIT_INTERRUPTED as _EXIT_INTERRUPTED
-from ._common import fail as _fail
+from ._common import EXIT_FAILED as _EXIT_MEMBER_FAILED
+from ._common import fail as _fail, guarded
 
 __all__ = ["sweep"]
 
@@ -152,16 +152,10 @@ def sweep(sweep_file, scheduler, workers, dashboard, tls_ca_file, tls_cert, tls_
     options = {"dashboard": dash, "security": security}
     if connect_timeout is not None:
         options["timeout"] = connect_timeout
-    try:
+    with guarded(lambda exc: "the members that finished are kept and skipped when the sweep is run again",
+                 bad_input=(ValueError, FileNotFoundError, ImportError), cleanup=close_bar):
         result = sw.run_sweep(plan, scheduler=scheduler, n_workers=workers, progress=progress, started=started,
                               **options)
-    except KeyboardInterrupt:
-        close_bar()
-        _fail("interrupted; the members that finished are kept and skipped when the sweep is run again",
-              _EXIT_INTERRUPTED)
-    except (ValueError, FileNotFoundError, ImportError) as exc:
-        close_bar()
-        _fail(str(exc))
     close_bar()
     failures = result.failures
     rerun = result.rerun

@@ -24,7 +24,7 @@ import numpy as np
 
 from .loop import SOURCES, ClosedLoop, output_names, source_inputs
 
-__all__ = ["DesignError", "LoopMargins", "check_stable", "closed_loop_response", "frequency_response", "loop_gains",
+__all__ = ["DesignError", "LoopMargins", "check_stable", "closed_loop_response", "frequency_response", "grid_margins", "loop_gains",
            "loop_margins", "noise_budget", "dominant_sources"]
 
 #: Frequencies per batched solve of :func:`frequency_response` (bounds the memory: n_f x n_state^2 complex).
@@ -220,6 +220,64 @@ def check_stable(cl: ClosedLoop, tol: float = 1e-9) -> None:
     worst = min(ms, key=lambda m: (m.phase_margin if math.isfinite(m.phase_margin) else -1e9))
     loop = worst.channel.split("[")[0]
     raise DesignError(f"closed_loop.controllers.{loop}",
-                      f"the closed loop is unstable (pole at Re = {np.max(ev.real):.3g} 1/s; channel {worst.channel}: "
-                      f"phase margin {worst.phase_margin:.3g} deg, gain margin {worst.gain_margin:.3g}); "
-                      "allowed: a stabilising design (docs/closed-loop.md)")
+                      f"the closed loop is unstable (pole Re = {np.max(ev.real):.3g} 1/s; {worst.channel}: "
+                      f"phase margin {worst.phase_margin:.3g} deg" + (f", gain margin {worst.gain_margin:.3g}"
+                                                                      if math.isfinite(worst.gain_margin) else "")
+                      + "); allowed: a stabilising design (docs/closed-loop.md)")
+
+
+def _first_min_per_row(rows, key, n_rows):
+    """For each row r < ``n_rows``: the position (into ``rows``/``key``) of the smallest key, the first of equals
+    (-1 for a row without entries)."""
+    out = np.full(n_rows, -1)
+    if len(rows):
+        order = np.lexsort((np.arange(len(rows)), key, rows))
+        first = np.r_[True, rows[order][1:] != rows[order][:-1]]
+        out[rows[order][first]] = order[first]
+    return out
+
+
+def grid_margins(L, f) -> dict:
+    """Margins of loop gains ``L`` (..., n) given on the increasing grid ``f`` (n,) [Hz], for every leading index
+    at once, with python-control's ``stability_margins`` conventions (FRD: a phase crossover where arg(-L) changes
+    sign with Re L <= 0 at the interval's left end; a gain crossover where |L| - 1 changes sign), each crossover
+    located by linear interpolation in log f of arg(-L) (resp. log|L|), the gain |L| and phase there likewise.
+    Returns arrays of shape L.shape[:-1]: ``gain_margin`` (the one closest to 1 in dB, python-control's choice;
+    inf: none) and ``f_gain_margin`` [Hz]; ``gain_margin_lower`` (the largest margin below 1: the gain may fall
+    by that factor; 0: none) and ``gain_margin_upper`` (the smallest above 1; inf: none), the gain interval
+    around 1 in which the loop stays stable; ``phase_margin`` [deg] (smallest in magnitude; inf: none) and
+    ``crossover`` [Hz] (nan: none)."""
+    L = np.asarray(L)
+    shape = L.shape[:-1]
+    L2 = L.reshape(-1, L.shape[-1])
+    R = L2.shape[0]
+    x = np.log(np.asarray(f, dtype=np.float64))
+    ang = np.angle(-L2)
+    lmag = np.log(np.abs(L2))
+    out = {}
+    # phase crossovers
+    r, i = np.nonzero((np.diff(np.sign(ang), axis=1) != 0) & (L2[:, :-1].real <= 0))
+    t = ang[r, i] / (ang[r, i] - ang[r, i + 1])
+    x180 = x[i] + t * (x[i + 1] - x[i])
+    gm = np.exp(-(lmag[r, i] + t * (lmag[r, i + 1] - lmag[r, i])))
+    with np.errstate(divide="ignore"):
+        k = _first_min_per_row(r, np.abs(np.log(gm)), R)
+    gm_, x180_ = np.r_[gm, math.inf], np.r_[x180, math.nan]     # index -1: none
+    out["gain_margin"] = gm_[k]
+    out["f_gain_margin"] = np.exp(x180_[k])
+    low = np.zeros(R)
+    up = np.full(R, math.inf)
+    np.maximum.at(low, r[gm < 1], gm[gm < 1])
+    np.minimum.at(up, r[gm > 1], gm[gm > 1])
+    out["gain_margin_lower"], out["gain_margin_upper"] = low, up
+    # gain crossovers
+    r, i = np.nonzero(np.diff(np.sign(lmag), axis=1) != 0)
+    t = lmag[r, i] / (lmag[r, i] - lmag[r, i + 1])
+    xc = x[i] + t * (x[i + 1] - x[i])
+    ph0 = np.angle(L2[r, i])
+    dph = np.angle(L2[r, i + 1] / L2[r, i])                     # the phase step, unwrapped
+    pm = np.remainder(np.degrees(ph0 + t * dph), 360.0) - 180.0
+    k = _first_min_per_row(r, np.abs(pm), R)
+    out["phase_margin"] = np.r_[pm, math.inf][k]
+    out["crossover"] = np.exp(np.r_[xc, math.nan][k])
+    return {key: v.reshape(shape) for key, v in out.items()}

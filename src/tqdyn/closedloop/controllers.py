@@ -30,7 +30,7 @@ import numpy as np
 from ..scenario.closed_loop import LOOPS, check_controller
 from ..scenario.values import ScenarioError
 
-__all__ = ["Controller", "ControllerError", "LOOPS", "lead_lag_pid"]
+__all__ = ["Controller", "ControllerError", "LOOPS", "lead_lag_pid", "pi_controller"]
 
 #: Invalid controllers raise the scenario's one-line error naming the key.
 ControllerError = ScenarioError
@@ -62,3 +62,13 @@ def lead_lag_pid(f_c: float, alpha: float = 10.0, integrator_ratio: float = 10.0
     s = 1j * wc
     mag = abs((s + wz) * (s + wi) / (s * (s + wp))) / wc ** 2
     return Controller(zeros=(-wz, -wi), poles=(0.0, -wp), gain=1.0 / mag, name=name)
+
+
+def pi_controller(f_c: float, integrator_ratio: float = 10.0, name: str = "controller") -> Controller:
+    """A proportional-integral design for a flat plant (a loop closed on a measured acceleration, e.g. the
+    drag-free loop of an accelerometer): C(s) = k (s + w_c/r)/s with |C(i w_c)| = 1 at the crossover f_c
+    [Hz] (k = 1/sqrt(1 + 1/r^2), dimensionless); below w_c/r the loop gain rises as 1/f, so the
+    sensitivity falls as f: |S| ~ r f / f_c there (phase margin 90 deg - atan(1/r))."""
+    wc = 2 * math.pi * f_c
+    wi = wc / integrator_ratio
+    return Controller(zeros=(-wi,), poles=(0.0,), gain=1.0 / math.sqrt(1.0 + 1.0 / integrator_ratio ** 2), name=name)

@@ -1,4 +1,5 @@
-"""Default closed-loop parameters, noise models and controllers of TianQin, LISA and Taiji.
+"""Default closed-loop parameters, noise models and controllers of TianQin, LISA and Taiji, and (through
+:mod:`tqdyn.closedloop.flown`) of the single-spacecraft missions LISA Pathfinder (``lpf``) and TianQin-1.
 
 Every number has its source in src/tqdyn/data/SOURCES.md (section "Closed-loop defaults"); the ones
 marked *assumption* are tqdyn's choices where no public document gives a value, stated with the
@@ -11,13 +12,19 @@ import math
 
 import numpy as np
 
-from ..scenario.closed_loop import MISSIONS, PLANT_KEYS
+from .._choices import unknown
+
+from ..scenario.closed_loop import (CONSTELLATION_MISSIONS, MISSIONS, PLANT_KEYS, SCHEME_LOOPS,
+                                    SINGLE_SPACECRAFT_MISSIONS)
 from .controllers import Controller, lead_lag_pid
+from .flown import (flown_controllers, flown_noise, flown_plant, flown_plant_parameters, flown_requirement,
+                    flown_working_point)
 from .noise import AsdModel
 from .plant import PlantParameters, WorkingPoint, plant_parameters
 
-__all__ = ["MISSIONS", "controller_from_keys", "default_controllers", "default_noise", "default_plant",
-           "representative_plant", "representative_working_point", "requirement", "resolve"]
+__all__ = ["CONSTELLATION_MISSIONS", "MISSIONS", "SINGLE_SPACECRAFT_MISSIONS", "controller_from_keys",
+           "default_controllers", "default_noise", "default_plant", "representative_plant",
+           "representative_working_point", "requirement", "resolve"]
 
 
 #: Plant defaults per mission (scenario keys of [closed_loop.plant]).
@@ -41,21 +48,27 @@ CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitu
 
 def _check(mission: str) -> None:
     if mission not in MISSIONS:
-        raise ValueError(f"closed_loop.mission: {mission!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+        raise ValueError(unknown("closed_loop.mission", mission, MISSIONS, problem="is not a mission"))
 
 
 def default_plant(mission: str) -> dict:
     """The [closed_loop.plant] defaults of ``mission`` (keys of :class:`tqdyn.closedloop.plant.PlantParameters`
-    that are not geometry): masses [kg], inertias [kg m^2], tm_side [m], stiffness [s^-2], crosstalk [1]."""
+    that are not geometry): masses [kg], inertias [kg m^2], tm_side [m], stiffness [s^-2], crosstalk [1]; the
+    single-spacecraft missions also tm2_stiffness [s^-2] and tm_separation [m] (their geometry)."""
     _check(mission)
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_plant(mission)
     return {**_COMMON_PLANT, **_PLANT[mission]}
 
 
 def requirement(mission: str) -> AsdModel:
     """The mission's TM acceleration-noise requirement [m/s^2/Hz^1/2] (one-sided):
     TianQin 1e-15 sqrt(1 + 0.1 mHz/f); LISA 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4);
-    Taiji 3e-15 with LISA's knees."""
+    Taiji 3e-15 with LISA's knees; LISA Pathfinder's on Delta g and TianQin-1's (none):
+    :func:`tqdyn.closedloop.flown.flown_requirement`."""
     _check(mission)
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_requirement(mission)
     if mission == "tianqin":
         return AsdModel(1e-15, ((1e-4, -0.5),), "m/s^2", "requirement")
     return AsdModel(3e-15, ((4e-4, -1.0), (8e-3, 2.0)), "m/s^2", "requirement")
@@ -64,6 +77,8 @@ def requirement(mission: str) -> AsdModel:
 def default_noise(mission: str) -> dict:
     """{source: AsdModel} defaults of ``mission`` (one-sided ASDs; units of :data:`tqdyn.closedloop.loop.SOURCES`)."""
     _check(mission)
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_noise(mission)
     req = requirement(mission)
     a = _PLANT[mission]["tm_side"]
 
@@ -92,9 +107,12 @@ def default_noise(mission: str) -> dict:
 
 def default_controllers(mission: str) -> dict:
     """{loop: Controller}: :func:`tqdyn.closedloop.controllers.lead_lag_pid` at :data:`CROSSOVER_HZ`
-    (the same crossovers for the three missions; the plants differ in masses and inertias only by
-    the actuator conversion, which the controllers' acceleration commands absorb)."""
+    (the same crossovers for the three constellation missions; the plants differ in masses and inertias only
+    by the actuator conversion, which the controllers' acceleration commands absorb); the single-spacecraft
+    missions' loops: :func:`tqdyn.closedloop.flown.flown_controllers`."""
     _check(mission)
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_controllers(mission)
     return {loop: lead_lag_pid(f, name=loop) for loop, f in CROSSOVER_HZ.items()}
 
 
@@ -110,13 +128,23 @@ def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
     """(mission, plant dict, {loop: Controller}, {source: AsdModel}) of a
     :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` over the mission's defaults (the mission:
     ``closed_loop.mission`` or the spacecraft ``architecture``); a given noise ``level`` or ``knees``
-    replaces that part of the default."""
+    replaces that part of the default.  A ``closed_loop.scheme`` other than the mission's takes the
+    project's lead-lag design for its loops (:data:`CROSSOVER_HZ`; 20 mHz for a loop it does not name).
+    ValueError (one line) for ``tm_separation`` on a constellation mission."""
     mission = config.mission(architecture)
     raw = config.raw or {}
     plant = default_plant(mission)
     for k, v in raw.get("plant", {}).items():
+        if k == "tm_separation" and mission not in SINGLE_SPACECRAFT_MISSIONS:
+            raise ValueError(f"closed_loop.plant.tm_separation: {v!r} is not allowed for {mission!r}; allowed: "
+                             f"the single-spacecraft missions ({', '.join(SINGLE_SPACECRAFT_MISSIONS)}) only (a "
+                             "run's geometry comes from its spacecraft)")
         plant[k] = float(v) if PLANT_KEYS[k] == 1 else tuple(float(x) for x in v)
+    scheme = config.scheme(architecture)
     ctl = default_controllers(mission)
+    if set(ctl) != set(SCHEME_LOOPS[scheme]):       # another scheme than the mission's: its loops' defaults
+        ctl = {loop: lead_lag_pid(CROSSOVER_HZ.get(loop, CROSSOVER_HZ["attitude"]), name=loop)
+               for loop in SCHEME_LOOPS[scheme]}
     for loop, spec in raw.get("controllers", {}).items():
         ctl[loop] = controller_from_keys(loop, spec["zeros"], spec["poles"], float(spec["gain"]))
     noise = default_noise(mission)
@@ -133,11 +161,15 @@ def representative_working_point(mission: str, self_gravity=None) -> WorkingPoin
     (TianQin: GM_E/r^3 at r = 1e8 m; LISA/Taiji: GM_S/(1 au)^3) in a frame turning at the orbital rate
     about Z_S, theta = 60 deg, DC suspension from the self-gravity (default Table IV; the nominal
     scheme puts the differences dg_y, dg_z on the TMs: A_1 = -A_2 = (0, dg_y/(2 cos 30), dg_z/2)
-    along Y_OA, Z), no drag-free DC acceleration along the sensitive axes.  SI units, S / OA_l frames."""
+    along Y_OA, Z), no drag-free DC acceleration along the sensitive axes.  SI units, S / OA_l frames.
+    The single-spacecraft missions: :func:`tqdyn.closedloop.flown.flown_working_point` (``self_gravity``
+    unused)."""
     from ..constellation.control import dragfree_general, oa_rotation
     from ..constellation.spacecraft import TABLE_IV_SELF_GRAVITY
 
     _check(mission)
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_working_point(mission)
     gm, r = (3.986004415e14, 1e8) if mission == "tianqin" else (1.32712440041e20, 1.495978707e11)
     n2 = gm / r ** 3
     sg = TABLE_IV_SELF_GRAVITY if self_gravity is None else np.asarray(self_gravity)
@@ -152,7 +184,10 @@ def representative_working_point(mission: str, self_gravity=None) -> WorkingPoin
 def representative_plant(mission: str, **over) -> PlantParameters:
     """The :class:`~tqdyn.closedloop.plant.PlantParameters` of ``mission``'s preset spacecraft at theta =
     60 deg with the mission's default plant values, ``over`` replacing some of them (keys of
-    :func:`default_plant`, e.g. ``crosstalk=0.0``)."""
+    :func:`default_plant`, e.g. ``crosstalk=0.0``); a single-spacecraft mission's own geometry
+    (:func:`tqdyn.closedloop.flown.flown_plant_parameters`)."""
     from ..constellation.spacecraft import Spacecraft
 
+    if mission in SINGLE_SPACECRAFT_MISSIONS:
+        return flown_plant_parameters(mission, {**default_plant(mission), **over})
     return plant_parameters({**default_plant(mission), **over}, Spacecraft.preset(mission), math.pi / 3)

@@ -20,11 +20,13 @@ import numpy as np
 
 from .budget import check_stable
 from .loop import build_closed_loop
+from .frequency import STACKED_SCHEMES, closed_loop_matrices, closed_loops, stack_loops, unstable_loops
 from .missions import resolve
 from .plant import plant_parameters
 from .working_point import segment_rows, third_body_positions, working_points
 
-__all__ = ["REQUIRED_FIELDS", "ClosedLoopError", "ClosedLoopModel", "closed_loop_model", "run_scenario"]
+__all__ = ["REQUIRED_FIELDS", "ClosedLoopError", "ClosedLoopModel", "closed_loop_model", "run_scenario",
+           "static_closed_loop_model"]
 
 #: Fields of a trajectory that the model reads (a coupled run: attitude, MOSAs, test masses, control).
 REQUIRED_FIELDS = ("sat/T_S_I", "sat/omega", "sat/omega_dot", "mosa/angle", "tm/a_suspension", "tm/alpha_suspension",
@@ -42,10 +44,13 @@ class ClosedLoopModel:
     loops : list over satellites of lists of (t_start [s], ClosedLoop), one per segment.
     noise : {source: AsdModel}; mission : str; settings : dict
     (:meth:`tqdyn.scenario.closed_loop.ClosedLoopConfig.settings`: fs [Hz], duration [s] or None, seed,
-    segment [s], f_min, f_max [Hz], n_freq, attitude_z_sensor); satellite_names : tuple; t_span : (t0, t1) [s].
+    segment [s], f_min, f_max [Hz], n_freq, attitude_z_sensor, scheme (resolved)); satellite_names : tuple;
+    t_span : (t0, t1) [s].
     parts : list over satellites of lists (one per segment, as ``loops``) of (PlantParameters,
     WorkingPoint) the loops were built from; controllers : {loop: Controller} (to rebuild a loop with
-    changed parameters, e.g. without cross-talk).
+    changed parameters, e.g. without cross-talk); stack : the loops' blocks
+    (:class:`tqdyn.closedloop.frequency.LoopStack`, satellite-major: loop ``loops[i][k]`` is entry
+    i n_segment + k) for the frequency domain, or None.
     """
 
     loops: list
@@ -56,6 +61,7 @@ class ClosedLoopModel:
     t_span: tuple
     parts: list = field(default_factory=list)
     controllers: dict = field(default_factory=dict)
+    stack: object = None
 
 
 def _where(traj) -> str:
@@ -107,24 +113,49 @@ def _craft(sc):
                       theta_nominal=sc.theta_nominal)
 
 
-def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_sensor: str, validate: bool):
-    """(loops, parts) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments ``rows``."""
-    n_sat = len(wps[0])
-    loops = [[] for _ in range(n_sat)]
+def _build(p, wp, controllers: dict, attitude_z_sensor: str, scheme: str, validate: bool):
+    try:
+        cl = build_closed_loop(p, wp, controllers, attitude_z_sensor, scheme)
+    except ValueError as exc:
+        raise ClosedLoopError(str(exc)) from None
+    if validate:
+        check_stable(cl)
+    return cl
+
+
+def _assemble(parts, controllers: dict, attitude_z_sensor: str, scheme: str, validate: bool):
+    """(closed loops, stack) of the (PlantParameters, WorkingPoint) ``parts``: every loop built at once
+    (:mod:`tqdyn.closedloop.frequency`) for the schemes it stacks (:data:`~tqdyn.closedloop.frequency.
+    STACKED_SCHEMES`), the unstable ones refused; otherwise ("single_tm", whose drag-free error is a
+    controller's output) one loop at a time with stack None (the budget then takes the per-loop path)."""
+    if scheme not in STACKED_SCHEMES:
+        return [_build(p, wp, controllers, attitude_z_sensor, scheme, validate) for p, wp in parts], None
+    try:
+        st = stack_loops(parts, controllers, attitude_z_sensor, scheme)
+    except ValueError as exc:
+        raise ClosedLoopError(str(exc)) from None
+    mats = closed_loop_matrices(st)
+    cls = closed_loops(st, mats)
+    if validate:
+        for j in unstable_loops(mats[0], cls[0].system.state_labels):
+            check_stable(cls[j])                   # DesignError naming the loop and its margins
+    return cls, st
+
+
+def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_sensor: str, validate: bool,
+           scheme: str = "constellation"):
+    """(loops, parts, stack) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments
+    ``rows`` (:func:`_assemble`)."""
+    n_sat, n_seg = len(wps[0]), len(rows)
     parts = [[] for _ in range(n_sat)]
-    for k, (a, _b, _m) in enumerate(rows):
+    for k in range(n_seg):
         for i in range(n_sat):
             wp = wps[k][i]
-            p = plant_parameters(plant, craft, wp.theta)
-            try:
-                cl = build_closed_loop(p, wp, controllers, attitude_z_sensor)
-            except ValueError as exc:
-                raise ClosedLoopError(str(exc)) from None
-            if validate:
-                check_stable(cl)
-            loops[i].append((float(t[a]), cl))
-            parts[i].append((p, wp))
-    return loops, parts
+            parts[i].append((plant_parameters(plant, craft, wp.theta), wp))
+    cls, st = _assemble([pw for per_sat in parts for pw in per_sat], controllers, attitude_z_sensor, scheme,
+                        validate)
+    loops = [[(float(t[rows[k][0]]), cls[i * n_seg + k]) for k in range(n_seg)] for i in range(n_sat)]
+    return loops, parts, st
 
 
 def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopModel:
@@ -147,8 +178,11 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
         raise ClosedLoopError(f"trajectory: {len(t)} row(s); allowed: a run of at least 2 rows")
     scen = run_scenario(traj)
     cfg = scen.closed_loop if config is None else config
-    settings = cfg.settings()
-    mission, plant, ctl, noise = resolve(cfg, traj.spacecraft.architecture)
+    settings = {**cfg.settings(), "scheme": cfg.scheme(traj.spacecraft.architecture)}
+    try:
+        mission, plant, ctl, noise = resolve(cfg, traj.spacecraft.architecture)
+    except ValueError as exc:
+        raise ClosedLoopError(str(exc)) from None
     rows = segment_rows(t, settings["segment"])
     mids = [m for _a, _b, m in rows]
     central_gm, pos, gms = _gravity(scen, t[mids])       # gravity gradient: central body + third bodies
@@ -156,8 +190,42 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
     wps = working_points(t[mids], traj["sat/r"][mids], traj["sat/T_S_I"][mids], traj["sat/omega"][mids],
                          traj["sat/omega_dot"][mids], traj["mosa/angle"][mids], traj["tm/a_suspension"][mids],
                          traj["tm/alpha_suspension"][mids], traj["sat/a_dragfree"][mids], sg, central_gm, pos, gms)
-    loops, parts = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl, settings["attitude_z_sensor"], validate)
+    loops, parts, stack = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl, settings["attitude_z_sensor"],
+                                 validate, cfg.scheme(traj.spacecraft.architecture))
     names = tuple(getattr(traj, "satellite_names", ())) or tuple(f"Sat{i + 1}" for i in range(len(loops)))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,
                            satellite_names=names, t_span=(float(t[0]), float(t[-1])), parts=parts,
-                           controllers=dict(ctl))
+                           controllers=dict(ctl), stack=stack)
+
+
+def static_closed_loop_model(config=None, validate: bool = True) -> ClosedLoopModel:
+    """The closed loop of a mission at its documented static working point, without a run: one spacecraft,
+    one segment starting at t = 0 (docs/closed-loop.md).
+
+    config : :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` (``closed_loop.mission`` required, e.g.
+        ``tqdyn.scenario.closed_loop_config({"mission": "lpf"})``) or a mission name.
+    The working point: :func:`tqdyn.closedloop.missions.representative_working_point` (the constellation
+    missions' first-principles point; LISA Pathfinder's and TianQin-1's, :mod:`tqdyn.closedloop.flown`), the
+    plant :func:`~tqdyn.closedloop.missions.representative_plant` with the configuration's plant values.
+    ``t_span`` (0, ``closed_loop.duration`` or ``closed_loop.segment``) [s].  ClosedLoopError (one line naming
+    the key) for a configuration without a mission, a geometry the scheme cannot control or an unstable design.
+    """
+    from ..scenario.closed_loop import ClosedLoopConfig
+    from .missions import representative_plant, representative_working_point
+
+    cfg = ClosedLoopConfig(raw={"mission": config}) if isinstance(config, str) else config
+    if cfg is None or "mission" not in (cfg.raw or {}):
+        raise ClosedLoopError("closed_loop.mission: missing; allowed: a mission (the static working point of a "
+                              "mission needs one: tqdyn closed-loop --mission NAME)")
+    settings = {**cfg.settings(), "scheme": cfg.scheme()}
+    try:
+        mission, plant, ctl, noise = resolve(cfg, str(cfg.raw["mission"]))
+    except ValueError as exc:
+        raise ClosedLoopError(str(exc)) from None
+    p = representative_plant(mission, **plant)
+    wp = representative_working_point(mission)
+    (cl,), stack = _assemble([(p, wp)], ctl, settings["attitude_z_sensor"], settings["scheme"], validate)
+    span = float(settings["duration"] or settings["segment"])
+    return ClosedLoopModel(loops=[[(0.0, cl)]], noise=noise, mission=mission, settings=settings,
+                           satellite_names=(mission,), t_span=(0.0, span), parts=[[(p, wp)]], controllers=dict(ctl),
+                           stack=stack)

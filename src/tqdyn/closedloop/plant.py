@@ -33,7 +33,8 @@ import numpy as np
 
 from ..constellation.control import oa_rotation
 
-__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "plant_parameters", "sensitive_basis"]
+__all__ = ["PlantParameters", "WorkingPoint", "dof_names", "linear_plant", "plant_matrices", "plant_parameters",
+           "sensitive_basis", "tm_stiffness"]
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -56,6 +57,11 @@ class PlantParameters:
     cross-talk, the fraction of a force (torque) commanded on one axis of a TM that appears on each
     other axis of the same TM; housing_centers (2, 3) [m, S], lever_arms (2, 3) [m, S] (EH centre
     minus MOSA pivot) and sensitive_axes (2, 3) [unit, OA_l] from the trajectory's spacecraft.
+    n_tm : 2, or 1 for a spacecraft with one TM (TianQin-1: TM 2's coordinates are then placeholders);
+    mosa : True for housings on articulated MOSAs, False for housings fixed in the body (a single
+    spacecraft: LISA Pathfinder, TianQin-1; the MOSA angles are then placeholders).  A placeholder
+    coordinate is decoupled from everything, unexcited and damped (q'' = -q' - q per 1 s^2, poles at
+    -0.5 +- 0.87i rad/s), so that every plant has the same coordinates and named outputs (zero there).
     """
 
     sc_mass: float
@@ -70,6 +76,8 @@ class PlantParameters:
     housing_centers: np.ndarray
     lever_arms: np.ndarray
     sensitive_axes: np.ndarray
+    n_tm: int = 2
+    mosa: bool = True
 
     @property
     def tm_inertia(self) -> float:
@@ -104,14 +112,19 @@ class WorkingPoint:
 def plant_parameters(plant: dict, craft, theta: float) -> PlantParameters:
     """The :class:`PlantParameters` of a spacecraft from the ``[closed_loop.plant]`` values ``plant`` (the
     keys of :data:`tqdyn.scenario.closed_loop.PLANT_KEYS`, e.g. :func:`tqdyn.closedloop.missions.default_plant`;
-    the per-axis stiffnesses the same for both TMs) and the geometry of ``craft``
-    (:class:`tqdyn.constellation.spacecraft.Spacecraft`) at the opening angle ``theta`` [rad]."""
+    the per-axis stiffnesses ``stiffness`` of both TMs unless ``tm2_stiffness`` gives TM 2's) and the geometry
+    of ``craft`` (:class:`tqdyn.constellation.spacecraft.Spacecraft`) at the opening angle ``theta`` [rad]."""
     return PlantParameters(sc_mass=plant["sc_mass"], sc_inertia=plant["sc_inertia"], tm_mass=plant["tm_mass"],
                            tm_side=plant["tm_side"], mosa_inertia=plant["mosa_inertia"],
-                           mosa_stiffness=plant["mosa_stiffness"], stiffness=np.tile(plant["stiffness"], (2, 1)),
-                           rotational_stiffness=np.tile(plant["rotational_stiffness"], (2, 1)),
+                           mosa_stiffness=plant["mosa_stiffness"], stiffness=tm_stiffness(plant),
+                           rotational_stiffness=tm_stiffness(plant, "rotational_stiffness"),
                            crosstalk=plant["crosstalk"], housing_centers=craft.housing_centers(theta),
                            lever_arms=craft.lever_arms(theta), sensitive_axes=craft.sensitive_axes_array)
+
+
+def tm_stiffness(plant: dict, key: str = "stiffness") -> np.ndarray:
+    """(2, 3) [s^-2]: ``plant[key]`` for TM 1 and ``plant["tm2_" + key]`` (default the same) for TM 2."""
+    return np.array([plant[key], plant.get(f"tm2_{key}", plant[key])], dtype=np.float64)
 
 
 def dof_names() -> list[str]:
@@ -201,11 +214,11 @@ class _Equations:
         half = 0.5 * wp.theta_dot
         rh = np.asarray(p.housing_centers, dtype=np.float64)[l]
         rho = np.asarray(p.lever_arms, dtype=np.float64)[l]
-        rh_dot = np.cross((1.0, -1.0)[l] * half * Z, rho)                 # w_oa x rho
+        rh_dot = np.cross((1.0, -1.0)[l] * half * Z, rho) if p.mosa else np.zeros(3)   # w_oa x rho
         Rl, kx, kr = R[l], np.diag(p.stiffness[l]), np.diag(p.rotational_stiffness[l])
         xs, es = slice(_IX[l], _IX[l] + 3), slice(_IETA[l], _IETA[l] + 3)
         th = _ITH + l
-        c = np.cross(Z, rho)                                  # d r_h / d dth_l (S)
+        c = np.cross(Z, rho) if p.mosa else np.zeros(3)      # d r_h / d dth_l (S); fixed housings: none
         col = self.col
         F = col["F[0]"]
         fcol, tcol, acol, bcol = col[f"f{l + 1}[0]"], col[f"t{l + 1}[0]"], col[f"a{l + 1}[0]"], col[f"b{l + 1}[0]"]
@@ -243,13 +256,14 @@ class _Equations:
         Wt = Rl.T @ (wp.omega + np.array([0.0, 0.0, (1 if l == 0 else -1) * half]))
         Sw, Swd = _skew(Wt), _skew(wp.alpha_suspension[l])
         M[es, 3:6] = Rl.T
-        M[es, th] = Rl.T @ Z
+        zm = Z if p.mosa else np.zeros(3)                      # the housing turns with its MOSA (if any)
+        M[es, th] = Rl.T @ zm
         D[es, es] = Sw
         D[es, 3:6] = Sw @ Rl.T
-        D[es, th] = Sw @ Rl.T @ Z
+        D[es, th] = Sw @ Rl.T @ zm
         K[es, es] = Swd + kr
         K[es, 3:6] = Swd @ Rl.T
-        K[es, th] = Swd @ Rl.T @ Z
+        K[es, th] = Swd @ Rl.T @ zm
         B[es, tcol:tcol + 3] = X / Itm
         B[es, bcol:bcol + 3] = np.eye(3)
         # --- MOSA: Im (Z . (phi'' + W' phi + W phi') + dth'') + k dth = tau  (reaction -tau Z on the spacecraft)
@@ -259,6 +273,23 @@ class _Equations:
         K[th, th] = p.mosa_stiffness / Im
         B[th, col[f"tm[{l}]"]] = 1.0 / Im
         B[3:6, col[f"tm[{l}]"]] = -Jinv @ Z
+
+    def placeholders(self) -> None:
+        """Absent coordinates (:class:`PlantParameters`: TM 2 of a single-TM spacecraft, the MOSA angles of
+        fixed housings): decoupled, unexcited, damped (q'' + q' + q = 0)."""
+        idx = []
+        if self.p.n_tm == 1:
+            idx += list(range(_IX[1], _IX[1] + 3)) + list(range(_IETA[1], _IETA[1] + 3)) + [_ITH + 1]
+        if not self.p.mosa:
+            idx += [_ITH + l for l in range(self.p.n_tm)]
+            for l in range(2):                              # no MOSA actuator: its torque reaches nothing
+                self.B[:, self.col[f"tm[{l}]"]] = 0.0
+        for i in idx:
+            for m in (self.M, self.D, self.K, self.B):
+                m[i, :] = 0.0
+            for m in (self.M, self.D, self.K):
+                m[:, i] = 0.0
+            self.M[i, i] = self.D[i, i] = self.K[i, i] = 1.0
 
     def outputs(self, A, Bs) -> tuple[list, list, list]:
         """(C blocks, D blocks, names) of the outputs: q, the TMs' non-gravitational accelerations (OA_l)
@@ -294,10 +325,19 @@ class _Equations:
 
 def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> control.StateSpace:
     """The linearised plant (module docstring) as a named python-control StateSpace (continuous)."""
+    A, Bs, C, D, inputs, outs, states = plant_matrices(p, wp)
+    return control.ss(A, Bs, C, D, inputs=inputs, outputs=outs, states=states, name=name)
+
+
+def plant_matrices(p: PlantParameters, wp: WorkingPoint) -> tuple:
+    """The linearised plant's (A (40, 40), B (40, 32), C (32, 40), D (32, 32), input names, output names,
+    state names) of :func:`linear_plant`: A = [[0, I], [-M^-1 K, -M^-1 D]], B = [[0], [M^-1 B_q]] (the
+    states [q, q'], SI)."""
     eq = _Equations(p, wp)
     eq.spacecraft()
-    for l in range(2):
+    for l in range(p.n_tm):
         eq.test_mass(l)
+    eq.placeholders()
     n = eq.M.shape[0]
     Minv = np.linalg.inv(eq.M)
     A = np.zeros((2 * n, 2 * n))
@@ -307,4 +347,4 @@ def linear_plant(p: PlantParameters, wp: WorkingPoint, name: str = "plant") -> c
     Bs = np.vstack([np.zeros((n, eq.B.shape[1])), Minv @ eq.B])
     C, Dm, outs = eq.outputs(A, Bs)
     states = dof_names() + [f"d{s}" for s in dof_names()]
-    return control.ss(A, Bs, np.vstack(C), np.vstack(Dm), inputs=eq.inputs, outputs=outs, states=states, name=name)
+    return A, Bs, np.vstack(C), np.vstack(Dm), list(eq.inputs), outs, states

@@ -20,6 +20,8 @@ central differences), ``tm/a_suspension`` and ``tm/alpha_suspension`` (OA_l), ``
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .plant import WorkingPoint
@@ -55,14 +57,18 @@ def third_body_positions(reference, epoch, t, bodies, ephemeris) -> np.ndarray:
 
 
 def segment_rows(t, segment_s: float) -> list[tuple[int, int, int]]:
-    """Split the rows of the run's time axis ``t`` (N,) [s] into segments of ``segment_s`` [s]:
-    (first row, last row + 1, row of the working point (the one nearest the segment's middle))."""
+    """Split the rows of the run's time axis ``t`` (N,) [s] into consecutive segments of ``segment_s`` [s] from
+    t[0]: ceil(span / segment_s) of them (a run of exactly n segments' length gives n; at least one), the last
+    one holding the final row; each (first row, last row + 1, row of the working point (the one nearest the
+    segment's middle))."""
     t = np.asarray(t, dtype=np.float64)
-    edges = np.arange(t[0], t[-1] + 0.5 * segment_s, segment_s)
+    span = float(t[-1] - t[0])
+    n = max(1, math.ceil(span / segment_s - 1e-9))
     out = []
-    for a in edges:
+    for k in range(n):
+        a = t[0] + k * segment_s
         i0 = int(np.searchsorted(t, a - 1e-9))
-        i1 = int(np.searchsorted(t, a + segment_s - 1e-9))
+        i1 = len(t) if k == n - 1 else int(np.searchsorted(t, a + segment_s - 1e-9))
         if i1 <= i0:
             continue
         mid = int(np.argmin(np.abs(t[i0:i1] - (a + 0.5 * segment_s)))) + i0

@@ -116,6 +116,7 @@ from math import atan2, sqrt
 
 from numba import njit
 
+from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..numerics.vec3 import add as _add, axpy as _axpy, cross as _cross, dot as _dot
 from ..numerics.vec3 import row as _row, scale as _scale, sub as _sub
@@ -128,6 +129,7 @@ __all__ = [
     "LAW_TAYLOR1",
     "LAW_TAYLOR2",
     "law_code",
+    "nominal_kinematics",
     "sat_kinematics",
 ]
 
@@ -151,7 +153,7 @@ def law_code(name: str) -> int:
     try:
         return LAW_CODES[name]
     except (KeyError, TypeError):
-        raise ValueError(f"pointing law {name!r} is not allowed; allowed: {', '.join(LAW_CODES)}") from None
+        raise ValueError(unknown("pointing law", name, LAW_CODES)) from None
 
 
 # ------------------------------------------------------------------ jets
@@ -265,14 +267,16 @@ def _beam_iterative(d0, vi, ai, vm, am, jm, sm, c):
 
 
 @njit(cache=True)
-def _beam_jet(law, i, m, r_hi, r_lo, v, a, jm, sm, c):
-    """Beam jet (b, b', b'') of satellite i towards remote satellite m."""
+def _beam_jet(law, jerk_pert, i, m, r_hi, r_lo, v, a, jm, sm, c):
+    """Beam jet (b, b', b'') of satellite i towards remote satellite m
+    (jerk_pert None: the global law, as in :func:`nominal_kinematics`)."""
     d0 = _arm(r_hi, r_lo, i, m)
     vi, ai = _row(v, i), _row(a, i)
     vm, am = _row(v, m), _row(a, m)
-    if law == 3:
-        b, _ = _beam_iterative(d0, vi, ai, vm, am, jm, sm, c)
-        return b
+    if jerk_pert is not None:
+        if law == 3:
+            b, _ = _beam_iterative(d0, vi, ai, vm, am, jm, sm, c)
+            return b
     return _beam_taylor(law, d0, _sub(vm, vi), _sub(am, ai), vm, am, jm, sm, c)
 
 
@@ -333,18 +337,30 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
     iterative law does not converge (non-finite input).
     """
     _check(law, r_hi, r_lo, v, a, T_out, w_out, wd_out, th_out)
+    nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out)
+
+
+@njit(cache=True)
+def nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out):
+    """:func:`sat_kinematics` without its checks of the law code and the
+    shapes, for callers whose arrays and law are fixed by construction (the
+    right-hand side of the coupled system): the checks' error messages
+    would be compiled into every kernel that calls it.  ``jerk_pert`` None
+    stands for the global law (law 0, which needs no jerks): the local laws'
+    code is then left out when the caller is compiled."""
     z = (0.0, 0.0, 0.0)
     j0 = j1 = j2 = s0 = s1 = s2 = z
-    if law != 0:
-        j0, s0 = _monopole_jerk_snap((r_hi[0, 0] + r_lo[0, 0], r_hi[0, 1] + r_lo[0, 1], r_hi[0, 2] + r_lo[0, 2]),
-                                     _row(v, 0), _row(a, 0), gm)
-        j0 = _add(j0, _row(jerk_pert, 0))
-        j1, s1 = _monopole_jerk_snap((r_hi[1, 0] + r_lo[1, 0], r_hi[1, 1] + r_lo[1, 1], r_hi[1, 2] + r_lo[1, 2]),
-                                     _row(v, 1), _row(a, 1), gm)
-        j1 = _add(j1, _row(jerk_pert, 1))
-        j2, s2 = _monopole_jerk_snap((r_hi[2, 0] + r_lo[2, 0], r_hi[2, 1] + r_lo[2, 1], r_hi[2, 2] + r_lo[2, 2]),
-                                     _row(v, 2), _row(a, 2), gm)
-        j2 = _add(j2, _row(jerk_pert, 2))
+    if jerk_pert is not None:  # None: the global law (compiled without the local laws' jerks)
+        if law != 0:
+            j0, s0 = _monopole_jerk_snap((r_hi[0, 0] + r_lo[0, 0], r_hi[0, 1] + r_lo[0, 1], r_hi[0, 2] + r_lo[0, 2]),
+                                         _row(v, 0), _row(a, 0), gm)
+            j0 = _add(j0, _row(jerk_pert, 0))
+            j1, s1 = _monopole_jerk_snap((r_hi[1, 0] + r_lo[1, 0], r_hi[1, 1] + r_lo[1, 1], r_hi[1, 2] + r_lo[1, 2]),
+                                         _row(v, 1), _row(a, 1), gm)
+            j1 = _add(j1, _row(jerk_pert, 1))
+            j2, s2 = _monopole_jerk_snap((r_hi[2, 0] + r_lo[2, 0], r_hi[2, 1] + r_lo[2, 1], r_hi[2, 2] + r_lo[2, 2]),
+                                         _row(v, 2), _row(a, 2), gm)
+            j2 = _add(j2, _row(jerk_pert, 2))
     for i in range(3):
         j = (i + 1) % 3
         k = (i + 2) % 3
@@ -354,8 +370,8 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
             jj, sj, jk, sk = j2, s2, j0, s0
         else:
             jj, sj, jk, sk = j0, s0, j1, s1
-        bj0, bj1, bj2 = _beam_jet(law, i, j, r_hi, r_lo, v, a, jj, sj, c)
-        bk0, bk1, bk2 = _beam_jet(law, i, k, r_hi, r_lo, v, a, jk, sk, c)
+        bj0, bj1, bj2 = _beam_jet(law, jerk_pert, i, j, r_hi, r_lo, v, a, jj, sj, c)
+        bk0, bk1, bk2 = _beam_jet(law, jerk_pert, i, k, r_hi, r_lo, v, a, jk, sk, c)
         X0, X1, X2, _, _, _ = _unit_jet(_add(bj0, bk0), _add(bj1, bk1), _add(bj2, bk2))
         c0, c1, c2 = _cross_jet(bj0, bj1, bj2, bk0, bk1, bk2)
         Z0, Z1, Z2, sn, _, _ = _unit_jet(c0, c1, c2)

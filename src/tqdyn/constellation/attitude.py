@@ -99,6 +99,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from ..astro.constants import C_LIGHT
 from .indices import MOSA_SIGN, PARTNERS, Mosa, Sat
 
@@ -250,7 +251,7 @@ def beam_vectors(r, v=None, a=None, *, law="global", jerk=None, snap=None, c=C_L
         that cannot be formed from the inputs are None.
     """
     if law not in LAWS:
-        raise ValueError(f"unknown pointing law {law!r}; expected one of {LAWS}")
+        raise ValueError(unknown("pointing law", law, LAWS))
     beams = []
     for idx in (_J, _K):
         d = _arm_jet(r, v, a, idx)
@@ -456,7 +457,7 @@ def attitude(r, v=None, a=None, *, law="global", method="direct", jerk=None, sna
     :class:`Attitude` (fields and shapes documented there).
     """
     if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; expected one of {METHODS}")
+        raise ValueError(unknown("method", method, METHODS))
     if method == "p-frame" and law != "global":
         raise ValueError("the p-frame method is defined for the global law only (one common plane)")
     if law != "global" and v is None:

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from ..astro.constants import C_LIGHT
 from .geometry import _f64, arms, by_mosa
 from .indices import EMITTER_OF_MOSA, LINK_OF_MOSA
@@ -108,7 +109,7 @@ def beam_directions(law: str, R, V=None, A=None, *, light_times=None) -> Beams:
     the grid are NaN).  Times are TT.  Returns :class:`Beams` with n (N, 3, 2, 3).
     """
     if law not in LAWS:
-        raise ValueError(f"pointing law {law!r} is not allowed; allowed: {', '.join(LAWS)}")
+        raise ValueError(unknown("pointing law", law, LAWS))
     if law == "iterative":
         if light_times is None:
             raise ValueError("the iterative law needs light_times: tqdyn.lightpath.light_travel_times(t, R, V, A) "

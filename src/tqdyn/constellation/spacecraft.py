@@ -100,13 +100,13 @@ class ArchitectureError(ValueError):
     """An invalid :class:`Spacecraft` field: one line ``Spacecraft.<field> = <value> is invalid; allowed: ...``;
     attributes ``field``, ``value``, ``allowed``."""
 
-    def __init__(self, field_name: str, value, allowed: str):
-        self.field, self.value, self.allowed = field_name, value, allowed
-        super().__init__(f"Spacecraft.{field_name} = {value!r} is invalid; allowed: {allowed}")
+    def __init__(self, field_name: str, value, allowed: str, problem: str = "is invalid"):
+        self.field, self.value, self.allowed, self.problem = field_name, value, allowed, problem
+        super().__init__(f"Spacecraft.{field_name} = {value!r} {problem}; allowed: {allowed}")
 
 
-def _bad(field_name: str, value, allowed: str) -> ValueError:
-    return ArchitectureError(field_name, value, allowed)
+def _bad(field_name: str, value, allowed: str, problem: str = "is invalid") -> ValueError:
+    return ArchitectureError(field_name, value, allowed, problem)
 
 
 def _vectors(value, name: str, unit: bool = False) -> np.ndarray:
@@ -271,21 +271,21 @@ class Spacecraft:
             far = np.linalg.norm(a, axis=-1)
             if np.any(far > self.envelope_radius):
                 l = int(np.argmax(far))
-                raise _bad(name, a.tolist(), f"points within envelope_radius = {self.envelope_radius} m of the CoM "
-                           f"(TM {l + 1}'s is {far[l]:.6g} m away: outside the spacecraft)")
+                raise _bad(name, a.tolist(), f"points within envelope_radius = {self.envelope_radius} m of the CoM",
+                           f"puts TM {l + 1}'s {far[l]:.6g} m from the CoM, outside the spacecraft")
         if np.array_equal(r0[0], r0[1]):
             raise _bad("housing_centers_nominal", r0.tolist(), "two distinct points (one per TM)")
         sens = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]) if self.sensitive_axes is None else \
             np.array(_vectors(self.sensitive_axes, "sensitive_axes", unit=True))
         if self.scheme == "tianqin" and not np.array_equal(sens, [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]):
             raise _bad("sensitive_axes", sens.tolist(),
-                       'X_OA_l ([[1, 0, 0], [1, 0, 0]]) for the "tianqin" drag-free scheme (its closed form); '
-                       'the "lisa" scheme takes any independent axes')
+                       '[[1, 0, 0], [1, 0, 0]], or dragfree = "lisa" (any axes)',
+                       'is not X_OA_l (the "tianqin" drag-free scheme)')
         det = self.axes_determinant(self.theta_nominal, sens)
         if abs(det) < MIN_AXES_DETERMINANT:
             raise _bad("sensitive_axes", sens.tolist(),
-                       f"axes with |e_1 . (e_2 x Z_S)| >= {MIN_AXES_DETERMINANT:g} at theta_nominal (is {abs(det):.3g}: "
-                       "parallel sensitive axes, or both in the plane of Z_S, leave the drag-free control undetermined)")
+                       f">= {MIN_AXES_DETERMINANT:g} (axes neither parallel nor both in the Z_S plane)",
+                       f"leave drag-free undetermined: |e_1 . (e_2 x Z_S)| = {abs(det):.3g}")
         for a in (r0, piv, sens):
             a.setflags(write=False)
         object.__setattr__(self, "_r0", r0)

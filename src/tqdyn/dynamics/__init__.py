@@ -19,10 +19,10 @@ module                   job
 from .initial import initial_state
 from .layout import PRECISIONS
 from .propagation import check_inputs, propagate, two_body_energy, warm_up
-from .results import Checkpoint, Rows, RunResult, row_names
+from .results import Checkpoint, NonFiniteStateError, Rows, RunResult, row_names
 from .rhs import evaluate_rhs
 from .system import System, build_system, self_gravity_oa
 
-__all__ = ["PRECISIONS", "Checkpoint", "Rows", "RunResult", "System", "build_system", "check_inputs",
+__all__ = ["PRECISIONS", "Checkpoint", "NonFiniteStateError", "Rows", "RunResult", "System", "build_system", "check_inputs",
            "evaluate_rhs", "initial_state", "propagate", "row_names", "self_gravity_oa", "two_body_energy",
            "warm_up"]

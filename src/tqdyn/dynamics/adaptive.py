@@ -17,8 +17,8 @@ import numpy as np
 from ..numerics import dp87
 from ..numerics import hermite
 from . import layout as _lay
-from .fixed import DEFAULT_CHUNK, _one_step, _scale_tableau, _workspace
-from .results import RunResult, select_rows, to_dd
+from .fixed import DEFAULT_CHUNK, _scale_tableau, _workspace, chunk_kernel
+from .results import NonFiniteStateError, RunResult, check_finite_states, select_rows, to_dd
 from .rhs import evaluate_rhs
 
 __all__ = ["propagate_adaptive"]
@@ -86,7 +86,9 @@ def propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, prog
     nb = y.shape[0]
     rows: list = []
     cpar = system.cpar
-    gw, fw, aux = _lay.workspace(y)
+    gw, fw, aux = _lay.workspace(y, cpar)
+    kernel = chunk_kernel(fw)  # one step per call: the fixed-step kernel, its rows unused
+    out_y1, out_a1, no_aux = np.empty((1,) + y.shape), np.empty((1, nb, 3) + y.shape[2:]), np.empty((0, _lay.AUX_LEN))
 
     def flush(force=False):
         if sink is not None and rows and (force or len(rows) >= DEFAULT_CHUNK):
@@ -118,10 +120,15 @@ def propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, prog
         he = unit.he * float(h_exact)
         tdat = _node_tdat(model, epoch, [t + ci * h_exact for ci in c_nodes])
         y_try, comp_try = y.copy(), comp.copy()
-        _one_step(y_try, comp_try, K, ystage, err, ha, unit.nz, unit.nnz, hb, unit.nzb, unit.nnzb, he,
-                  tdat, model.params, model.layout, cpar, aux, aux, gw, fw)
+        kernel(y_try, comp_try, K, ystage, err, ha, unit.nz, unit.nnz, hb, unit.nzb, unit.nnzb, he,
+               np.ascontiguousarray(tdat)[None], model.params, model.layout, cpar, aux, gw, fw, 1, out_y1, out_a1,
+               no_aux)
         n_rhs += 13
         norm = dp87.error_norm(y_try, err, rtol)
+        if not (np.isfinite(norm) and np.isfinite(y_try).all()):  # no step size makes it finite: stop here
+            t_try = _dd_of(t + h_exact)
+            check_finite_states(n_acc + 1, np.array([t_try]), y_try[None])
+            raise NonFiniteStateError(n_acc + 1, t_try[0] + t_try[1], int(np.argmax(~np.isfinite(err).all(axis=1))))
         if norm <= 1.0:
             t_new = t + h_exact
             a0 = K[0][:, 3:6].copy()

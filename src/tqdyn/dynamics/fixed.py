@@ -24,12 +24,13 @@ from numba import njit
 
 from ..forces.model import ForceModel
 from ..numerics import dp87
-from ..numerics.dd import add, ld, mul, st
+from ..numerics.dd import add, copy_columns, ld, mul, st
 from . import layout as _lay
-from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import evaluate_rhs, point_mass_system, system_rhs
+from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
+from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
-__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_plan", "deliver_rows", "input_pipeline", "propagate_fixed", "warm_up"]
+__all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_kernel", "chunk_plan", "deliver_rows",
+           "input_pipeline", "propagate_fixed", "warm_up", "warm_up_systems"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -49,40 +50,61 @@ def _workspace(y0_dd, precision):
     return y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros(y.shape[:2])
 
 
-@njit(cache=True)
-def _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout,
+@njit(inline="always")
+def _one_step(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout,
               cpar, aux0, aux, gw, fw):
     """One DP87 step in place: the 13 stages (K[0] = f(y) first, its
     diagnostics into aux0), then the compensated update of y.  tdat_step:
-    (13, n_tdat) time-only inputs at the stage times.  Independent point
-    masses call their right-hand side directly: passing the coupled system's
-    work arrays 13 times per step costs time (their reference counts)."""
-    if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
-        point_mass_system(y, tdat_step[0], params, layout, cpar, K[0])
-        for i in range(1, 13):
-            dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
-            point_mass_system(ystage, tdat_step[i], params, layout, cpar, K[i])
-    else:
-        system_rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
-        for i in range(1, 13):
-            dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
-            system_rhs(ystage, tdat_step[i], params, layout, cpar, K[i], aux, gw, fw)
+    (13, n_tdat) time-only inputs at the stage times; rhs: the system's
+    right-hand side (:func:`tqdyn.dynamics.rhs.coupled_rhs` or
+    :func:`~tqdyn.dynamics.rhs.point_mass_rhs`)."""
+    rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
+    for i in range(1, 13):
+        dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
+        rhs(ystage, tdat_step[i], params, layout, cpar, K[i], aux, gw, fw)
     dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
+
+
+@njit(inline="always")
+def _steps(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
+    for n in range(n_steps):
+        copy_columns(y, out_y[n], 0, 6)
+        aux0 = out_aux[n] if out_aux.shape[0] > 0 else aux
+        _one_step(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout,
+                  cpar, aux0, aux, gw, fw)
+        copy_columns(K[0], out_a[n], 3, 3)
+
+
+# The kernels: one per system, each the loop of _steps compiled with that
+# system's right-hand side (numba inlines _steps and _one_step before typing,
+# so a kernel is one compiled function holding one system; :func:`chunk_kernel`
+# picks the run's).
 
 
 @njit(cache=True, nogil=True)
 def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                  cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
-    """n_steps fixed DP87 steps.  Before step n it records the state y_n in
-    out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s acceleration (stage 1) in
-    out_a[n] (n_body, 3[, 2]) and its diagnostics in out_aux[n] (AUX_LEN,)
-    (if out_aux has rows).  tdat: (n_steps, 13, n_tdat)."""
-    for n in range(n_steps):
-        out_y[n] = y
-        aux0 = out_aux[n] if out_aux.shape[0] > 0 else aux
-        _one_step(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout,
-                  cpar, aux0, aux, gw, fw)
-        out_a[n] = K[0][:, 3:6]
+    """n_steps fixed DP87 steps of the coupled constellation.  Before step n
+    it records the state y_n in out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s
+    acceleration (stage 1) in out_a[n] (n_body, 3[, 2]) and its diagnostics
+    in out_aux[n] (AUX_LEN,) (if out_aux has rows).  tdat: (n_steps, 13, n_tdat)."""
+    _steps(coupled_rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
+
+
+@njit(cache=True, nogil=True)
+def _fixed_chunk_points(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+                        cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
+    """:func:`_fixed_chunk` for independent point masses (fw None)."""
+    _steps(point_mass_rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
+           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
+
+
+def chunk_kernel(fw):
+    """The DP87 kernel of the system whose work arrays ``fw`` are
+    (:func:`tqdyn.dynamics.layout.workspace`: None for point masses)."""
+    return _fixed_chunk_points if fw is None else _fixed_chunk
 
 
 @njit(cache=True)
@@ -108,27 +130,38 @@ def _scale_tableau(a, b, h, ha, hb):
             st(ha, mul(ld(a, i, j), h), i, j)
 
 
-def warm_up(precision: str = "dd") -> None:
-    """Compile the fixed-step kernels for ``precision`` (numba JIT, a few
+def warm_up(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+    """Compile the fixed-step kernel for ``precision`` (numba JIT, a few
     seconds on first use in a process, then cached on disk) so that later
-    timings measure the propagation alone.  One compiled kernel serves the
-    point-mass and the coupled systems."""
+    timings measure the propagation alone.  ``cpar``: the run's system
+    (the ``cpar`` of its :class:`tqdyn.dynamics.system.System`), whose kernel is compiled
+    (each system has its own: independent point masses, the coupled
+    constellation with the global or with a local pointing law); None: the
+    point masses' and the coupled constellation's with the global law."""
     _lay.check_precision(precision)
+    for c in warm_up_systems(cpar):
+        _compile_chunk(precision, c)
+    _grid_times(0, 1, np.array((1.0, 0.0)), np.zeros(13), np.empty((1, 2)), np.empty((0, 13, 2)))
+
+
+def warm_up_systems(cpar: np.ndarray | None) -> tuple:
+    """The system parameters whose kernels :func:`warm_up` compiles for ``cpar``."""
+    if cpar is not None:
+        return (cpar,)
+    return _lay.make_cpar(_lay.MODE_POINT_MASS), _lay.make_cpar(_lay.MODE_COUPLED)
+
+
+def _compile_chunk(precision: str, cpar: np.ndarray) -> None:
+    """Compile the kernel of the system ``cpar`` for the argument types of a run (zero steps run)."""
     tail = (2,) if precision == "dd" else ()
-    y = np.zeros((1, 6) + tail)
-    y[0, 0] = 1.0e7
-    y[0, 4] = 6.0e3
+    y = np.zeros((3, 6) + tail)
     coef = dp87.step_coefficients(dp87.load_tableau(), 1, precision)
     model = ForceModel([])
-    K = np.zeros((13,) + y.shape)
-    cpar = _lay.make_cpar(_lay.MODE_POINT_MASS)
-    gw, fw, aux = _lay.workspace(y)
-    _fixed_chunk(y, np.zeros_like(y), K, np.zeros_like(y), np.zeros((1, 6)), coef.ha, coef.nz, coef.nnz,
-                 coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((1, 13, 0)), model.params, model.layout,
-                 cpar, aux, gw, fw, 1, np.empty((1,) + y.shape), np.empty((1, 1, 3) + tail),
-                 np.empty((0, _lay.AUX_LEN)))
-    _grid_times(0, 1, np.array(coef.h), coef.c, np.empty((1, 2)), np.empty((0, 13, 2)))
-    evaluate_rhs(y, np.zeros(0), model)
+    gw, fw, aux = _lay.workspace(y, cpar)
+    chunk_kernel(fw)(y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros((3, 6)),
+                     coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((0, 13, 0)),
+                     model.params, model.layout, cpar, aux, gw, fw, 0, np.empty((0,) + y.shape),
+                     np.empty((0, 3, 3) + tail), np.empty((0, _lay.AUX_LEN)))
 
 
 # --------------------------------------------------------------------------
@@ -172,7 +205,9 @@ class CheckpointClock:
 def deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t, y, a, aux) -> None:
     """Hand the rows of the steps n0, n0 + 1, ... (dd times ``t``, states ``y``, accelerations ``a``,
     diagnostics ``aux``) to ``sink`` (every ``every``-th step: :func:`select_rows`) and fold the
-    diagnostics into ``extremes`` (when the run forms them, ``n_aux``)."""
+    diagnostics into ``extremes`` (when the run forms them, ``n_aux``).  A state that is not finite
+    stops the run here (:func:`~tqdyn.dynamics.results.check_finite_states`), before its rows go out."""
+    check_finite_states(n0, t, y)
     if sink is not None:
         sink(select_rows(t, y, a, precision, every, n0, aux, system))
     if n_aux:
@@ -225,7 +260,8 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
     nb = y.shape[0]
     acc_shape = (nb, 3) + y.shape[2:]
     cpar = system.cpar
-    gw, fw, aux = _lay.workspace(y)
+    gw, fw, aux = _lay.workspace(y, cpar)
+    kernel = chunk_kernel(fw)
     n_aux = _lay.AUX_LEN if system.coupled else 0
     t_start = _time.perf_counter()
     clock = CheckpointClock(checkpoint_every, checkpoint_interval_s, n_total)
@@ -278,9 +314,9 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
         for o, e, tdat in parts:
             t_cpu = _time.thread_time()
-            _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
-                         coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, e - o, out_y[o:e],
-                         out_a[o:e], out_aux[o:e])
+            kernel(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
+                   coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, e - o, out_y[o:e],
+                   out_a[o:e], out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat
         deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t_out, out_y, out_a, out_aux)
@@ -299,6 +335,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
                 else np.zeros(0))
     k_end, aux_end = evaluate_rhs(y, np.atleast_1d(tdat_end), model, cpar, with_aux=True)
     wall = _time.perf_counter() - t_start
+    check_finite_states(n_total, t_end, y[None])
     if sink is not None:
         sink(select_rows(t_end, y[None], k_end[None, :, 3:6], precision, every, n_total, aux_end[None], system))
     return RunResult(precision=precision, mode="fixed", t_final=t_end[0], y0=y0_dd,

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._choices import unknown
+
 __all__ = ["PRECISIONS", "check_precision", "MODE_POINT_MASS", "MODE_COUPLED", "MODE_FREE_TM", "CP_LEN", "AUX_LEN",
            "SCHEME_CODES", "TM_GRAVITY_CODES", "SYSTEM_TDAT_BODIES", "JERK_BODIES_MAX", "empirical_of", "make_cpar", "workspace",
            "aux_views"]
@@ -28,7 +30,7 @@ PRECISIONS = ("dd", "float64")
 def check_precision(precision):
     """ValueError naming ``run.precision`` unless it is one of :data:`PRECISIONS`."""
     if precision not in PRECISIONS:
-        raise ValueError(f"run.precision: {precision!r} is not allowed; allowed: {', '.join(PRECISIONS)}")
+        raise ValueError(unknown("run.precision", precision, PRECISIONS))
 
 
 MODE_POINT_MASS = 0
@@ -144,12 +146,21 @@ def empirical_of(cpar: np.ndarray, n_par: int) -> np.ndarray:
     return np.ascontiguousarray(cpar[CP_LEN:]).reshape(-1, n_par)
 
 
-def workspace(y: np.ndarray):
+def workspace(y: np.ndarray, cpar: np.ndarray | None = None):
     """(gw, fw, aux) scratch for :func:`system_rhs` with state ``y``: gw
     (15, 3[, 2]) accelerations in the working precision, fw a tuple of
-    float64 arrays, aux (AUX_LEN,)."""
-    return (np.zeros((15, 3) + y.shape[2:]), tuple(np.zeros(shape) for _, shape in _FW_SHAPES),
-            np.zeros(AUX_LEN))
+    float64 arrays, aux (AUX_LEN,).  Their types tell the compiled code
+    which system runs, so that a run compiles its own only: for the
+    point-mass system (``cpar`` of MODE_POINT_MASS) fw is None; for the
+    coupled one with the global pointing law (cpar[CP_LAW] = 0, the
+    default without cpar) its jerk array fw[19] is None (the local laws'
+    jerk model is left out)."""
+    if cpar is not None and cpar[CP_MODE] == MODE_POINT_MASS:
+        fw = None
+    else:
+        local = cpar is not None and cpar[CP_LAW] != 0
+        fw = tuple(None if name == "jp" and not local else np.zeros(shape) for name, shape in _FW_SHAPES)
+    return np.zeros((15, 3) + y.shape[2:]), fw, np.zeros(AUX_LEN)
 
 
 def aux_views(aux: np.ndarray) -> dict:

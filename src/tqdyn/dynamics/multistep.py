@@ -36,11 +36,12 @@ from numba import njit
 
 from ..numerics import dp87
 from ..numerics import multistep as _ms
+from ..numerics.dd import copy_columns
 from . import layout as _lay
-from .fixed import (CheckpointClock, _as_precision, _fixed_chunk, _grid_times, _workspace, chunk_plan, deliver_rows,
-                    input_pipeline)
-from .results import Checkpoint, RunResult, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import evaluate_rhs, point_mass_system, system_rhs
+from .fixed import (CheckpointClock, _as_precision, _grid_times, _workspace, chunk_kernel, chunk_plan, deliver_rows,
+                    input_pipeline, warm_up_systems)
+from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
+from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
 __all__ = ["INPUT_BLOCK", "propagate_multistep", "warm_up_multistep", "corrector_stages"]
 
@@ -63,45 +64,57 @@ def corrector_stages(corrector: str) -> tuple[int, bool]:
     return c.count("c"), c.endswith("e")
 
 
-@njit(cache=True)
-def _evaluate(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
-    """k = f(t, y) (independent point masses call their right-hand side
-    directly, as :func:`.fixed._one_step` does)."""
-    if cpar[_lay.CP_MODE] == _lay.MODE_POINT_MASS:
-        point_mass_system(y, tdat_row, params, layout, cpar, k)
-    else:
-        system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)
-
-
-@njit(cache=True, nogil=True)
-def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
-                     layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
-    """n_steps steps P(EC)^n_corr [E]: predict, evaluate, n_corr times
-    correct and evaluate, the last evaluation only if ``evaluated``.  Before
-    step n it records the state y_n in out_y[n], the table's newest
-    acceleration f_n in out_a[n] and that evaluation's diagnostics aux_cur
-    in out_aux[n] (if out_aux has rows).  tdat: (n_steps, n_tdat) inputs at
-    the end times t_{n+1} of the steps.  head: (1,) int64 ring index of f_n;
-    stats: (2,) running maxima of the first correction's change of
-    positions [m] and velocities [m/s]."""
+@njit(inline="always")
+def _steps(rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
+           layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
     h = head[0]
     for n in range(n_steps):
-        out_y[n] = y
-        out_a[n] = F[h]
+        copy_columns(y, out_y[n], 0, 6)
+        copy_columns(F[h], out_a[n], 0, 3)
         if out_aux.shape[0] > 0:
-            out_aux[n] = aux_cur
+            for j in range(aux_cur.shape[0]):
+                out_aux[n, j] = aux_cur[j]
         _ms.predict(S, cS, s, cs, F, h, coef, hh, ypred)
-        _evaluate(ypred, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
+        rhs(ypred, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
         for it in range(n_corr):
             _ms.correct(S, cS, s, cs, F, h, k, coef, hh, y)
             if it == 0:
                 _ms.max_change(y, ypred, stats)
             if evaluated or it < n_corr - 1:
-                _evaluate(y, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
+                rhs(y, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
         if n_corr == 0:
-            y[:] = ypred
+            copy_columns(ypred, y, 0, 6)
         h = _ms.commit(S, cS, s, cs, F, h, k)
     head[0] = h
+
+
+@njit(cache=True, nogil=True)
+def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
+                     layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
+    """n_steps steps P(EC)^n_corr [E] of the coupled constellation: predict,
+    evaluate, n_corr times correct and evaluate, the last evaluation only if
+    ``evaluated``.  Before step n it records the state y_n in out_y[n], the
+    table's newest acceleration f_n in out_a[n] and that evaluation's
+    diagnostics aux_cur in out_aux[n] (if out_aux has rows).  tdat:
+    (n_steps, n_tdat) inputs at the end times t_{n+1} of the steps.  head:
+    (1,) int64 ring index of f_n; stats: (2,) running maxima of the first
+    correction's change of positions [m] and velocities [m/s].  One kernel
+    per system, as in :mod:`.fixed`."""
+    _steps(coupled_rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
+           params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
+
+
+@njit(cache=True, nogil=True)
+def _multistep_chunk_points(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
+                            params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
+    """:func:`_multistep_chunk` for independent point masses (fw None)."""
+    _steps(point_mass_rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
+           params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
+
+
+def _kernel(fw):
+    """The multistep kernel of the system whose work arrays ``fw`` are (None: point masses)."""
+    return _multistep_chunk_points if fw is None else _multistep_chunk
 
 
 class _State:
@@ -138,25 +151,25 @@ class _State:
         self.head[0] = self.F.shape[0] - 1
 
 
-def warm_up_multistep(precision: str = "dd") -> None:
-    """Compile the multistep kernels for ``precision`` (numba JIT, cached on disk)."""
+def warm_up_multistep(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+    """Compile the multistep kernel for ``precision`` (numba JIT, cached on
+    disk); ``cpar`` as for :func:`tqdyn.dynamics.fixed.warm_up`."""
     from ..forces.model import ForceModel
 
     _lay.check_precision(precision)
     tail = (2,) if precision == "dd" else ()
-    y = np.zeros((1, 6) + tail)
-    y[0, 0] = 1.0e7
-    y[0, 4] = 6.0e3
+    y = np.zeros((3, 6) + tail)
     order = _ms.ORDERS[0]
     mc = _ms.step_coefficients(order, 1, precision)
     model = ForceModel([])
     st = _State(y, order)
-    cpar = _lay.make_cpar(_lay.MODE_POINT_MASS)
-    gw, fw, _ = _lay.workspace(y)
     _ms.start(st.y, st.F, 0, mc.coef, mc.hh, st.S, st.cS, st.s, st.cs)
-    _multistep_chunk(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, np.zeros_like(y),
-                     np.zeros_like(y), st.aux, np.zeros(2), 1, True, np.zeros((1, 0)), model.params, model.layout, cpar,
-                     gw, fw, 1, np.empty((1,) + y.shape), np.empty((1, 1, 3) + tail), np.empty((0, _lay.AUX_LEN)))
+    for c in warm_up_systems(cpar):
+        gw, fw, _ = _lay.workspace(y, c)
+        _kernel(fw)(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, np.zeros_like(y),
+                    np.zeros_like(y), st.aux, np.zeros(2), 1, True, np.zeros((0, 0)), model.params, model.layout,
+                    c, gw, fw, 0, np.empty((0,) + y.shape), np.empty((0, 3, 3) + tail),
+                    np.empty((0, _lay.AUX_LEN)))
 
 
 def _start_up(st, mc, scenario, precision, model, epoch, tab, y0_dd, sink, system, cpu):
@@ -179,14 +192,15 @@ def _start_up(st, mc, scenario, precision, model, epoch, tab, y0_dd, sink, syste
     cpu["inputs"] += _time.thread_time() - t_cpu
     t_cpu = _time.thread_time()
     cpar = system.cpar
-    gw, fw, aux = _lay.workspace(y)
+    gw, fw, aux = _lay.workspace(y, cpar)
     out_y = np.empty((n_s,) + y.shape)
     out_a = np.empty((n_s, y.shape[0], 3) + y.shape[2:])
     out_aux = np.empty((n_s if system.coupled else 0, _lay.AUX_LEN))
-    _fixed_chunk(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he,
-                 tdat, model.params, model.layout, cpar, aux, gw, fw, n_s, out_y, out_a, out_aux)
+    chunk_kernel(fw)(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he,
+                     tdat, model.params, model.layout, cpar, aux, gw, fw, n_s, out_y, out_a, out_aux)
     k_end, aux_end = evaluate_rhs(y, tdat_end, model, cpar, with_aux=True)
     cpu["loop"] += _time.thread_time() - t_cpu
+    check_finite_states(0, t_out[:n_s], out_y)
     if sink is not None:
         sink(select_rows(t_out[:n_s], out_y, out_a, precision, scenario.run.output_every, 0, out_aux, system))
     st.y[...] = y
@@ -215,7 +229,8 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
     st = _State(_as_precision(y0_dd, precision), order)
     h = np.array(mc.h)
     cpar = system.cpar
-    gw, fw, _ = _lay.workspace(st.y)
+    gw, fw, _ = _lay.workspace(st.y, cpar)
+    kernel = _kernel(fw)
     n_aux = _lay.AUX_LEN if system.coupled else 0
     cpu = {"inputs": 0.0, "loop": 0.0}
     extremes: dict = {}
@@ -279,9 +294,9 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
         out_aux = np.empty((m if n_aux else 0, _lay.AUX_LEN))
         for o, e, tdat in parts:
             t_cpu = _time.thread_time()
-            _multistep_chunk(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux,
-                             stats, n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, e - o,
-                             out_y[o:e], out_a[o:e], out_aux[o:e])
+            kernel(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux, stats,
+                   n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, e - o, out_y[o:e], out_a[o:e],
+                   out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat
         deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t_out, out_y, out_a, out_aux)

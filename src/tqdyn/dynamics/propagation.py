@@ -26,21 +26,25 @@ from .fixed import warm_up as _warm_up_fixed
 from .initial import initial_state
 from .multistep import propagate_multistep, warm_up_multistep
 from .layout import PRECISIONS, check_precision
-from .results import Checkpoint, Rows, RunResult
+from .results import Checkpoint, NonFiniteStateError, Rows, RunResult, check_finite_states
 from .system import build_system
 
-__all__ = ["propagate", "check_inputs", "two_body_energy", "warm_up", "PRECISIONS", "Checkpoint", "Rows",
-           "RunResult"]
+__all__ = ["propagate", "check_inputs", "two_body_energy", "warm_up", "PRECISIONS", "Checkpoint",
+           "NonFiniteStateError", "Rows", "RunResult"]
 
 
-def warm_up(precision: str = "dd", method: str = "dp87") -> None:
+def warm_up(precision: str = "dd", method: str = "dp87", cpar: np.ndarray | None = None) -> None:
     """Compile the kernels of ``method`` ("dp87" | "multistep") for
     ``precision`` (numba JIT, a few seconds on first use, then cached on
     disk) so that later timings measure the propagation alone.  The DP87
-    kernels are always compiled (they also start the multistep method)."""
-    _warm_up_fixed(precision)
+    kernel is always compiled (it also starts the multistep method).
+    ``cpar``: the run's system (the ``cpar`` of its
+    :class:`tqdyn.dynamics.system.System`, ``build_system(scenario).cpar``), whose kernels alone are
+    compiled; None: those of independent point masses and of the coupled
+    constellation with the global pointing law."""
+    _warm_up_fixed(precision, cpar)
     if method == "multistep":
-        warm_up_multistep(precision)
+        warm_up_multistep(precision, cpar)
 
 
 def two_body_energy(y_dd: np.ndarray, gm) -> list:
@@ -80,6 +84,11 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     of wall-clock time since the last one (0 = never), after the rows up to
     that step went to the sink.  Where the checkpoints fall does not change
     the steps: a run resumed from any of them is bit-identical.
+
+    A state that stops being finite (inf, NaN) stops the propagation at that step, before its rows
+    reach the sink: :class:`~tqdyn.dynamics.results.NonFiniteStateError` (a ``ValueError``) naming
+    the step, its time and the satellite (fixed mode: every step's state is checked, per chunk;
+    adaptive mode: each attempted step).
     """
     cpu0 = time.process_time()
     precision = precision or scenario.run.precision
@@ -90,16 +99,21 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     epoch = scenario.epoch
     tab = dp87.load_tableau(scenario.integrator.tableau)
     y0_dd = initial_state(scenario, model, system) if y0 is None else np.asarray(y0, np.float64)
-    if scenario.integrator.mode == "adaptive":
-        if start is not None or checkpoint_every or checkpoint_interval_s:
-            raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
-        result = propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system)
-    elif scenario.integrator.method == "multistep":
-        result = propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                                     start, checkpoint, checkpoint_every, system, checkpoint_interval_s)
-    else:
-        result = propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
-                                  start, checkpoint, checkpoint_every, system, checkpoint_interval_s)
+    try:
+        check_finite_states(0, np.zeros((1, 2)), y0_dd[None])
+        if scenario.integrator.mode == "adaptive":
+            if start is not None or checkpoint_every or checkpoint_interval_s:
+                raise ValueError("integrator.mode: checkpoints and --resume need mode = \"fixed\"")
+            result = propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, progress, system)
+        elif scenario.integrator.method == "multistep":
+            result = propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                                         start, checkpoint, checkpoint_every, system, checkpoint_interval_s)
+        else:
+            result = propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progress, chunk,
+                                      start, checkpoint, checkpoint_every, system, checkpoint_interval_s)
+    except NonFiniteStateError as exc:
+        raise NonFiniteStateError(exc.step, exc.t, exc.body, _body_name(scenario, exc.body),
+                                  model.reference.time_scale) from None
     if [t.name for t in model.terms] in (["earth_monopole"], ["sun_monopole"]) and not system.coupled \
             and system.centre_ramp is None:
         e0 = two_body_energy(result.y0, model.terms[0].gm)
@@ -109,6 +123,15 @@ def propagate(scenario, *, precision: str | None = None, sink: Callable[[Rows], 
     result.reference = model.reference
     result.cpu_process_s = time.process_time() - cpu0
     return result
+
+
+def _body_name(scenario, body: int) -> str:
+    """The name of body ``body`` of the state: a satellite, or a test mass of the free-TM mode."""
+    names = [s.name for s in scenario.satellites]
+    if body < len(names):
+        return names[body]
+    sat, tm = divmod(body - len(names), 2)
+    return f"{names[sat]} test mass {tm + 1}" if sat < len(names) else f"body {body}"
 
 
 def check_inputs(scenario, model: ForceModel | None = None) -> ForceModel:

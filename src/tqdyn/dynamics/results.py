@@ -17,7 +17,7 @@ import numpy as np
 from ..constellation.indices import MOSA_SIGN
 from . import layout as _lay
 
-__all__ = ["Rows", "Checkpoint", "RunResult", "row_names"]
+__all__ = ["Rows", "Checkpoint", "NonFiniteStateError", "RunResult", "check_finite_states", "row_names"]
 
 DD = tuple  # (hi, lo) pair of float64 arrays of equal shape
 
@@ -102,6 +102,36 @@ def row_names(coupled: bool, free_tms: bool = False) -> tuple[str, ...]:
     if not coupled:
         return _POINT_MASS_ROWS
     return _COUPLED_ROWS + (("tm_housing_offset",) if free_tms else ())
+
+
+class NonFiniteStateError(ValueError):
+    """A propagation stopped because a state is no longer finite (inf or NaN: a force or acceleration
+    out of range).  step: the step index whose state is not finite (0 the initial state); t [s since
+    the epoch, the run's time scale]; body: the index of the body in the state (satellites first, then
+    the test masses of the free-TM mode); the message names them (and the satellite, once
+    :func:`tqdyn.dynamics.propagate` knows the names)."""
+
+    def __init__(self, step: int, t: float, body: int, name: str | None = None, time_scale: str = ""):
+        self.step, self.t, self.body = int(step), float(t), int(body)
+        who = repr(name) if name else f"body {self.body}"
+        scale = f" {time_scale}" if time_scale else ""
+        super().__init__(f"propagation: the state of {who} is not finite at step {self.step} (t = {self.t:.9g} s"
+                         f"{scale} after the epoch): a force, acceleration or initial state is out of range")
+
+
+def check_finite_states(n0: int, t: np.ndarray, y: np.ndarray) -> None:
+    """Raise :class:`NonFiniteStateError` at the first of the steps n0, n0 + 1, ... whose state is
+    not finite.  t: (m, 2) dd times [s]; y: (m, n_body, 6[, 2]) states.  Cheap for finite rows (one
+    sum of the block; the rows are searched only when it is not finite)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(np.sum(y)):
+            return
+    ok = np.isfinite(y.reshape(y.shape[0], y.shape[1], -1)).all(axis=2)          # (m, n_body)
+    if ok.all():  # a finite block whose sum overflowed
+        return
+    k, b = np.argwhere(~ok)[0]
+    t = np.asarray(t, np.float64).reshape(-1, 2)
+    raise NonFiniteStateError(n0 + int(k), float(t[k, 0] + t[k, 1]), int(b))
 
 
 def to_dd(y: np.ndarray, ndim_value: int) -> np.ndarray:

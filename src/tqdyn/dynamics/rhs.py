@@ -3,8 +3,9 @@
 State layout: y (n_body, 6[, 2]) with rows (x, y, z, vx, vy, vz) [m, m/s],
 GCRS, geocentric, t in TT; trailing axis 2 in dd mode (see :mod:`tqdyn.numerics.dd`).
 
-Two systems share one compiled entry point, :func:`system_rhs`, selected by
-``cpar[CP_MODE]``:
+Two systems share one entry point, :func:`system_rhs`, selected by
+``cpar[CP_MODE]`` (the point-mass system runs without the coupled work
+arrays, ``fw`` None; the compiled loops have one kernel per system):
 
 * ``MODE_POINT_MASS`` -- every body moves under the force model of
   :mod:`tqdyn.forces.model` (independent satellites).
@@ -66,7 +67,7 @@ import numpy as np
 from numba import njit
 
 from ..constellation._control_jit import housing_geometry, satellite_control
-from ..constellation._kinematics_jit import sat_kinematics
+from ..constellation._kinematics_jit import nominal_kinematics
 from ..constellation.indices import MOSA_SIGN
 from ..forces.earth import j2_jerk_gcrs_z
 from ..forces.differential import differential_gravity, direct_terms
@@ -80,7 +81,8 @@ from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX
                      CP_SG_OA, CP_SG_S, CP_SGC, CP_LEN, CP_TD, CP_THNOM, CP_TMG, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
                      TM_SUSP, TM_VHI, TM_VLO, TMG_DIRECT, make_cpar, workspace)
 
-__all__ = ["system_rhs", "point_masses", "point_mass_system", "evaluate_rhs", "toward_centre"]
+__all__ = ["system_rhs", "coupled_rhs", "point_mass_rhs", "point_masses", "point_mass_system", "evaluate_rhs",
+           "toward_centre"]
 
 
 @njit(cache=True)
@@ -111,7 +113,7 @@ def point_mass_system(y, tdat, params, layout, cpar, k):
         add_empirical(y, cpar[CP_LEN:].reshape((n, N_PAR)), k)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _gravity_into(gw, row, x, y, z, vx, vy, vz, tdat, params, layout):
     ax, ay, az = gravity(x, y, z, vx, vy, vz, tdat, params, layout)
     st(gw, ax, row, 0)
@@ -134,8 +136,10 @@ def _breathing_angle(r_hi, r_lo, i):
 
 
 @njit(cache=True)
-def _jerk_perturbation(cpar, tdat, fw):
-    """Jerk of each satellite beyond the central monopole [m/s^3] into fw[19].
+def _jerk_perturbation(cpar, tdat, fw, jp):
+    """Jerk of each satellite beyond the central monopole [m/s^3] into jp
+    (fw[19]; None for the global law, which needs none: then nothing is
+    computed, nor compiled).
 
     The local pointing laws need the remote satellites' jerk for omega_dot
     (it enters as jerk / c).  Modelled: the tidal terms of the jerk bodies
@@ -156,7 +160,9 @@ def _jerk_perturbation(cpar, tdat, fw):
     1e-12 m of their EH centers over 10 days (tests/test_coupled.py; with the
     monopole jerk alone they do not).
     """
-    v, r_hi, r_lo, jp = fw[2], fw[0], fw[1], fw[19]
+    if jp is None:
+        return
+    v, r_hi, r_lo = fw[2], fw[0], fw[1]
     o = int(cpar[CP_TD])
     k = cpar[CP_J2K]
     nb = int(cpar[CP_NJB])
@@ -191,7 +197,7 @@ def _control_pass(cpar, fw):
     arrays (positions, velocities, accelerations)."""
     r_hi, r_lo, v, a, T, om, omd, th, r0, rho, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], \
         fw[8], fw[9], fw[10]
-    sat_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, fw[19], cpar[CP_GM], cpar[CP_C], T, om, omd, th)
+    nominal_kinematics(int(cpar[CP_LAW]), r_hi, r_lo, v, a, fw[19], cpar[CP_GM], cpar[CP_C], T, om, omd, th)
     r0_nom = cpar[CP_R0:CP_R0 + 6].reshape((2, 3))
     piv = cpar[CP_PIV:CP_PIV + 6].reshape((2, 3))
     for i in range(3):
@@ -238,7 +244,9 @@ def _oa_to_inertial(T, i, theta, l, x, y, z):
 
 
 @njit(cache=True)
-def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
+def coupled_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
+    """dy/dt of the coupled constellation (MODE_COUPLED, MODE_FREE_TM); arguments as
+    :func:`system_rhs`."""
     free = cpar[CP_MODE] == MODE_FREE_TM
     control_on = cpar[CP_CONTROL] != 0.0
     r_hi, r_lo, v, a, T, om, omd, th, r0, vel = fw[0], fw[1], fw[2], fw[3], fw[4], fw[5], fw[6], fw[7], fw[8], fw[10]
@@ -263,7 +271,7 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
                                                                  v[i, 1], v[i, 2], tdat, params, layout)
     # 2. attitude and EH geometry
     if cpar[CP_LAW] != 0:
-        _jerk_perturbation(cpar, tdat, fw)
+        _jerk_perturbation(cpar, tdat, fw, fw[19])
     _control_pass(cpar, fw)
     # 3. differential gravity at the EH centers: term by term
     # (:mod:`tqdyn.forces.differential`) or, "direct", the full model there (dd)
@@ -372,7 +380,14 @@ def _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw):
             aux[b + TM_A], aux[b + TM_A + 1], aux[b + TM_A + 2] = to_f64(tx), to_f64(ty), to_f64(tz)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def point_mass_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
+    """:func:`point_mass_system` with the arguments of :func:`system_rhs`
+    (the work arrays are not used, nor passed on: their reference counts
+    cost time)."""
+    point_mass_system(y, tdat, params, layout, cpar, k)
+
+
 def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
     """dy/dt of the whole system at one instant.
 
@@ -381,12 +396,17 @@ def system_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
     instant of y (TT since the epoch); params, layout: the force model's; cpar: (CP_LEN,)
     constellation parameters (:func:`make_cpar`); aux: (AUX_LEN,) float64
     diagnostics written by the coupled modes; gw, fw: scratch
-    (:func:`workspace`).
+    (:func:`workspace`), fw None for the point-mass system (MODE_POINT_MASS).
+
+    The compiled loops (:mod:`.fixed`, :mod:`.multistep`) do not branch on
+    the system: each has one kernel per system, compiled with the
+    right-hand side of that system (:func:`coupled_rhs` or
+    :func:`point_mass_rhs`), so a run compiles only the system it runs.
     """
-    if cpar[CP_MODE] == MODE_POINT_MASS:
+    if fw is None:
         point_mass_system(y, tdat, params, layout, cpar, k)
     else:
-        _coupled(y, tdat, params, layout, cpar, k, aux, gw, fw)
+        coupled_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw)
 
 
 @njit(cache=True)
@@ -419,14 +439,10 @@ def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: n
     cpar: the system's parameters (:attr:`System.cpar`; default: point
     masses).  With ``with_aux`` returns (k, aux), aux the (AUX_LEN,)
     diagnostics of the coupled modes (see :func:`tqdyn.dynamics.layout.aux_views`).
+    The kernels called are those the propagation kernels call (compiled with them).
     """
     k = np.zeros_like(y)
     cpar = make_cpar(MODE_POINT_MASS) if cpar is None else cpar
-    gw, fw, aux = workspace(y)
-    _rhs_at(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
+    gw, fw, aux = workspace(y, cpar)
+    system_rhs(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
     return (k, aux) if with_aux else k
-
-
-@njit(cache=True)
-def _rhs_at(y, tdat_row, params, layout, cpar, k, aux, gw, fw):
-    system_rhs(y, tdat_row, params, layout, cpar, k, aux, gw, fw)

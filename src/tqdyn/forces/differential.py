@@ -64,6 +64,8 @@ import math
 
 from numba import njit
 
+from ..numerics.jit import dynamic
+
 from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
 from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, float64_terms
@@ -116,7 +118,7 @@ def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     degree :data:`MOON_DEGREE_DG`, without its term on the Earth), at the
     position r [m] and velocity v [m/s] of the force model's frame.
     float64; returns (x, y, z)."""
-    return float64_terms(0.0, 0.0, 0.0, rx, ry, rz, vx, vy, vz, tdat, params, layout, MOON_DEGREE_DG)
+    return float64_terms(0.0, 0.0, 0.0, rx, ry, rz, vx, vy, vz, tdat, params, layout, dynamic(MOON_DEGREE_DG))
 
 
 @njit(cache=True)

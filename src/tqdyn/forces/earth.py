@@ -43,7 +43,8 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache)
+from .._choices import unknown
+from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
 from ..numerics.dd import add, const, div, mul, sqrt, sub
 from ..readers.gravity_fields import GravityModel, egm2008
 from .spherical_harmonics import NMAX_SH, sh_accel_flat
@@ -289,7 +290,7 @@ def _earth_field(rx, ry, rz, tdat, params, static, tides):
     # degree 2 evaluated elsewhere (in extended precision, degree2_accel_ext)?
     nmin = 3 if params[PARAM_HEADER + 2 * L] != 0.0 else 2
     x, y, z = itrs_from_gcrs(tdat, rx, ry, rz)
-    ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, 0, nt, nmin)
+    ax, ay, az = sh_accel_flat(x, y, z, gm, radius, C, S, ld, n, mo, dC, dS, dynamic(0), nt, nmin)
     return gcrs_from_itrs(tdat, ax, ay, az)
 
 
@@ -426,14 +427,14 @@ def earth_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     (rx, ry, rz) [m] (velocity unused).  tdat: this term's (n_tdat,)
     time-only inputs at the instant; params: :meth:`EarthField.params`.
     float64 scalars; returns (ax, ay, az)."""
-    return _earth_field(rx, ry, rz, tdat, params, True, True)
+    return _earth_field(rx, ry, rz, tdat, params, dynamic(True), dynamic(True))
 
 
 @njit(cache=True)
 def earth_field_static_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """As :func:`earth_field_accel`, the static field only (no corrections):
     for force budgets.  m, m/s in, m/s^2 out, GCRS."""
-    return _earth_field(rx, ry, rz, tdat, params, True, False)
+    return _earth_field(rx, ry, rz, tdat, params, dynamic(True), dynamic(False))
 
 
 @njit(cache=True)
@@ -441,7 +442,7 @@ def earth_tides_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """As :func:`earth_field_accel`, the summed coefficient corrections only
     (the tides' acceleration, for force budgets; for one tide model alone
     build an EarthField with that provider only).  m/s^2, GCRS."""
-    return _earth_field(rx, ry, rz, tdat, params, False, True)
+    return _earth_field(rx, ry, rz, tdat, params, dynamic(False), dynamic(True))
 
 
 @njit(cache=True)
@@ -464,7 +465,7 @@ def earth_field_accel_batch(r, tdat, params, part: str = "total") -> np.ndarray:
     """
     flags = {"total": (True, True), "static": (True, False), "tides": (False, True)}
     if part not in flags:
-        raise ValueError(f"earth_field_accel_batch: part {part!r} not one of {tuple(flags)}")
+        raise ValueError(unknown("earth_field_accel_batch: part", part, flags))
     r = np.ascontiguousarray(np.atleast_2d(r), dtype=np.float64)
     tdat = np.ascontiguousarray(np.atleast_2d(tdat), dtype=np.float64)
     if r.shape[-1] != 3 or tdat.shape[0] not in (1, r.shape[0]):

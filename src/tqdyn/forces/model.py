@@ -33,6 +33,7 @@ from numba import njit
 from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
+from ..numerics.jit import dynamic
 from .body_gms import body_gms
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
@@ -258,7 +259,7 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     return ForceModel(terms, reference)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
     and velocity (vx, vy, vz) [m/s] relative to the central body, in the
@@ -323,7 +324,7 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
         o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
         gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, -1)
+    px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, dynamic(-1))
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
 
 

@@ -39,7 +39,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from .._choices import unknown
+from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
 from ..astro.lunar_orientation import LIBRATIONS, lunar_pa_rotation
 from ..astro.timescales import tdb_jd
 from .spherical_harmonics import sh_accel
@@ -72,7 +73,7 @@ def _field_gcrs(px, py, pz, tdat, params, ntrunc=-1):
     qx = t00 * px + t01 * py + t02 * pz
     qy = t10 * px + t11 * py + t12 * pz
     qz = t20 * px + t21 * py + t22 * pz
-    fx, fy, fz = sh_accel(qx, qy, qz, gm, radius, cnm, snm, nmax, 2)
+    fx, fy, fz = sh_accel(qx, qy, qz, gm, radius, cnm, snm, nmax, dynamic(2))
     return (t00 * fx + t10 * fy + t20 * fz,
             t01 * fx + t11 * fy + t21 * fz,
             t02 * fx + t12 * fy + t22 * fz)
@@ -90,7 +91,7 @@ def moon_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     [gm (m^3/s^2), radius (m), nmax, C (nmax+1)^2 row-major, S (nmax+1)^2
     row-major] (fully normalised, PA frame).
     """
-    ax, ay, az = _field_gcrs(rx - tdat[0], ry - tdat[1], rz - tdat[2], tdat, params)
+    ax, ay, az = _field_gcrs(rx - tdat[0], ry - tdat[1], rz - tdat[2], tdat, params, dynamic(-1))
     return ax - tdat[12], ay - tdat[13], az - tdat[14]
 
 
@@ -110,7 +111,7 @@ def _earth_terms(tdat, params):
     (Moon-centred position -s) [m/s^2, GCRS], for every row of tdat (n, 15)."""
     for i in range(tdat.shape[0]):
         row = tdat[i]
-        ax, ay, az = _field_gcrs(-row[0], -row[1], -row[2], row, params)
+        ax, ay, az = _field_gcrs(-row[0], -row[1], -row[2], row, params, dynamic(-1))
         row[12], row[13], row[14] = ax, ay, az
 
 
@@ -186,7 +187,7 @@ class MoonField:
         if self.degree < 2:
             raise ValueError(f"MoonField: degree {self.degree} < 2 (the monopole is the third-body term)")
         if self.libration not in LIBRATIONS:
-            raise ValueError(f"MoonField: libration {self.libration!r} is not one of {LIBRATIONS}")
+            raise ValueError(unknown("MoonField: libration", self.libration, LIBRATIONS))
         self.model()  # ValueError now if the degree exceeds the coefficient file's
 
     def model(self):

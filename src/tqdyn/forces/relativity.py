@@ -62,6 +62,7 @@ import erfa
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from ..astro.constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J_EARTH_IERS2010
 from ..astro.ephemeris import Ephemeris, default_ephemeris, planetary_gm
 from ..astro.timescales import tdb_jd, tt_jd
@@ -263,7 +264,7 @@ class Relativity:
 
     def __post_init__(self):
         if self.j_axis not in _J_AXES:
-            raise ValueError(f"relativity: j_axis = {self.j_axis!r}; expected one of {', '.join(_J_AXES)}")
+            raise ValueError(unknown("relativity: j_axis", self.j_axis, _J_AXES))
         for label, value in (("gm_earth", self.gm_earth), ("j_earth", self.j_earth)):
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f"relativity: {label} = {value!r}; expected a positive finite number")

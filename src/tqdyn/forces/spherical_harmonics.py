@@ -72,7 +72,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache)
+from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
 
 __all__ = [
     "NMAX_SH",
@@ -152,11 +152,6 @@ _A, _B, _FZ, _FM, _FP, _CK = _factor_tables(_JT, NMAX_SH)
 for _t in (_A, _B, _FZ, _FM, _FP, _CK):
     _t.setflags(write=False)
 del _t
-
-# a (1,) zero array standing in for "no static coefficients" / "no corrections"
-_EMPTY1 = np.zeros(1)
-_EMPTY1.setflags(write=False)
-
 
 @njit(cache=True)
 def _factors(j, k):
@@ -409,8 +404,10 @@ def sh_accel(x, y, z, gm, radius, C, S, nmax, nmin=2, mmax=-1):
         raise ValueError("sh_accel: nmax above the degree of the coefficient arrays (or C, S not square)")
     if mmax < 0 or mmax > nmax:
         mmax = nmax
-    return sh_accel_flat(x, y, z, gm, radius, C.reshape(L * L), S.reshape(L * L), L, nmax, mmax,
-                         _EMPTY1, _EMPTY1, 1, -1, nmin)
+    Cf, Sf = C.reshape(L * L), S.reshape(L * L)
+    # no corrections: empty views (not constant arrays, not constant sizes: the
+    # types of the other kernels' calls, so that all share one compiled core)
+    return sh_accel_flat(x, y, z, gm, radius, Cf, Sf, L, nmax, mmax, Cf[:0], Sf[:0], dynamic(1), dynamic(-1), nmin)
 
 
 @njit(cache=True)
@@ -452,4 +449,5 @@ def sh_accel_corrections(x, y, z, gm, radius, dC, dS, nt, nmin=2, packed=False):
     size = (nt + 1) * (nt + 2) // 2 if packed else (nt + 1) * (nt + 1)
     if nt >= 0 and (dC.shape[0] < size or dS.shape[0] < size):
         raise ValueError("sh_accel_corrections: dC, dS shorter than their degree nt needs")
-    return sh_accel_flat(x, y, z, gm, radius, _EMPTY1, _EMPTY1, 1, -1, -1, dC, dS, 0 if packed else nt + 1, nt, nmin)
+    return sh_accel_flat(x, y, z, gm, radius, dC[:0], dS[:0], dynamic(1), dynamic(-1), dynamic(-1), dC, dS,
+                         0 if packed else nt + 1, nt, nmin)

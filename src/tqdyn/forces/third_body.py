@@ -50,6 +50,7 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
+from .._choices import unknown as unknown_name
 from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
 
 __all__ = ["ThirdBodies", "pm_difference", "third_body_accel", "third_bodies_accel", "third_body_accel_ext",
@@ -226,7 +227,8 @@ class ThirdBodies:
         a body evaluated in extended precision)."""
         unknown = set(self.extended) - set(self.names)
         if unknown:
-            raise ValueError(f"third bodies: extended names {sorted(unknown)} are not among {self.names}")
+            raise ValueError(unknown_name("third bodies: extended", sorted(unknown)[0], self.names,
+                                          problem="is not among the bodies"))
         return np.array([len(self.gms), *self.gms, *(float(n in self.extended) for n in self.names)],
                         dtype=np.float64)
 

@@ -110,7 +110,7 @@ def read_checkpoint(path) -> CheckpointFile:
         reason = " ".join(str(exc).split())
         if "allow_pickle" in reason:
             reason = "it holds object data, which a checkpoint never does"
+        reason = reason if len(reason) <= 40 else reason[:37] + "..."
         raise CheckpointError(
-            f"checkpoint {str(path)!r} is damaged or not a tqdyn checkpoint ({type(exc).__name__}: "
-            f"{reason[:160]}); remove it (and the hidden partial trajectory .<output>.*.tmp next to it) "
-            f"and run again without --resume") from None
+            f"checkpoint {str(path)!r} is damaged ({type(exc).__name__}: {reason}); remove it (and "
+            f".<output>.*.tmp) and run again without --resume") from None

@@ -16,7 +16,8 @@ Every dataset is chunked and carries a Fletcher-32 checksum.  Writing is atomic:
 :class:`ClosedLoopWriter` writes to a hidden temporary file beside the output and renames it into
 place on :meth:`~ClosedLoopWriter.close`; a failure or an interrupt (with-block, :meth:`abort`)
 removes the temporary file and leaves the output path as it was.  Strings are stored as fixed-length
-UTF-8 bytes.  Units SI.
+UTF-8 strings (HDF5 character set UTF-8); the budget's datasets are compressed (byte shuffle + gzip).  Version 1
+files (ASCII strings, ``gain_margin`` python-control's choice) are read into version 2's layout.  Units SI.
 """
 
 from __future__ import annotations
@@ -33,7 +34,8 @@ import numpy as np
 from .._version import __version__ as _TQDYN_VERSION
 from ..closedloop.simulate import Block, Sink
 from .trajectory import OutputError, OutputIOError, check_writable
-from .trajectory._h5safe import _cleanup, _close_h5, _io_reason
+from .stop import check_stop
+from .trajectory._h5safe import _cleanup, _close_h5, _io_reason, _vfd
 from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError", "ClosedLoopWriter",
@@ -41,16 +43,17 @@ __all__ = ["FORMAT", "FORMAT_VERSION", "ClosedLoopFile", "ClosedLoopFormatError"
 
 FORMAT = "tqdyn-closed-loop"
 """Value of the root attribute ``format``."""
-FORMAT_VERSION = 1
-"""Format version written; readers accept any version <= this."""
+FORMAT_VERSION = 2
+"""Format version written; readers accept any version <= this (docs/closed-loop-file.md#older-versions)."""
 
 #: Root attributes and their meaning (docs/closed-loop-file.md).
 ROOT_ATTRS = {
     "format": f'str, always "{FORMAT}"',
     "format_version": f"int, {FORMAT_VERSION}",
     "tqdyn_version": "str, version of tqdyn that wrote the file",
-    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji"',
-    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise",
+    "mission": 'str, the mission whose defaults apply: "tianqin" | "lisa" | "taiji" | "lpf" | "tianqin-1"',
+    "source_file": "str, file name (no directory) of the coupled run (trajectory file) the loops linearise; "
+                   "the source_* attributes are empty (0) for a mission's static working point (--mission)",
     "source_path": "str, absolute path of that file when the closed loop was computed",
     "source_sha256": "str, SHA-256 of the trajectory file's bytes",
     "source_scenario_sha256": "str, SHA-256 of the run's resolved scenario (its root attribute scenario, UTF-8)",
@@ -76,16 +79,43 @@ class ClosedLoopFormatError(ValueError):
     """A file that is not a readable closed-loop file: one line naming the file and what was found."""
 
 
-def _chunks(shape) -> tuple | None:
-    return tuple(max(1, min(int(n), 65536)) for n in shape) if all(int(n) > 0 for n in shape) and shape else None
+#: Largest chunk of a budget dataset [bytes] (the leading axes, e.g. the segments, are split first).
+_BUDGET_CHUNK_BYTES = 1 << 21
+#: Compression of the budget's datasets (h5py: byte shuffle, then gzip at this level).
+_GZIP_LEVEL = 4
+
+
+def _chunks(shape, itemsize: int = 8) -> tuple | None:
+    """Chunks of at most :data:`_BUDGET_CHUNK_BYTES` (and 65,536 per axis): whole trailing axes, the leading
+    ones cut first."""
+    if not shape or not all(int(n) > 0 for n in shape):
+        return None
+    ch = [max(1, min(int(n), 65536)) for n in shape]
+    for k in range(len(ch)):
+        rest = itemsize * int(np.prod(ch[k + 1:], dtype=np.int64))
+        if rest * ch[k] <= _BUDGET_CHUNK_BYTES:
+            break
+        ch[k] = max(1, _BUDGET_CHUNK_BYTES // max(1, rest))
+    return tuple(ch)
 
 
 def _put(group, name: str, value, dims=(), attrs=None):
     arr = np.asarray(value)
-    if arr.dtype.kind in "USO":
-        arr = text_array(arr)
-    ch = _chunks(arr.shape)
-    ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None)
+    text = arr.dtype.kind in "USO"
+    if text:
+        arr = text_array(arr)                      # fixed-length UTF-8 bytes, stored with the UTF-8 character set
+    ch = _chunks(arr.shape, arr.dtype.itemsize)
+    extra = {"compression": "gzip", "compression_opts": _GZIP_LEVEL, "shuffle": True} if ch is not None else {}
+    if text:                                       # HDF5 converts no ASCII to UTF-8: the UTF-8 type in file and memory
+        tid = h5py.h5t.C_S1.copy()
+        tid.set_size(arr.dtype.itemsize)
+        tid.set_cset(h5py.h5t.CSET_UTF8)
+        ds = group.create_dataset(name, shape=arr.shape, dtype=h5py.Datatype(tid), chunks=ch,
+                                  fletcher32=ch is not None, **extra)
+        if arr.size:
+            ds.id.write(h5py.h5s.ALL, h5py.h5s.ALL, np.ascontiguousarray(arr), mtype=tid)
+    else:
+        ds = group.create_dataset(name, data=arr, chunks=ch, fletcher32=ch is not None, **extra)
     ds.attrs["dims"] = ",".join(dims)
     ds.attrs["kind"] = "text" if arr.dtype.kind == "S" else "number"
     for k, v in (attrs or {}).items():
@@ -121,6 +151,7 @@ class ClosedLoopWriter(Sink):
         try:
             h5 = h5py.File(tmp, "w", rdcc_nbytes=_RDCC_NBYTES)
             self._state["h5"] = h5
+            self._state["fd"] = _vfd(h5)
             for k, v in {"format": FORMAT, "format_version": FORMAT_VERSION, "tqdyn_version": _TQDYN_VERSION,
                          **{k: v for k, v in attrs.items() if k not in ("format", "format_version")}}.items():
                 h5.attrs[k] = v
@@ -205,6 +236,7 @@ class ClosedLoopWriter(Sink):
             return self._path
         h5 = self._h5("close")
         try:
+            check_stop()  # a stop signal that arrived: no file is renamed into place
             if not self._meta or self._row != int(self._meta["n_samples"]) or not self._budget:
                 raise ValueError(f"close: the closed-loop file {str(self._path)!r} is incomplete ({self._row} of "
                                  f"{self._meta.get('n_samples', '?')} samples, budget "
@@ -303,7 +335,26 @@ class ClosedLoopFile:
                                  "time_unit": "s on the run's time axis since the epoch"})
 
 
-def _read_budget(h5, fname: str):
+def _upgrade_v1(data: dict) -> None:
+    """A version-1 budget in version 2's layout: version 1's ``gain_margin`` is python-control's choice (the
+    margin closest to 1 in dB, the upper one when a loop has both); ``gain_margin_lower`` and
+    ``gain_margin_upper`` are what it tells (inf: no phase crossover, so none of either; NaN: not recorded) and
+    ``gain_margin`` becomes the lower one."""
+    import xarray as xr
+
+    gm = data.get("gain_margin")
+    if gm is None or "gain_margin_lower" in data:
+        return
+    v = np.asarray(gm.values, dtype=np.float64)
+    lower = np.where(np.isinf(v), 0.0, np.where(v < 1, v, np.nan))
+    upper = np.where(np.isinf(v), np.inf, np.where(v > 1, v, np.nan))
+    attrs = dict(gm.attrs, units="1")
+    data["gain_margin"] = xr.Variable(gm.dims, lower, attrs=attrs)
+    data["gain_margin_lower"] = xr.Variable(gm.dims, lower, attrs=attrs)
+    data["gain_margin_upper"] = xr.Variable(gm.dims, upper, attrs=attrs)
+
+
+def _read_budget(h5, fname: str, version: int = FORMAT_VERSION):
     import xarray as xr
 
     g = h5["budget"]
@@ -316,6 +367,8 @@ def _read_budget(h5, fname: str):
         attrs = {k: native_attr(v) for k, v in ds.attrs.items() if k not in ("dims", "kind", "role")}
         var = xr.Variable(dims, _values(ds, fname), attrs=attrs)
         (coords if native_attr(ds.attrs.get("role")) == "coord" else data)[name] = var
+    if version < 2:
+        _upgrade_v1(data)
     return xr.Dataset(data, coords=coords, attrs={k: native_attr(v) for k, v in g.attrs.items()
                                                   if k not in ("variables", "coordinates")})
 
@@ -332,8 +385,8 @@ def read_closed_loop(path) -> ClosedLoopFile:
             fmt, ver = attrs.get("format"), attrs.get("format_version")
             if fmt != FORMAT:
                 raise ClosedLoopFormatError(
-                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} with "
-                    f"format_version <= {FORMAT_VERSION} (a file written by tqdyn closed-loop)")
+                    f"{fname}: format = {fmt!r} (format_version = {ver!r}); expected format {FORMAT!r} "
+                    "(written by tqdyn closed-loop)")
             if isinstance(ver, bool) or not isinstance(ver, int) or ver < 1:
                 raise ClosedLoopFormatError(f"{fname}: format = {fmt!r} with invalid format_version = {ver!r}; "
                                             f"expected an int 1..{FORMAT_VERSION}")
@@ -344,7 +397,7 @@ def read_closed_loop(path) -> ClosedLoopFile:
             if "budget" not in h5 or "timeseries" not in h5:
                 raise ClosedLoopFormatError(f"{fname}: the group '/budget' or '/timeseries' is missing; re-create "
                                             "it (tqdyn closed-loop)")
-            budget = _read_budget(h5, fname)
+            budget = _read_budget(h5, fname, ver)
     except DAMAGED as exc:
         raise ClosedLoopFormatError(damaged_message(fname, exc, "tqdyn closed-loop")) from None
     return ClosedLoopFile(p, attrs, budget)

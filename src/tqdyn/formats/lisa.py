@@ -68,13 +68,12 @@ import pathlib
 from collections.abc import Mapping
 from typing import Any
 
-import h5py
 import numpy as np
 
 from ..astro.timescales import TCB_ORIGINS, tcb_jd_of_epoch
 from ..lightpath.lisa_bcrs import BCRS_AXES
 from . import trajectory as _io
-from .atomic import replacing
+from .atomic import replacing_h5
 
 __all__ = [
     "AXES",
@@ -267,7 +266,7 @@ def write_lisa_orbits(path, t, x, v, a, ltt, d_ltt, n, ppr, d_ppr, *, delta_tau,
         root[key] = _attr_value(key, val)
     root.update(version=LISA_ORBIT_FORMAT_VERSION, t0=float(t0), dt=float(dt), size=int(N))
 
-    with replacing(out, "LISA orbit file") as tmp, h5py.File(tmp, "x") as h5:
+    with replacing_h5(out, "LISA orbit file") as h5:
         for key, val in root.items():
             h5.attrs[key] = val
         for name, arr in arrays.items():

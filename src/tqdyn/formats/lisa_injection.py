@@ -14,19 +14,19 @@ t0 + k dt per injection point and MOSA, named ``<point>_<ij>``:
 LISA Instrument interpolates each dataset by a degree-5 interpolating spline (exact at the samples) and
 takes it as zero outside [t0, t0 + (size - 1) dt].  Absent datasets are zero.  tqdyn adds its own root
 attributes (``generator``, ``tqdyn_version``, descriptions).  Written atomically
-(:func:`tqdyn.formats.atomic.replacing`).
+(:func:`tqdyn.formats.atomic.replacing_h5`).
 """
 
 from __future__ import annotations
 
 import math
 
-import h5py
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from .._version import __version__ as _TQDYN_VERSION
 from . import trajectory as _io
-from .atomic import replacing
+from .atomic import replacing_h5
 
 __all__ = ["GLITCH_FILE_VERSION", "POINTS", "write_lisa_injection"]
 
@@ -50,13 +50,14 @@ def write_lisa_injection(out_path, t0: float, dt: float, series: dict, attrs: di
     if not (math.isfinite(t0) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"t0 = {t0!r}, dt = {dt!r}: must be finite with dt > 0 (s)")
     if not series:
-        raise ValueError("series: empty; allowed: datasets <point>_<ij> of " + ", ".join(POINTS))
+        raise ValueError("series: empty; allowed: datasets <point>_<ij> of " + allowed(POINTS))
     arrays, size = {}, None
     for name, v in series.items():
         point, _, mosa = str(name).rpartition("_")
         if point not in POINTS or mosa not in _MOSAS:
-            raise ValueError(f"series: dataset {name!r} is not <point>_<ij> with point in {', '.join(POINTS)} "
-                             f"and ij in {', '.join(_MOSAS)}")
+            raise ValueError(f"series: dataset {name!r} is not <point>_<ij>"
+                             f"{did_you_mean(name, [f'{p}_{m}' for p in POINTS for m in _MOSAS])}; allowed: point "
+                             f"in {allowed(POINTS)} and ij in {allowed(_MOSAS)}")
         a = np.asarray(v, dtype=np.float64)
         if a.ndim != 1 or (size is not None and a.size != size):
             raise ValueError(f"series[{name!r}]: shape {a.shape}; expected ({size if size else 'n'},) like the others")
@@ -66,18 +67,17 @@ def write_lisa_injection(out_path, t0: float, dt: float, series: dict, attrs: di
         arrays[name] = a
     if size < 2:
         raise ValueError(f"series: {size} sample(s); need at least 2")
-    with replacing(out, "LISA injection file") as tmp:
-        with h5py.File(tmp, "w") as h5:
-            h5.attrs["version"] = GLITCH_FILE_VERSION
-            h5.attrs["size"] = int(size)
-            h5.attrs["dt"] = dt
-            h5.attrs["t0"] = t0
-            h5.attrs["tqdyn_version"] = _TQDYN_VERSION
-            for k, v in (attrs or {}).items():
-                h5.attrs[k] = v
-            for name, a in arrays.items():
-                ds = h5.create_dataset(name, data=a)
-                ds.attrs["units"] = POINTS[name.rpartition("_")[0]]
-                if descriptions and name in descriptions:
-                    ds.attrs["description"] = descriptions[name]
+    with replacing_h5(out, "LISA injection file") as h5:
+        h5.attrs["version"] = GLITCH_FILE_VERSION
+        h5.attrs["size"] = int(size)
+        h5.attrs["dt"] = dt
+        h5.attrs["t0"] = t0
+        h5.attrs["tqdyn_version"] = _TQDYN_VERSION
+        for k, v in (attrs or {}).items():
+            h5.attrs[k] = v
+        for name, a in arrays.items():
+            ds = h5.create_dataset(name, data=a)
+            ds.attrs["units"] = POINTS[name.rpartition("_")[0]]
+            if descriptions and name in descriptions:
+                ds.attrs["description"] = descriptions[name]
     return out

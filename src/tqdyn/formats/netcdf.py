@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import importlib.util
 import os
-import secrets
 from pathlib import Path
+
+from .atomic import replacing
 
 __all__ = ["netcdf_engine", "write_netcdf"]
 
@@ -25,13 +26,12 @@ def netcdf_engine() -> str:
 def write_netcdf(dataset, path: str | os.PathLike, encoding: dict | None = None) -> Path:
     """Write ``dataset`` atomically as netCDF-4 (engine :func:`netcdf_engine`)
     to ``path`` (temporary file in the same directory, then renamed), with
-    xarray's per-variable ``encoding`` (e.g. checksums) if given.
-    Returns the absolute path."""
+    xarray's per-variable ``encoding`` (e.g. checksums) if given.  The file is built in memory and
+    written with ordinary file writes (:func:`tqdyn.formats.atomic.replacing`, as
+    :func:`~tqdyn.formats.atomic.replacing_h5` does: HDF5 never sees a full disk, which becomes
+    :class:`~tqdyn.formats.trajectory.OutputIOError`).  Returns the absolute path."""
     path = Path(os.path.abspath(os.fspath(path)))
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
-    try:
-        dataset.to_netcdf(tmp, engine=netcdf_engine(), encoding=encoding)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    image = dataset.to_netcdf(engine=netcdf_engine(), encoding=encoding)
+    with replacing(path, "the sweep file") as tmp, open(tmp, "xb") as f:
+        f.write(image)
     return path

@@ -18,7 +18,7 @@ One file holds one batch least-squares fit (``tqdyn od fit SCENARIO MEAS.tdm --o
   :func:`tqdyn.od.problem.residual_rows`; files without it have m' = m and row i = measurement i).
 
 Every non-empty dataset is chunked with a Fletcher-32 checksum; strings are fixed-length UTF-8 bytes;
-datasets carry ``units`` and ``description``.  Writing is atomic (:func:`tqdyn.formats.atomic.replacing`):
+datasets carry ``units`` and ``description``.  Writing is atomic (:func:`tqdyn.formats.atomic.replacing_h5`):
 a failure or an interrupt leaves no file and the output path as it was.
 """
 
@@ -29,11 +29,10 @@ import math
 import pathlib
 from dataclasses import dataclass, field
 
-import h5py
 import numpy as np
 
 from .._version import __version__ as _TQDYN_VERSION
-from .atomic import replacing
+from .atomic import replacing_h5
 from .trajectory import check_writable
 from .trajectory.reader import DAMAGED, damaged_message, native_attr, open_for_reading, read_dataset, text_array
 
@@ -178,16 +177,15 @@ def write_estimate_file(path, estimate, measurements, *, attrs: dict, units=None
     row of each residual row (None: the identity, m' = m).  Raises OutputError (one line)."""
     out = check_writable(path)
     root, params, rows = _contents(estimate, measurements, attrs, units, residual_rows)
-    with replacing(out, "the estimate file") as tmp:
-        with h5py.File(tmp, "w") as h5:
-            for k, v in root.items():
-                h5.attrs[k] = v
-            g = h5.create_group("parameters")
-            for k, v in params.items():
-                _put(g, k, v, *_PARAM[k])
-            g = h5.create_group("measurements")
-            for k, v in rows.items():
-                _put(g, k, v, *_MEAS[k])
+    with replacing_h5(out, "the estimate file") as h5:
+        for k, v in root.items():
+            h5.attrs[k] = v
+        g = h5.create_group("parameters")
+        for k, v in params.items():
+            _put(g, k, v, *_PARAM[k])
+        g = h5.create_group("measurements")
+        for k, v in rows.items():
+            _put(g, k, v, *_MEAS[k])
     return out
 
 

@@ -31,7 +31,10 @@ Round trip: ``value``, ``sigma``, ``type``, ``sat`` and ``peer`` are exact; ``t`
 1 ns (the epoch digits), exactly when t and the epoch in the run's time scale are whole nanoseconds
 (a geocentric run from a UTC epoch, t on a grid of nanoseconds); rows come back in time order, rows
 of equal t in the order of their segments -- the order written when the table is in that order.
-Errors: one-line ``ValueError`` naming the file, the segment and the field.
+Errors: one-line ``ValueError`` naming the file, the segment or the line, and the field (the TDM
+reader's checks, :mod:`tqdyn.formats.tdm`; a value whose metres overflow float64; a negative
+``tqdyn sat``).  The rows' epochs against a run (its span, its step grid) are checked by the caller
+with the rows' lines (``with_lines``; ``tqdyn od fit``: :func:`tqdyn.workflows.od.fit_to_file`).
 """
 
 from __future__ import annotations
@@ -43,8 +46,9 @@ from decimal import Decimal, InvalidOperation
 import erfa
 import numpy as np
 
+from .._choices import unknown
 from ..astro.timescales import tdb_after, tt_jd
-from .tdm import Tdm, TdmSegment, read_tdm, write_tdm
+from .tdm import Tdm, TdmSegment, parse_epoch, read_tdm, write_tdm
 
 __all__ = ["TYPES", "TIME_SCALES", "measurements_to_tdm", "read_measurements_tdm", "tdm_to_measurements",
            "write_measurements_tdm"]
@@ -87,22 +91,15 @@ def _epoch_texts(epoch, time_scale: str, t: np.ndarray) -> list[str]:
 
 
 def _t_of(texts: list[str], epoch, time_scale: str) -> np.ndarray:
-    """Seconds since the epoch (the time scale's) of calendar epoch texts, rounded to 1 ns."""
+    """Seconds since the epoch (the time scale's) of calendar epoch texts, rounded to 1 ns (the texts were
+    checked by the TDM reader, :func:`tqdyn.formats.tdm.parse_epoch`)."""
     e1, e2 = TIME_SCALES[time_scale](epoch, 0.0)
     out = np.empty(len(texts))
     for i, s in enumerate(texts):
-        s = s.rstrip("Z")
-        date, clock = s.split("T")
-        if len(date) == 8:  # YYYY-DDD
-            d = datetime.date(int(date[:4]), 1, 1) + datetime.timedelta(days=int(date[5:]) - 1)
-            y, m, day = d.year, d.month, d.day
-        else:
-            y, m, day = int(date[:4]), int(date[5:7]), int(date[8:10])
-        hh, mm, ss = clock.split(":")
-        whole, _, frac = ss.partition(".")
-        d1, d2 = erfa.dtf2d(time_scale, y, m, day, int(hh), int(mm), float(whole))
+        f = parse_epoch(s, time_scale)
+        d1, d2 = erfa.dtf2d(time_scale, f.year, f.month, f.day, f.hour, f.minute, float(f.second))
         sec = (float(d1) - float(e1)) * 86400.0 + (float(d2) - float(e2)) * 86400.0  # error ~1e-11 s
-        sec += float(Decimal("0." + frac)) if frac else 0.0
+        sec += float(Decimal("0." + f.fraction)) if f.fraction else 0.0
         base = np.floor(sec)  # whole seconds, then the fraction rounded to the 1 ns of the digits
         out[i] = base + np.round((sec - base) * 1e9) / 1e9
     return out
@@ -117,7 +114,7 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     info: {key: value} written as header comments ``tqdyn key = value`` (the writer's own keys).
     Raises ValueError (one line) for an unknown type, a non-finite value, a sigma that is not > 0."""
     if time_scale not in TIME_SCALES:
-        raise ValueError(f"time_scale: {time_scale!r}; allowed: {', '.join(TIME_SCALES)}")
+        raise ValueError(unknown("time_scale", time_scale, TIME_SCALES))
     cols = {f: np.asarray(getattr(meas, f)) for f in _FIELDS}
     m = cols["t"].size
     if any(c.shape != (m,) for c in cols.values()):
@@ -141,7 +138,7 @@ def measurements_to_tdm(meas, *, epoch, time_scale: str, satellite_names=None, i
     for i in range(m):
         typ = str(cols["type"][i])
         if typ not in TYPES:
-            raise ValueError(f"measurements.type[{i}] = {typ!r}; allowed: {', '.join(TYPES)}")
+            raise ValueError(unknown(f"measurements.type[{i}]", typ, TYPES))
         key = (typ, int(cols["sat"][i]), str(cols["peer"][i]), float(sig[i]))
         groups.setdefault(key, []).append(i)
     epochs = _epoch_texts(epoch, time_scale, cols["t"].astype(np.float64))
@@ -185,10 +182,13 @@ def _tqdyn_comments(comments) -> dict:
     return out
 
 
-def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, name: str = "<tdm>"):
+def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, name: str = "<tdm>",
+                        with_lines: bool = False):
     """(fields, info) of a TDM written by :func:`measurements_to_tdm`: fields = {t (m,) float64 [s],
     type (m,) str, sat (m,) int64, peer (m,) str, value (m,) float64 [m, m/s], sigma (m,) float64}
-    in time order; info = the header's ``tqdyn`` comments (epoch, time_scale and the writer's keys).
+    in time order, with ``with_lines`` also line (m,) int64 (each row's line in the file; 0 for a
+    message built in memory); info = the header's ``tqdyn`` comments (epoch, time_scale and the
+    writer's keys).
 
     epoch, time_scale: the scenario's (t = 0 and its scale); None: the file's own (``tqdyn epoch``),
     given as an Epoch they must agree with it.  Raises ValueError (one line naming ``name``)."""
@@ -212,8 +212,8 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
         except ValueError as exc:
             raise ValueError(f"{name}: header: tqdyn epoch = {file_epoch!r} ({exc})") from None
     if file_scale not in TIME_SCALES:
-        raise ValueError(f"{name}: header: tqdyn time_scale = {file_scale!r}; allowed: {', '.join(TIME_SCALES)}")
-    parts = {f: [] for f in _FIELDS}
+        raise ValueError(unknown(f"{name}: header: tqdyn time_scale", file_scale, TIME_SCALES))
+    parts = {f: [] for f in _FIELDS + ("line",)}
     for k, seg in enumerate(tdm.segments, start=1):
         where = f"{name}, segment {k}"
         c = _tqdyn_comments(seg.meta_comments)
@@ -223,7 +223,7 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
                              "written by tqdyn od simulate")
         typ = c["type"]
         if typ not in TYPES:
-            raise ValueError(f"{where}: tqdyn type = {typ!r}; allowed: {', '.join(TYPES)}")
+            raise ValueError(unknown(f"{where}: tqdyn type", typ, TYPES))
         kw, _, _, unit, _ = TYPES[typ]
         if seg.metadata.get("TIME_SYSTEM") != file_scale:
             raise ValueError(f"{where}: TIME_SYSTEM = {seg.metadata.get('TIME_SYSTEM')!r}; allowed: {file_scale} "
@@ -239,16 +239,25 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
                              f"a number with its unit {unit}") from None
         if sig_unit != unit or not (np.isfinite(sigma) and sigma > 0):
             raise ValueError(f"{where}: tqdyn sigma = {c['sigma']!r}; allowed: a number > 0 followed by {unit}")
+        if sat < 0:
+            raise ValueError(f"{where}: tqdyn sat = {c['sat']!r}; allowed: a satellite index >= 0 (0 the first)")
         other = sorted({d[0] for d in seg.data} - {kw})
         if other:
             raise ValueError(f"{where}: data keyword {other[0]}; allowed: {kw} for {typ}")
         epochs = [e for _, e, _ in seg.data]
+        lines = list(seg.lines) if len(seg.lines) == len(seg.data) else [0] * len(seg.data)
         try:
-            values = [_si_value(v) for _, _, v in seg.data]
+            values = np.array([_si_value(v) for _, _, v in seg.data], np.float64)
         except InvalidOperation:
             raise ValueError(f"{where}: {kw}: a value is not a number") from None
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"{name}, line {lines[i]}: {kw}: value {seg.data[i][2]!r} (km) is {values[i]} in {unit}; "
+                             "allowed: |value| <= 1.7e305 (km)")
         parts["t"].append(_t_of(epochs, epoch, file_scale))
-        parts["value"].append(np.array(values, np.float64))
+        parts["value"].append(values)
+        parts["line"].append(np.array(lines, np.int64))
         n = len(epochs)
         parts["type"].append(np.full(n, typ, dtype=object))
         parts["sat"].append(np.full(n, sat, dtype=np.int64))
@@ -259,10 +268,13 @@ def tdm_to_measurements(tdm: Tdm, *, epoch=None, time_scale: str | None = None, 
     fields = {f: v[order] for f, v in cat.items()}
     fields["type"] = fields["type"].astype(str)
     fields["peer"] = fields["peer"].astype(str)
+    if not with_lines:
+        del fields["line"]
     return fields, info
 
 
-def read_measurements_tdm(path, *, epoch=None, time_scale: str | None = None):
-    """(fields, info) of the measurement file ``path`` (:func:`tdm_to_measurements`); the TDM reader's
-    one-line errors for a malformed file."""
-    return tdm_to_measurements(read_tdm(path), epoch=epoch, time_scale=time_scale, name=str(path))
+def read_measurements_tdm(path, *, epoch=None, time_scale: str | None = None, with_lines: bool = False):
+    """(fields, info) of the measurement file ``path`` (:func:`tdm_to_measurements`, ``with_lines``:
+    each row's line in the file too); the TDM reader's one-line errors for a malformed file."""
+    return tdm_to_measurements(read_tdm(path), epoch=epoch, time_scale=time_scale, name=str(path),
+                               with_lines=with_lines)

@@ -50,6 +50,7 @@ from collections.abc import Sequence
 import erfa
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from .._version import __version__
 
 from ..astro.oem_states import GEOCENTRIC, HELIOCENTRIC, INTERPOLATIONS
@@ -152,10 +153,12 @@ def _prepare(seg: OemSegment, k: int) -> dict:
     center = _text(seg.center_name, f"{p}.center_name", upper=True)
     frame = _text(seg.ref_frame, f"{p}.ref_frame", upper=True)
     if frame not in REF_FRAMES:
-        raise ValueError(f"{p}.ref_frame = {frame!r} is not supported (allowed: {', '.join(REF_FRAMES)})")
+        raise ValueError(f"{p}.ref_frame = {frame!r} is not supported{did_you_mean(frame, REF_FRAMES)} "
+                         f"(allowed: {allowed(REF_FRAMES)})")
     tsys = _text(seg.time_system, f"{p}.time_system", upper=True)
     if tsys not in TIME_SYSTEMS:
-        raise ValueError(f"{p}.time_system = {tsys!r} is not supported (allowed: {', '.join(TIME_SYSTEMS)})")
+        raise ValueError(f"{p}.time_system = {tsys!r} is not supported{did_you_mean(tsys, TIME_SYSTEMS)} "
+                         f"(allowed: {allowed(TIME_SYSTEMS)})")
     jd1 = np.asarray(seg.jd1)
     if jd1.ndim != 1 or jd1.shape[0] < 1:
         raise ValueError(f"{p}.jd1: shape {jd1.shape}, expected (N,) with N >= 1 epochs")
@@ -181,8 +184,8 @@ def _prepare(seg: OemSegment, k: int) -> dict:
     if seg.interpolation is not None:
         method = _text(seg.interpolation, f"{p}.interpolation", upper=True)
         if method not in INTERPOLATIONS:
-            raise ValueError(f"{p}.interpolation = {method!r} is not supported "
-                             f"(allowed: {', '.join(INTERPOLATIONS)})")
+            raise ValueError(f"{p}.interpolation = {method!r} is not supported{did_you_mean(method, INTERPOLATIONS)} "
+                             f"(allowed: {allowed(INTERPOLATIONS)})")
         deg = seg.interpolation_degree
         if not isinstance(deg, (int, np.integer)) or isinstance(deg, bool) or deg < 1:
             raise ValueError(f"{p}.interpolation_degree = {deg!r}: must be an int >= 1")

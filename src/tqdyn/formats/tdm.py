@@ -15,7 +15,11 @@ tables 3-2, 3-3 and 3-5; ``PARTICIPANT_n``, ``EPHEMERIS_NAME_n``,
 for n = 1..5); the mandatory CREATION_DATE, ORIGINATOR, TIME_SYSTEM,
 PARTICIPANT_1 are present; blocks are opened and closed in order; a data
 line has an epoch and a number; a keyword appears once in the header or a
-metadata block.  Writes are atomic (:func:`tqdyn.formats.atomic.replacing`).
+metadata block; epochs (data lines, START_TIME, STOP_TIME in the block's TIME_SYSTEM,
+CREATION_DATE in UTC) are calendar dates and times that exist
+(:func:`tqdyn.readers.dates.calendar_problem`: month, day, day of year, hour, minute, a second 60
+only in a UTC leap second) and START_TIME is not after STOP_TIME; data values are finite numbers
+(``1e999`` is refused at its line).  Writes are atomic (:func:`tqdyn.formats.atomic.replacing`).
 
 XML: the PyPI package ``ccsds-ndm`` (3.1.1, GPL-3.0-or-later, depends on
 ``lxml`` and ``xsdata``) reads and writes TDM XML and KVN through an object
@@ -26,15 +30,21 @@ independent reader and writer of tqdyn's measurement files, tests/test_od_files.
 
 from __future__ import annotations
 
+import datetime
+import math
 import pathlib
 import re
 from dataclasses import dataclass, field
+from decimal import Decimal
+from typing import NamedTuple
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
+from ..readers.dates import calendar_problem
 from .atomic import replacing
 
-__all__ = ["Tdm", "TdmSegment", "read_tdm", "parse_tdm", "format_tdm", "write_tdm"]
+__all__ = ["Tdm", "TdmEpoch", "TdmSegment", "read_tdm", "parse_epoch", "parse_tdm", "format_tdm", "write_tdm"]
 
 _HEADER = ("CREATION_DATE", "ORIGINATOR", "MESSAGE_ID")
 _META = {
@@ -55,18 +65,63 @@ _DATA = {
 }
 _DATA_N = re.compile(r"^(RECEIVE_FREQ|TRANSMIT_FREQ|TRANSMIT_FREQ_RATE|RECEIVE_PHASE_CT|TRANSMIT_PHASE_CT)_[1-5]$")
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")
+_EPOCH = re.compile(r"^(\d{4})-(?:(\d{2})-(\d{2})|(\d{3}))T(\d{2}):(\d{2}):(\d{2})(?:\.(\d*))?Z?$")
+_EPOCH_FORMS = "YYYY-MM-DDThh:mm:ss[.d] or YYYY-DDDThh:mm:ss[.d]"
+
+
+class TdmEpoch(NamedTuple):
+    """The fields of a TDM epoch text: calendar date (``day_of_year`` for the YYYY-DDD form, else
+    0), hour, minute, whole second and the fraction's digits (text, may be empty)."""
+
+    year: int
+    month: int
+    day: int
+    hour: int
+    minute: int
+    second: int
+    fraction: str
+    day_of_year: int = 0
+
+    def key(self) -> tuple:
+        """A key that orders the epochs of one time scale in time."""
+        return (datetime.date(self.year, self.month, self.day).toordinal(), self.hour, self.minute, self.second,
+                Decimal("0." + self.fraction) if self.fraction else Decimal(0))
+
+
+def parse_epoch(text: str, time_system: str) -> TdmEpoch:
+    """The fields of the epoch ``text`` (YYYY-MM-DDThh:mm:ss[.d] or YYYY-DDDThh:mm:ss[.d], optional
+    trailing Z) of the time scale ``time_system``; ValueError with one phrase (what is wrong and
+    what is allowed: :func:`tqdyn.readers.dates.calendar_problem`) if it is not an instant."""
+    m = _EPOCH.match(text)
+    if m is None:
+        raise ValueError(f"epoch {text!r} is not {_EPOCH_FORMS}")
+    y, mo, d, doy, hh, mi, ss, frac = m.groups()
+    y, hh, mi, ss = int(y), int(hh), int(mi), int(ss)
+    sec = ss + (float("0." + frac) if frac else 0.0)
+    if doy is not None:
+        why = calendar_problem(y, None, None, hh, mi, sec, day_of_year=int(doy), scale=time_system)
+    else:
+        why = calendar_problem(y, int(mo), int(d), hh, mi, sec, scale=time_system)
+    if why is not None:
+        raise ValueError(f"epoch {text!r}: {why}")
+    if doy is not None:
+        date = datetime.date(y, 1, 1) + datetime.timedelta(days=int(doy) - 1)
+        return TdmEpoch(y, date.month, date.day, hh, mi, ss, frac or "", int(doy))
+    return TdmEpoch(y, int(mo), int(d), hh, mi, ss, frac or "")
 
 
 @dataclass
 class TdmSegment:
     """One metadata block and its data block.  metadata: keyword -> value
     text (file order); meta_comments, data_comments: COMMENT texts; data:
-    list of (keyword, epoch text, value text)."""
+    list of (keyword, epoch text, value text); lines: the file's line number
+    of each data line (empty for a message built in memory; not compared)."""
 
     metadata: dict = field(default_factory=dict)
     meta_comments: list = field(default_factory=list)
     data: list = field(default_factory=list)
     data_comments: list = field(default_factory=list)
+    lines: list = field(default_factory=list, compare=False, repr=False)
 
     def observations(self, keyword: str) -> tuple[list[str], np.ndarray]:
         """Epoch texts and float values (n,) of the data lines with ``keyword``
@@ -100,9 +155,16 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
     state = "start"            # start, header, meta, between, data
     seg: TdmSegment | None = None
     last = 0
+    meta_lines: dict = {}      # keyword -> line of the current metadata block
 
     def bad(n: int, fld: str, why: str) -> ValueError:
         return ValueError(f"{name}, line {n}: {fld}: {why}")
+
+    def epoch(n: int, fld: str, text: str, time_system: str) -> TdmEpoch:
+        try:
+            return parse_epoch(text, time_system)
+        except ValueError as exc:
+            raise bad(n, fld, str(exc)) from None
 
     for n, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
@@ -143,11 +205,17 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
                     raise bad(n, "DATA_START", "the previous metadata block has no data block")
                 seg = TdmSegment()
                 tdm.segments.append(seg)
+                meta_lines = {}
                 state = "meta"
             elif line == "META_STOP":
                 for req in ("TIME_SYSTEM", "PARTICIPANT_1"):
                     if req not in seg.metadata:
                         raise bad(n, req, "missing from the metadata block (mandatory)")
+                span = {k: epoch(meta_lines[k], k, seg.metadata[k], seg.metadata["TIME_SYSTEM"])
+                        for k in ("START_TIME", "STOP_TIME") if k in seg.metadata}
+                if len(span) == 2 and span["START_TIME"].key() > span["STOP_TIME"].key():
+                    raise bad(meta_lines["STOP_TIME"], "STOP_TIME", f"{seg.metadata['STOP_TIME']!r} is before "
+                              f"START_TIME {seg.metadata['START_TIME']!r}; allowed: STOP_TIME >= START_TIME")
                 state = "between"
             elif line == "DATA_START":
                 state = "data"
@@ -162,11 +230,14 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
             raise bad(n, "line", f"{line!r} is not 'KEYWORD = value'")
         if state == "header":
             if k not in _HEADER:
-                raise bad(n, k, f"not a TDM header keyword; expected one of {', '.join(_HEADER)} or COMMENT")
+                raise bad(n, k, f"not a TDM header keyword{did_you_mean(k, _HEADER)}; expected one of "
+                                f"{allowed(_HEADER)} or COMMENT")
             if k in tdm.header:
                 raise bad(n, k, "appears twice in the header")
             if not v:
                 raise bad(n, k, "has no value")
+            if k == "CREATION_DATE":
+                epoch(n, k, v, "UTC")
             tdm.header[k] = v
         elif state == "meta":
             if not _is_meta(k):
@@ -176,6 +247,7 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
             if not v:
                 raise bad(n, k, "has no value")
             seg.metadata[k] = v
+            meta_lines[k] = n
         elif state == "data":
             if not _is_data(k):
                 raise bad(n, k, "not a TDM data keyword (CCSDS 503.0-B-2 table 3-5)")
@@ -184,9 +256,12 @@ def parse_tdm(text: str, name: str = "<tdm>") -> Tdm:
                 raise bad(n, k, f"{v!r} is not 'epoch value'")
             if not _NUMBER.match(parts[1]):
                 raise bad(n, k, f"value {parts[1]!r} is not a number")
-            if not re.match(r"^\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d*)?Z?$", parts[0]):
-                raise bad(n, k, f"epoch {parts[0]!r} is not YYYY-MM-DDThh:mm:ss[.d] or YYYY-DDDThh:mm:ss[.d]")
+            if not math.isfinite(float(parts[1].replace("d", "e").replace("D", "e"))):
+                raise bad(n, k, f"value {parts[1]!r} is not finite; allowed: a number within float64's range "
+                                "(|x| < 1.8e308)")
+            epoch(n, k, parts[0], seg.metadata["TIME_SYSTEM"])
             seg.data.append((k, parts[0], parts[1]))
+            seg.lines.append(n)
         else:
             raise bad(n, k, "keyword outside the header, a metadata or a data block")
     if state == "start":

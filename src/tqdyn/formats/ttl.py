@@ -14,7 +14,7 @@ The layout is exactly that of LISA Instrument 2.3's ``lisainstrument.ttl.ttl_fil
 
 tqdyn adds root attributes that LISA Instrument ignores (:data:`TQDYN_ATTRS`).  The file is written to a
 hidden temporary file beside the output and renamed into place when complete
-(:func:`tqdyn.formats.atomic.replacing`): an error, a full disk or Ctrl-C leaves the output path as it
+(:func:`tqdyn.formats.atomic.replacing_h5`): an error, a full disk or Ctrl-C leaves the output path as it
 was.  Units SI.
 """
 
@@ -26,9 +26,10 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
+from .._choices import unknown
 from .._version import __version__ as _TQDYN_VERSION
 from ..ttl.coupling import LINEAR_FIELDS, MOSAS
-from .atomic import replacing
+from .atomic import replacing_h5
 from .trajectory import check_writable
 
 __all__ = ["DATASET_SUFFIX", "ORDERS", "TQDYN_ATTRS", "TTLFile", "TTLFileError", "read_ttl_file", "write_ttl_file"]
@@ -38,6 +39,8 @@ DATASET_SUFFIX = {"local_phi": "phi_rx", "distant_phi": "phi_tx", "local_eta": "
 #: Spline degrees LISA Instrument 2.3 accepts (``TTLSourceInterp``).
 ORDERS = (3, 5)
 #: The root attributes tqdyn adds (LISA Instrument reads none of them).
+#: Where the attributes are listed.
+ATTRS_DOC = "docs/tilt-to-length.md#time-varying-coefficients-and-lisa-instruments-coefficient-file"
 TQDYN_ATTRS = {
     "tqdyn_version": "str, version of tqdyn that wrote the file",
     "time_axis": "str, what t is",
@@ -95,9 +98,9 @@ def write_ttl_file(path, t, coefficients: dict, order: int = 5, attrs: dict | No
     extra = {"tqdyn_version": _TQDYN_VERSION, **{k: str(v) for k, v in (attrs or {}).items()}}
     bad = [k for k in extra if k not in TQDYN_ATTRS]
     if bad:
-        raise ValueError(f"attrs: unknown attribute {bad[0]!r}; allowed: {', '.join(TQDYN_ATTRS)}")
+        raise ValueError(unknown("attrs", bad[0], TQDYN_ATTRS, ATTRS_DOC, problem="is not an attribute of the file"))
     out = check_writable(path)
-    with replacing(out, "TTL coefficient file") as tmp, h5py.File(tmp, "x") as h5:
+    with replacing_h5(out, "TTL coefficient file") as h5:
         h5.attrs["interpolation_order"] = int(order)
         for k, v in extra.items():
             h5.attrs[k] = v

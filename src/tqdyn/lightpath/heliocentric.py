@@ -30,6 +30,7 @@ import tomllib
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from ..forces.body_gms import BODY_GM_KEYS
 from ..astro.ephemeris import HELIOCENTRIC_BODIES, Ephemeris, default_ephemeris, planetary_gm
 from ..astro.reference import HELIOCENTRIC
@@ -87,7 +88,8 @@ def resolve_bodies(spec, trajectory=None) -> tuple[str, ...]:
     for b in spec:
         key = str(b).lower()
         if key not in HELIOCENTRIC_BODIES:
-            raise ValueError(f"body {b!r} is not allowed; allowed: {', '.join(HELIOCENTRIC_BODIES)}, or "
+            raise ValueError(f"body {b!r} is not allowed{did_you_mean(key, HELIOCENTRIC_BODIES)}; allowed: "
+                             f"{allowed(HELIOCENTRIC_BODIES)}, or "
                              f"{' / '.join(repr(s) for s in BODY_SETS)} (the Sun is the central body)")
         if key not in out:
             out.append(key)

@@ -114,6 +114,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._choices import unknown
 from ..astro.constants import C_LIGHT
 from ..astro.reference import GEOCENTRIC
 from ..constellation.indices import LINK_EMITTER, LINK_EMITTER_MOSA, LINK_RECEIVER, LINK_RECEIVER_MOSA
@@ -186,7 +187,7 @@ def link_bodies(x: np.ndarray, layout: str) -> tuple[np.ndarray, np.ndarray]:
         return x[:, _RECV_SAT, _RECV_MOSA], x[:, _EMIT_SAT, _EMIT_MOSA]
     if layout == "sat":
         return x[:, _RECV_SAT], x[:, _EMIT_SAT]
-    raise ValueError(f"layout: {layout!r} is not allowed; allowed: {', '.join(BODY_LAYOUTS)}")
+    raise ValueError(unknown("layout", layout, BODY_LAYOUTS))
 
 
 def _check_times(t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:

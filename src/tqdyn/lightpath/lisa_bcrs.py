@@ -39,6 +39,7 @@ from typing import Any
 import erfa
 import numpy as np
 
+from .._choices import unknown
 from ..astro.constants import J2000_JD
 from ..astro.geocentric import TDB_TO_TT_SCALE, gcrs_to_bcrs_states
 from ..astro.timescales import TCB_SCALE, tcb_origin_offset, tdb_jd, tdb_to_tcb
@@ -89,7 +90,7 @@ def lisa_orbit_quantities_bcrs(trajectory, *, shapiro: bool | None = None, gm_ea
     (TT-compatible; None for heliocentric runs) [m^3/s^2].
     """
     if axes not in BCRS_AXES:
-        raise ValueError(f"axes = {axes!r} is not allowed; allowed: {', '.join(BCRS_AXES)}")
+        raise ValueError(unknown("axes", axes, BCRS_AXES))
     ref = trajectory.reference
     helio = ref.origin == "sun"
     shapiro = helio if shapiro is None else bool(shapiro)

@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._choices import unknown
 from ..astro.constants import C_LIGHT, L_B
 from ..astro.reference import GEOCENTRIC
 from ..astro.timescales import TCB_SCALE, TCB_SCALE_MINUS_1
@@ -107,7 +108,7 @@ def proper_time_deviation_bcrs(t, r, v, a, *, origin_velocity, origin_accelerati
     = d delta_tau / d(against) [s/s]; rate_dot = d rate / d(against) [1/s].
     """
     if against not in PROPER_TIME_SCALES:
-        raise ValueError(f"against = {against!r}; allowed: {', '.join(PROPER_TIME_SCALES)}")
+        raise ValueError(unknown("against", against, PROPER_TIME_SCALES))
     r, v, a = (np.asarray(x, np.float64) for x in (r, v, a))
     if r.ndim != 3 or r.shape[-1] != 3 or v.shape != r.shape or a.shape != r.shape:
         raise ValueError(f"r, v, a: shapes {r.shape}, {v.shape}, {a.shape}; allowed: equal, (N, B, 3)")

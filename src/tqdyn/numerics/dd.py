@@ -50,7 +50,7 @@ from numba.extending import intrinsic, overload
 
 __all__ = [
     "add", "add_acc", "sub", "mul", "div", "sqrt", "neg", "fma_", "to_f64",
-    "ld", "st", "const", "lo_part",
+    "ld", "st", "const", "lo_part", "copy_columns",
     "two_sum", "two_prod", "fast_two_sum",
     "dd_from_mp", "dd_array_from_mp", "mp_from_dd", "mp_from_pair", "split_dd", "join_dd",
     "np_two_sum", "np_two_prod", "mp_exact", "np_fast_two_sum", "np_dd_add", "np_dd_sqr",
@@ -369,6 +369,16 @@ def _ov_st(arr, value, *idx):
         def impl(arr, value, *idx):
             arr[idx] = value[0]
         return impl
+
+
+@njit(inline="always")
+def copy_columns(src, dst, q0, n):
+    """dst[b, q] = src[b, q0 + q] for every row b and q < n (generic: both
+    parts of dd arrays).  An element loop: numpy's array assignment would
+    also compile its shape checks and their error messages into the kernel."""
+    for b in range(src.shape[0]):
+        for q in range(n):
+            st(dst, ld(src, b, q0 + q), b, q)
 
 
 # --------------------------------------------------------------------------

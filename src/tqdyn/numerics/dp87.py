@@ -33,6 +33,7 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
+from .._choices import unknown
 from .dd import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
 
@@ -79,7 +80,7 @@ class Tableau:
 def load_tableau(name: str = "corrected") -> Tableau:
     """The RK8(7)13M tableau ``name`` ("corrected" | "published") as exact numbers."""
     if name not in TABLEAUX:
-        raise ValueError(f"integrator.tableau: {name!r} is not known; allowed: {', '.join(TABLEAUX)}")
+        raise ValueError(unknown("integrator.tableau", name, TABLEAUX, problem="is not known"))
     suffix = name.upper()
     rows = getattr(_tab, f"A_{suffix}")
     a = tuple(tuple(_exact(rows[i][j]) if j < i else Fraction(0) for j in range(_N)) for i in range(_N))

@@ -30,8 +30,10 @@ import shutil
 import time
 
 import numba
+from numba.core import types as _types
+from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "install_cache_locator", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "install_cache_locator", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
@@ -113,6 +115,21 @@ def install_cache_locator() -> bool:
     except OSError:
         pass  # a read-only or vanished cache folder: nothing to clean
     return True
+
+
+@intrinsic
+def dynamic(typingctx, x):
+    """``x`` itself, typed as a run-time value (compiled code only).
+
+    numba compiles a jitted function once more for every distinct constant
+    passed to it from other compiled code (a literal argument type); a
+    constant wrapped in ``dynamic`` is passed as a plain int / float / bool,
+    so all such calls share one compiled version.  Costs nothing at run time.
+    """
+    def codegen(context, builder, signature, args):
+        return context.cast(builder, args[0], signature.args[0], signature.return_type)
+
+    return _types.unliteral(x)(x), codegen
 
 
 def _touch(path: pathlib.Path) -> None:

@@ -46,6 +46,7 @@ from numba import njit
 
 from . import _multistep_coefficients as _tab
 from .dd import add, dd_from_mp, div, ld, mp_exact, mul, st, sub, to_f64
+from .jit import dynamic
 
 __all__ = ["ORDERS", "CORRECTORS", "DEFAULT_ORDER", "DEFAULT_CORRECTOR", "Coefficients", "load_coefficients",
            "StepCoefficients", "step_coefficients", "predict", "correct", "commit", "start", "max_change", "ROW_NAMES"]
@@ -147,8 +148,8 @@ def predict(S, cS, s, cs, F, head, coef, hh, out):
     h, h2 = ld(hh, 0), ld(hh, 1)
     for b in range(S.shape[0]):
         for q in range(3):
-            accr = _weighted(F, head, _PP, coef, b, q, ld(cS, b, q), False, out, 0)
-            accv = _weighted(F, head, _PV, coef, b, q, ld(cs, b, q), False, out, 0)
+            accr = _weighted(F, head, dynamic(_PP), coef, b, q, ld(cS, b, q), dynamic(False), out, dynamic(0))
+            accv = _weighted(F, head, dynamic(_PV), coef, b, q, ld(cs, b, q), dynamic(False), out, dynamic(0))
             st(out, mul(add(ld(S, b, q), accr), h2), b, q)
             st(out, mul(add(ld(s, b, q), accv), h), b, q + 3)
 
@@ -161,8 +162,8 @@ def correct(S, cS, s, cs, F, head, k, coef, hh, out):
     h, h2 = ld(hh, 0), ld(hh, 1)
     for b in range(S.shape[0]):
         for q in range(3):
-            accr = _weighted(F, head, _CP, coef, b, q, ld(cS, b, q), True, k, 1)
-            accv = _weighted(F, head, _CV, coef, b, q, ld(cs, b, q), True, k, 1)
+            accr = _weighted(F, head, dynamic(_CP), coef, b, q, ld(cS, b, q), dynamic(True), k, dynamic(1))
+            accv = _weighted(F, head, dynamic(_CV), coef, b, q, ld(cs, b, q), dynamic(True), k, dynamic(1))
             st(out, mul(add(ld(S, b, q), accr), h2), b, q)
             st(out, mul(add(ld(s, b, q), accv), h), b, q + 3)
 

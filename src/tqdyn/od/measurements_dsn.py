@@ -44,6 +44,7 @@ from __future__ import annotations
 import erfa
 import numpy as np
 
+from .._choices import unknown
 from ..astro.ephemeris import default_ephemeris, planetary_gm
 from ..astro.reference import HELIOCENTRIC
 from ..astro.timescales import tdb_minus_tt
@@ -78,7 +79,8 @@ def station_itrs(stations=None) -> tuple[list[str], np.ndarray]:
     names = list(DEEP_SPACE_STATIONS) if stations is None else list(stations)
     bad = [s for s in names if s not in DEEP_SPACE_STATIONS]
     if bad:
-        raise ValueError(f"deep-space station {bad[0]!r} is not allowed; expected one of {sorted(DEEP_SPACE_STATIONS)}")
+        raise ValueError(unknown("deep-space station", bad[0], DEEP_SPACE_STATIONS,
+                                 "docs/orbit-determination.md#measurement-models", noun="stations"))
     return names, np.array([DEEP_SPACE_STATIONS[s] for s in names])
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from ..astro.constants import J2000_JD
 from ..readers.sinex import shipped_slrf, station_position
 from .measurements import Observable, geocentric_two_way
@@ -33,6 +34,8 @@ from .measurements import Observable, geocentric_two_way
 __all__ = ["ILRS_STATIONS", "SLR_SIGMA_M", "slr_range", "slr_station_positions"]
 
 #: A handful of ILRS stations: name -> (ILRS 4-digit code, SINEX point code).
+#: Where the stations are listed.
+_DOC = "docs/orbit-determination.md#measurement-models"
 ILRS_STATIONS = {
     "Yarragadee": ("7090", "A"),
     "Monument Peak": ("7110", "A"),
@@ -68,8 +71,8 @@ def slr_station_positions(epoch, stations=None) -> tuple[list[str], np.ndarray]:
         code, pt = ILRS_STATIONS[s] if isinstance(s, str) and s in ILRS_STATIONS else (s if isinstance(s, tuple) else (None, None))
         sols = [x for x in catalogue if x.code == code and x.point == pt]
         if not sols:
-            raise ValueError(f"SLR station {s!r} is not allowed: not in SLRF2020; "
-                             f"expected one of {sorted(ILRS_STATIONS)} or an (ILRS code, point) pair")
+            raise ValueError(f"SLR station {s!r} is not allowed: not in SLRF2020{did_you_mean(s, ILRS_STATIONS)}; "
+                             f"allowed: {allowed(ILRS_STATIONS, _DOC, noun='stations')} or an (ILRS code, point) pair")
         valid = [x for x in sols if x.start <= year <= x.end] or sorted(sols, key=lambda x: x.soln)[-1:]
         out.append(station_position(valid[0], year))
         labels.append(s if isinstance(s, str) else f"{code} {pt}")

@@ -59,6 +59,7 @@ import math
 import numpy as np
 from scipy import linalg, sparse
 
+from .._choices import did_you_mean
 from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
 from . import coupled, estimator
@@ -230,8 +231,10 @@ def measurement_biases(scen, meas: Measurements, bias: dict) -> np.ndarray:
             continue
         name = key if key.startswith("bias/") else f"bias/{key}"
         if name not in known:
-            fail(f"bias: {key!r} is not a bias of these measurements; allowed: a type of {', '.join(BIAS_TYPES)} "
-                 f"or one of {', '.join(n[5:] for n in known) or '(none)'}")
+            names = [n[5:] for n in known]  # "TYPE/PEER": a typo of one is suggested, not any of the same type
+            example = f" as {names[0]!r}" if names else ""
+            fail(f"bias: {key!r} is not a bias of these measurements{did_you_mean(key, names, cutoff=0.85)}; "
+                 f"allowed: a type of {', '.join(BIAS_TYPES)}, or TYPE/PEER{example}")
         out[keys == name] = v
     return out
 

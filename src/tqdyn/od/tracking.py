@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import allowed, shown, unknown
 from ..astro.ephemeris import ephemeris_named, planetary_gm
 from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from ..dynamics.empirical import PARAMETER_NAMES
@@ -48,6 +49,8 @@ COUPLED_GROUPS = ("state", "self_gravity_common", "bias")
 #: ground station and type (SLR and deep-space: the station's range calibration, its frequency
 #: offset) and one per one-way inter-satellite link (the ranging offsets of its two ends).
 #: GNSS pseudoranges have none: a bias common to a receiver's pseudoranges is its clock.
+#: Where the SLR and deep-space stations are listed.
+STATIONS_DOC = "docs/orbit-determination.md#measurement-models"
 BIAS_TYPES = ("slr_range", "isr_range", "dsn_range", "dsn_range_rate")
 #: The groups estimated when a plan names none: point-mass runs, coupled runs.
 DEFAULT_ESTIMATE = ("state", "s_frame")
@@ -92,7 +95,7 @@ class Tracking:
         kinds = (self.kinds,) if isinstance(self.kinds, str) else tuple(self.kinds)
         for k in kinds:
             if k not in TRACKING_KINDS:
-                fail(f"tracking.kinds: {k!r} is not allowed; allowed: {', '.join(TRACKING_KINDS)}")
+                fail(unknown("tracking.kinds", k, TRACKING_KINDS))
         if not kinds or len(set(kinds)) != len(kinds):
             fail(f"tracking.kinds: {kinds!r}; allowed: distinct kinds of {', '.join(TRACKING_KINDS)}")
         object.__setattr__(self, "kinds", kinds)
@@ -104,7 +107,7 @@ class Tracking:
             fail(f"tracking.interval_s: {self.interval_s} s is longer than the arc ({self.arc_s} s)")
         for key, v in (self.sigma or {}).items():
             if key not in MEASUREMENT_TYPES:
-                fail(f"tracking.sigma: {key!r} is not allowed; allowed: {', '.join(MEASUREMENT_TYPES)}")
+                fail(unknown("tracking.sigma", key, MEASUREMENT_TYPES))
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 fail(f"tracking.sigma[{key!r}] = {v!r}; allowed: a finite number > 0 (m or m/s)")
         for name in ("estimate", "consider"):
@@ -113,7 +116,7 @@ class Tracking:
             groups = (getattr(self, name),) if isinstance(getattr(self, name), str) else tuple(getattr(self, name))
             for g in groups:
                 if g not in GROUPS:
-                    fail(f"tracking.{name}: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
+                    fail(unknown(f"tracking.{name}", g, GROUPS))
             object.__setattr__(self, name, groups)
         if self.estimate is not None and not self.estimate:
             fail(f"tracking.estimate: empty; allowed: groups of {', '.join(GROUPS)}")
@@ -122,12 +125,11 @@ class Tracking:
             fail(f"tracking.consider: {sorted(both)[0]!r} is also estimated; a group is estimated or considered")
         for g, v in (self.a_priori_sigma or {}).items():
             if g not in GROUPS:
-                fail(f"tracking.a_priori_sigma: {g!r} is not allowed; allowed: {', '.join(GROUPS)}")
+                fail(unknown("tracking.a_priori_sigma", g, GROUPS))
             if g == "bias" and isinstance(v, dict):
                 for typ, x in v.items():
                     if typ not in BIAS_TYPES:
-                        fail(f"tracking.a_priori_sigma['bias']: {typ!r} is not allowed; allowed: "
-                             f"{', '.join(BIAS_TYPES)}")
+                        fail(unknown("tracking.a_priori_sigma['bias']", typ, BIAS_TYPES))
                     if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
                         fail(f"tracking.a_priori_sigma['bias'][{typ!r}] = {x!r}; allowed: a finite number > 0 "
                              f"(m, m/s for dsn_range_rate)")
@@ -145,8 +147,8 @@ class Tracking:
             st = (self.stations,) if isinstance(self.stations, str) else tuple(self.stations)
             for s in st:
                 if s not in ILRS_STATIONS and s not in DEEP_SPACE_STATIONS:
-                    fail(f"tracking.stations: {s!r} is not allowed; allowed: SLR "
-                         f"{', '.join(ILRS_STATIONS)}; deep-space {', '.join(DEEP_SPACE_STATIONS)}")
+                    fail(unknown("tracking.stations", s, [*ILRS_STATIONS, *DEEP_SPACE_STATIONS], STATIONS_DOC,
+                                 noun="stations"))
             object.__setattr__(self, "stations", st)
         if self.gnss_orbits is not None:
             orbits = tuple(self.gnss_orbits) if isinstance(self.gnss_orbits, (list, tuple)) else (self.gnss_orbits,)
@@ -192,8 +194,8 @@ class Tracking:
         cat = ILRS_STATIONS if kind == "slr" else DEEP_SPACE_STATIONS
         names = [s for s in self.stations if s in cat]
         if not names:
-            fail(f"tracking.stations: none of {list(self.stations)} is a{'n SLR' if kind == 'slr' else ' deep-space'} "
-                 f"station (tracking kind {kind!r}); allowed: {', '.join(cat)}")
+            fail(f"tracking.stations: {shown(list(self.stations))} has no {'SLR' if kind == 'slr' else 'deep-space'} "
+                 f"station (tracking {kind!r}); allowed: {allowed(cat, STATIONS_DOC, noun='stations')}")
         return names
 
 

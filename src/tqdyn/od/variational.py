@@ -63,7 +63,7 @@ from ..numerics import dp87
 from ..scenario import load_scenario
 from .parameters import OrbitParameters, per_satellite_names, scenario_with, state_names
 
-__all__ = ["Partials", "propagate_dd", "propagate_with_partials"]
+__all__ = ["Partials", "off_grid", "propagate_dd", "propagate_with_partials"]
 
 _FD_REL = 6e-6  # central-difference step relative to |r|, |v| (eps^(1/3))
 _BLOCK = 256    # steps per evaluation of the time-only inputs
@@ -114,14 +114,24 @@ def _load(scenario):
     return load_scenario(scenario) if isinstance(scenario, str) else scenario
 
 
+def off_grid(t, step: float) -> np.ndarray:
+    """True where t [s] (n,) is not a non-negative multiple of step [s] (to 1e-9 relative, 1e-9 s
+    below 1 s: the 1 ns digits of a measurement file's epochs)."""
+    t = np.asarray(t, np.float64)
+    k = np.rint(t / step)
+    return ~np.isfinite(t) | (k < 0) | (np.abs(k * step - t) > 1e-9 * np.maximum(1.0, np.abs(t)))
+
+
 def _grid(t_out, step: float, name: str) -> np.ndarray:
     """Step indices of t_out [s] on the grid k step (ValueError naming ``name`` otherwise)."""
     t = np.atleast_1d(np.asarray(t_out, np.float64))
-    k = np.rint(t / step)
-    if t.ndim != 1 or np.any(k < 0) or np.any(np.abs(k * step - t) > 1e-9 * np.maximum(1.0, np.abs(t))):
-        raise ValueError(f"t_out: {t_out!r} is not on the grid of {name} = {step} s; "
-                         f"allowed: non-negative multiples of {step} s")
-    return k.astype(np.int64)
+    if t.ndim != 1:
+        raise ValueError(f"t_out: shape {t.shape}; allowed: a 1-D array of times [s]")
+    bad = np.flatnonzero(off_grid(t, step))
+    if bad.size:
+        raise ValueError(f"t_out: {bad.size} of {t.size} times are not on the grid of {name} = {step} s, the first "
+                         f"t_out[{bad[0]}] = {t[bad[0]]!r} s; allowed: non-negative multiples of {step} s")
+    return np.rint(t / step).astype(np.int64)
 
 
 def propagate_dd(scenario, parameters: OrbitParameters | None = None, t_out=None):

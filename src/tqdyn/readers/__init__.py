@@ -8,6 +8,7 @@ leap-second table (:mod:`.leap_seconds`; these three from the
 ``astropy-iers-data`` package), NAIF kernels (:mod:`.naif`, :mod:`.pck`), CCSDS orbit ephemeris messages
 (:mod:`.oem`: OEM files as arrays and segments; their states are :mod:`tqdyn.astro.oem_states`),
 GNSS precise orbits in SP3-c/d (:mod:`.sp3`; their GCRS states are :mod:`tqdyn.od.gnss_sp3`),
-the Doodson notation (:mod:`.doodson`) and the shipped data (:mod:`.files`).
+the Doodson notation (:mod:`.doodson`), the shipped data (:mod:`.files`) and the calendar checks
+of the dates read from files (:mod:`.dates`).
 This layer imports nothing of tqdyn but :mod:`tqdyn.astro.constants`.
 """

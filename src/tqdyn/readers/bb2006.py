@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from .doodson import doodson_multipliers
 
 __all__ = [
@@ -138,8 +139,9 @@ def parse_bb2006(lines) -> AtmosphericTideModel:
     for wave in dict.fromkeys(r[0] for r in rows):
         number = declared.get(wave, DOODSON_NUMBERS.get(wave))
         if number is None:
-            raise ValueError(f"atmospheric-tide file: wave {wave!r} has no Doodson number "
-                             f"(header 'NAME (Doodson ABC.DEF)' or one of {sorted(DOODSON_NUMBERS)})")
+            raise ValueError(f"atmospheric-tide file: wave {wave!r} has no Doodson number"
+                             f"{did_you_mean(wave, DOODSON_NUMBERS)}; allowed: a header 'NAME (Doodson ABC.DEF)' "
+                             f"or {allowed(sorted(DOODSON_NUMBERS), noun='waves')}")
         numbers[wave] = number
     return AtmosphericTideModel(
         wave=tuple(r[0] for r in rows),

@@ -65,6 +65,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._choices import unknown
+
 __all__ = [
     "EGM2008_FILE",
     "GL0660B_FILE",
@@ -138,7 +140,7 @@ class GravityModel:
         if self.normalization != "full":
             raise ValueError(f"{self.name}: normalization {self.normalization!r}; only 'full' is stored")
         if self.tide_system not in TIDE_SYSTEMS:
-            raise ValueError(f"{self.name}: tide_system {self.tide_system!r} not one of {TIDE_SYSTEMS}")
+            raise ValueError(unknown(f"{self.name}: tide_system", self.tide_system, TIDE_SYSTEMS))
         C.setflags(write=False)
         S.setflags(write=False)
         object.__setattr__(self, "C", C)

@@ -54,6 +54,7 @@ from fractions import Fraction
 import erfa
 import numpy as np
 
+from .._choices import allowed, did_you_mean
 from ..astro.constants import DAY_S
 
 __all__ = [
@@ -218,7 +219,10 @@ def epoch_text(jd1, jd2) -> str:
 # ------------------------------------------------------------------ reading
 
 def _one_line(exc: BaseException) -> str:
+    """The exception in one line: its text (a ValueError's alone), after its type."""
     text = " ".join(str(exc).split())
+    if text and isinstance(exc, ValueError):
+        return text
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
@@ -254,10 +258,12 @@ def _metadata(src: str, k: int, nseg: int, meta: dict, rows) -> dict:
 
     frame = field("REF_FRAME").upper()
     if frame not in REF_FRAMES:
-        raise ValueError(f"{where}: REF_FRAME = {frame!r} is not supported (allowed: {', '.join(REF_FRAMES)})")
+        raise ValueError(f"{where}: REF_FRAME = {frame!r} is not supported{did_you_mean(frame, REF_FRAMES)} "
+                         f"(allowed: {allowed(REF_FRAMES)})")
     tsys = field("TIME_SYSTEM").upper()
     if tsys not in TIME_SYSTEMS:
-        raise ValueError(f"{where}: TIME_SYSTEM = {tsys!r} is not supported (allowed: {', '.join(TIME_SYSTEMS)})")
+        raise ValueError(f"{where}: TIME_SYSTEM = {tsys!r} is not supported{did_you_mean(tsys, TIME_SYSTEMS)} "
+                         f"(allowed: {allowed(TIME_SYSTEMS)})")
     if not rows:
         raise ValueError(f"{where}: the data section has no state vectors (truncated file?)")
     jd = np.array([_epoch_jd(str(row[0]), where, f"epoch of record {i + 1}") for i, row in enumerate(rows)],
@@ -391,15 +397,14 @@ def _check_order(src: str, metas: list[dict]) -> None:
     and TIME_SYSTEM, usable spans in time order, not overlapping; one line naming both segments' spans."""
     for k in range(1, len(metas)):
         a, b = metas[k - 1], metas[k]
-        where = f"{src}: segments {k} ({_label(a['texts'])}) and {k + 1} ({_label(b['texts'])})"
+        where = f"{src}: segments {k} and {k + 1}"
         for key in ("object_id", "time_system"):
             if a[key] != b[key]:
                 raise ValueError(f"{where} differ in {key.upper()} ({a[key]!r}, {b[key]!r}); allowed: one object in "
-                                 "one time system per file (CCSDS 502.0-B-2, 5.1.3)")
+                                 "one time system per file (CCSDS 502.0-B-2 5.1.3)")
         if _dsec(*b["start"], *a["stop"]) < -_same_epoch(a["texts"][1], b["texts"][0]):
-            raise ValueError(f"{where} overlap: segment {k + 1} starts before segment {k} stops; allowed: usable "
-                             "spans in time order, not overlapping (records may overlap outside "
-                             "USEABLE_START_TIME .. USEABLE_STOP_TIME; CCSDS 502.0-B-2)")
+            raise ValueError(f"{where} overlap: segment {k + 1} starts ({b['texts'][0]}) before segment {k} stops "
+                             f"({a['texts'][1]}); allowed: usable spans in time order")
 
 
 def read_oem_segments(path) -> list[OemTrajectory]:
@@ -414,9 +419,10 @@ def read_oem_segments(path) -> list[OemTrajectory]:
     return [traj for traj, _ in _read(path)]
 
 
-#: What :func:`read_oem` joins (the "allowed" of its messages).
-JOIN_RULE = ("segments of one CENTER_NAME and REF_FRAME, each starting where the previous one stops (records "
-             "may overlap outside USEABLE_START_TIME .. USEABLE_STOP_TIME), whose states agree there")
+#: What :func:`read_oem` joins (the "allowed" of its messages): segments of one CENTER_NAME and
+#: REF_FRAME, each starting where the previous one stops (records may overlap outside
+#: USEABLE_START_TIME .. USEABLE_STOP_TIME), whose states agree there.
+JOIN_RULE = "segments that join (docs/scenarios.md#oem-files)"
 
 
 def _join(src: str, parts: list[tuple[OemTrajectory, dict]]) -> OemTrajectory:
@@ -441,8 +447,7 @@ def _join(src: str, parts: list[tuple[OemTrajectory, dict]]) -> OemTrajectory:
         if why is None and gap > _same_epoch(a.stop_text, b.start_text):
             why = f"a gap of {gap:.9g} s ({gap / _DAY:.6g} d) between them"
         if why is not None:
-            raise ValueError(f"{src}: segments {k} ({a.label}) and {k + 1} ({b.label}) are not continuous: {why}; "
-                             f"allowed: {JOIN_RULE}")
+            raise ValueError(f"{src}: segments {k} and {k + 1} are not continuous: {why}; allowed: {JOIN_RULE}")
         if gap != 0:
             spans[k - 1] = dataclasses.replace(a, stop=b.start)
     first, last = segs[0], segs[-1]

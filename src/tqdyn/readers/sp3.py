@@ -22,7 +22,10 @@ What is read (columns are 1-based, as in the format documents):
 
 Returned in SI: positions [m] in the file's terrestrial frame, clocks [s], epochs as modified
 Julian day numbers and seconds of the day in the file's time system (:data:`TT_MINUS`: its offset
-to TT).  Malformed lines raise a one-line ``ValueError`` naming the file, the line and the field.
+to TT).  Malformed lines raise a one-line ``ValueError`` naming the file, the line and the field:
+a number that is not one or not finite, an epoch that is not a calendar date and time
+(:func:`tqdyn.readers.dates.calendar_problem`; the allowed time systems have no leap seconds, so
+second < 60), epochs not in increasing order, an epoch interval <= 0, a satellite count < 1.
 
 Consecutive files of the same satellites (the daily files of an analysis centre) are joined in
 time by :func:`merge_sp3`.
@@ -36,6 +39,8 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
+
+from .dates import calendar_problem
 
 __all__ = ["SP3Orbits", "TT_MINUS", "merge_sp3", "read_sp3"]
 
@@ -89,15 +94,12 @@ def _epoch(line: str, where: str, what: str) -> tuple[int, float]:
                 for lo, hi, n in ((4, 7, "year"), (9, 10, "month"), (12, 13, "day")))
     h, mi = _field(line, 15, 16, int, where, f"{what} hour"), _field(line, 18, 19, int, where, f"{what} minute")
     s = _field(line, 21, 31, float, where, f"{what} second")
-    try:
-        day = datetime.date(y, mo, d).toordinal() - _MJD_ORDINAL
-    except ValueError:
-        raise ValueError(f"{where}: {what} date {y:04d}-{mo:02d}-{d:02d} does not exist; allowed: a calendar date") \
-            from None
-    if not (0 <= h < 24 and 0 <= mi < 60 and 0 <= s < 61):
-        raise ValueError(f"{where}: {what} time {h:02d}:{mi:02d}:{s} is not allowed; allowed: hh 0-23, mm 0-59, "
-                         "ss.ssssssss 0-60")
-    return day, h * 3600.0 + mi * 60.0 + s
+    if not 1 <= y <= 9999:
+        raise ValueError(f"{where}: {what} year {y} is not allowed; allowed: 0001-9999")
+    why = calendar_problem(y, mo, d, h, mi, s, scale="GPS")  # the allowed time systems have no leap seconds
+    if why is not None:
+        raise ValueError(f"{where}: {what} {line[3:31].strip()!r}: {why}")
+    return datetime.date(y, mo, d).toordinal() - _MJD_ORDINAL, h * 3600.0 + mi * 60.0 + s
 
 
 def _sat_id(text: str) -> str:
@@ -129,6 +131,9 @@ def read_sp3(path) -> SP3Orbits:
     if len(lines) < 2 or not lines[1].startswith("##"):
         raise ValueError(f"{name}: line 2: missing the '##' line; allowed: an SP3-c or SP3-d header")
     interval = _field(lines[1].ljust(60), 25, 38, float, f"{name}: line 2", "epoch interval")
+    if not interval > 0:
+        raise ValueError(f"{name}: line 2: epoch interval (columns 25-38) = {interval:g} s is not allowed; allowed: "
+                         "a number of seconds > 0")
     sats: list[str] = []
     n_sats = None
     time_system = None
@@ -141,6 +146,9 @@ def read_sp3(path) -> SP3Orbits:
         if line.startswith("+ "):
             if n_sats is None:
                 n_sats = _field(line.ljust(60), 4, 6, int, where, "number of satellites")
+                if n_sats < 1:
+                    raise ValueError(f"{where}: number of satellites (columns 4-6) = {n_sats} is not allowed; "
+                                     "allowed: an integer >= 1")
             body = line[9:60]
             sats += [_sat_id(body[j:j + 3]) for j in range(0, len(body) - 2, 3)
                      if body[j:j + 3].strip() not in ("0", "00", "")]
@@ -151,6 +159,9 @@ def read_sp3(path) -> SP3Orbits:
                                  f"{', '.join(TT_MINUS)}")
         elif line.startswith("*"):
             epochs.append(_epoch(line.ljust(31), where, "epoch"))
+            if len(epochs) > 1 and epochs[-1] <= epochs[-2]:
+                raise ValueError(f"{where}: epoch {line[3:31].strip()!r} is not after the previous epoch; allowed: "
+                                 "epochs in increasing time order")
         elif line.startswith("P"):
             if not epochs:
                 raise ValueError(f"{where}: a position record before the first epoch line; allowed: '*' epoch first")

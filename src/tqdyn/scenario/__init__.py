@@ -26,7 +26,8 @@ TOML layout (every section and key optional except at least one
     [run]           duration ("10d", "12h", "30min", "3600s" or seconds),
                     precision ("dd" | "float64"), output, output_every,
                     max_steps (default 1e9: the most steps a run may have)
-    [integrator]    method ("dp87" | "multistep"), mode ("fixed" | "adaptive"), step [s],
+    [integrator]    method ("multistep" | "dp87"; not given: DEFAULT_METHOD with mode = "fixed",
+                    "dp87" adaptive), mode ("fixed" | "adaptive"), step [s],
                     tableau ("corrected" | "published"), rtol; multistep: order,
                     corrector ("pe" | "pec" | "pece" | "pecec" | "pecece")
     [forces]        earth_monopole, gm_earth [m^3/s^2], the force-model switches,

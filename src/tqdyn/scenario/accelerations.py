@@ -2,7 +2,8 @@
 
 Four optional keys, each an array with one 3-vector [m/s^2] per satellite (in the order of
 ``[[satellites]]``); absent keys are zero (the default: no such acceleration, and a run
-identical to one without the section)::
+identical to one without the section); each value finite, |value| <= 1e-3 m/s^2
+(:data:`tqdyn.scenario.values.MAX_ACCELERATION`)::
 
     [accelerations]
     s_frame = [[ax, ay, az], ...]   # constant, in the S frame of the constellation (3 satellites)
@@ -22,7 +23,7 @@ from decimal import Decimal
 import numpy as np
 
 from .toml_text import toml_value
-from .values import _num_array, _require, _set
+from .values import MAX_ACCELERATION, _num_array, _require, _set
 
 __all__ = ["ACCELERATION_KEYS", "AccelerationsConfig"]
 
@@ -48,7 +49,8 @@ class AccelerationsConfig:
                 _set(self, key, ())
                 continue
             n = len(value) if isinstance(value, (list, tuple)) else 1
-            _set(self, key, _num_array(value, f"accelerations.{key}", ((n, 3),), "m/s^2, one row per satellite"))
+            _set(self, key, _num_array(value, f"accelerations.{key}", ((n, 3),), "m/s^2, one row per satellite",
+                                       MAX_ACCELERATION))
 
     @property
     def nonzero(self) -> bool:

@@ -6,21 +6,25 @@ run's ``spacecraft.architecture``, and the settings' defaults of :data:`CLOSED_L
 (SI units; ASDs one-sided)::
 
     [closed_loop]
-    mission                       # "tianqin" | "lisa" | "taiji"
+    mission                       # one of MISSIONS: "tianqin" | "lisa" | "taiji" | "lpf" | "tianqin-1"
+    scheme                        # one of SCHEMES (default: the mission's, MISSION_SCHEME)
     fs                            # Hz, time-domain sample rate
-    duration                      # time-domain length ("3d" or s; default: the run's span)
+    duration                      # time-domain length ("3d" or s; default: the first day, or the run's span)
     seed                          # root seed of the noise realisations
     segment                       # frozen-coefficient segment length ("1d" or s)
     f_min, f_max, n_freq          # the budget's log frequency grid [Hz]
     attitude_z_sensor             # one of ATTITUDE_Z_SENSORS
     [closed_loop.plant]           # sc_mass [kg], sc_inertia [kg m^2] (3), tm_mass [kg], tm_side [m],
                                   # mosa_inertia [kg m^2], mosa_stiffness [N m/rad], stiffness [s^-2] (3),
-                                  # rotational_stiffness [s^-2] (3), crosstalk [1]
-    [closed_loop.controllers.<loop>]   # zeros, poles [rad/s; [re, im] for a conjugate pair], gain (LOOPS)
+                                  # rotational_stiffness [s^-2] (3), crosstalk [1], tm2_stiffness,
+                                  # tm2_rotational_stiffness [s^-2] (3, TM 2's when it differs),
+                                  # tm_separation [m] (single-spacecraft missions: the housings' distance)
+    [closed_loop.controllers.<loop>]   # zeros, poles [rad/s; [re, im] for a conjugate pair], gain
+                                       # (the loops of the scheme: SCHEME_LOOPS)
     [closed_loop.noise.<source>]       # level [unit/Hz^1/2], knees [[f Hz, slope], ...] (SOURCES)
 
-The loop and noise-source tables (:data:`LOOPS`, :data:`SOURCES`) live here, the lowest layer that
-names them; :mod:`tqdyn.closedloop` builds the loops from them.
+The loop and noise-source tables (:data:`LOOPS`, :data:`SCHEME_LOOPS`, :data:`SOURCES`) live here, the
+lowest layer that names them; :mod:`tqdyn.closedloop` builds the loops from them.
 
 The configuration is kept as given (sparse): :meth:`ClosedLoopConfig.to_toml_lines` writes back only the
 keys that were set, so scenarios without the section resolve to the same text as before it existed.
@@ -29,21 +33,34 @@ Errors are :class:`~tqdyn.scenario.values.ScenarioError` naming the key.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from decimal import Decimal
 from typing import Any
 
+from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
-from .values import ScenarioError, _one_of, _require
+from .values import ScenarioError, _require, _require_choice, _unknown_key
 
-__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "LOOPS", "MISSIONS", "PLANT_KEYS", "SOURCES",
-           "ClosedLoopConfig", "check_asd", "check_controller"]
+__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "COLLINEAR_LOOPS", "CONSTELLATION_MISSIONS", "DEFAULT_SERIES_S",
+           "LOOPS", "MISSIONS", "MISSION_SCHEME", "PLANT_KEYS", "SCHEMES", "SCHEME_LOOPS", "SINGLE_SPACECRAFT_MISSIONS",
+           "SINGLE_TM_LOOPS", "SOURCES", "ClosedLoopConfig", "check_asd", "check_controller"]
 
+#: Missions of a constellation (three spacecraft, a coupled run's working point).
+CONSTELLATION_MISSIONS = ("tianqin", "lisa", "taiji")
+#: Single-spacecraft missions that flew: LISA Pathfinder (two test masses on one axis) and TianQin-1 (one
+#: inertial sensor); their loops are built at a documented static working point (no run needed).
+SINGLE_SPACECRAFT_MISSIONS = ("lpf", "tianqin-1")
 #: Missions with a default closed-loop design (tqdyn.closedloop.missions).
-MISSIONS = ("tianqin", "lisa", "taiji")
-#: Control loops: name -> (channels, what is sensed, sensor, actuator).  Each channel's controller
-#: (tqdyn.closedloop.controllers) turns the sensed coordinate into an acceleration command.
+MISSIONS = CONSTELLATION_MISSIONS + SINGLE_SPACECRAFT_MISSIONS
+#: Control schemes (which sensor drives which actuator): "constellation" (a MOSA per TM, DWS attitude: the
+#: three constellation missions), "collinear" (two TMs on one axis, LISA Pathfinder's modes), "single_tm"
+#: (one inertial sensor in accelerometer mode, TianQin-1's).
+SCHEMES = ("constellation", "collinear", "single_tm")
+#: The scheme of each mission.
+MISSION_SCHEME = {"tianqin": "constellation", "lisa": "constellation", "taiji": "constellation",
+                  "lpf": "collinear", "tianqin-1": "single_tm"}
+#: Control loops of the "constellation" scheme: name -> (channels, what is sensed, sensor, actuator).  Each
+#: channel's controller (tqdyn.closedloop.controllers) turns the sensed coordinate into an acceleration command.
 LOOPS = {
     "dragfree": (("tm1 sensitive axis", "tm2 sensitive axis", "mean z of the TMs"), "m",
                  "interferometer (sensitive axes), capacitive (z)", "thrusters (force)"),
@@ -55,6 +72,29 @@ LOOPS = {
     "mosa": (("MOSA 1", "MOSA 2"), "rad", "DWS yaw of the MOSA (spacecraft yaw + MOSA angle)", "MOSA actuator"),
     "tm_rotation": (("tm1 x", "tm1 y", "tm1 z", "tm2 x", "tm2 y", "tm2 z"), "rad", "capacitive", "electrostatic torque"),
 }
+#: Loops of the "collinear" scheme (LISA Pathfinder's science mode; TM 1 at +tm_separation/2 on X_S, TM 2 at
+#: -tm_separation/2, both sensitive axes X_S; docs/closed-loop-validation.md).
+COLLINEAR_LOOPS = {
+    "dragfree": (("x: tm1 (o1)", "y: mean of the TMs", "z: mean of the TMs"), "m",
+                 "interferometer o1 (x), capacitive (y, z)", "thrusters (force)"),
+    "suspension": (("x: tm2 on o12",), "m", "interferometer o12 = x2 - x1", "electrostatic force on TM 2"),
+    "attitude": (("x: mean TM rotation about X", "y: (z1 - z2)/separation", "z: -(y1 - y2)/separation"), "rad",
+                 "capacitive (the TMs: the spacecraft follows them)", "thrusters (torque)"),
+    "tm_rotation": (("tm1 y", "tm1 z", "tm2 y", "tm2 z", "tm2 - tm1 x"), "rad", "capacitive", "electrostatic torque"),
+    "guidance": (("x", "y", "z"), "rad", "star tracker (the spacecraft's inertial attitude)",
+                 "electrostatic torque about X on both TMs (x), differential force along Z (y) and Y (z)"),
+}
+#: Loops of the "single_tm" scheme (TianQin-1: the inertial sensor as an accelerometer, drag-free on its
+#: measured acceleration, attitude on the star tracker).
+SINGLE_TM_LOOPS = {
+    "suspension": (("tm1 x", "tm1 y", "tm1 z"), "m", "capacitive", "electrostatic force (the accelerometer's servo)"),
+    "dragfree": (("x", "y", "z"), "m/s^2", "the suspension's command (the measured acceleration)",
+                 "thrusters (force)"),
+    "attitude": (("x", "y", "z"), "rad", "star tracker", "thrusters (torque)"),
+    "tm_rotation": (("tm1 x", "tm1 y", "tm1 z"), "rad", "capacitive", "electrostatic torque"),
+}
+#: The loop table of each scheme.
+SCHEME_LOOPS = {"constellation": LOOPS, "collinear": COLLINEAR_LOOPS, "single_tm": SINGLE_TM_LOOPS}
 #: Noise sources: name -> (components, unit of the ASD, where it enters the loop, tqdyn.closedloop.loop).
 SOURCES = {
     "thruster_force": (3, "N", "thrust, S axes"),
@@ -76,21 +116,27 @@ SOURCES = {
 #: the star tracker (as LISA Pathfinder, which had no DWS).
 ATTITUDE_Z_SENSORS = ("dws", "star_tracker")
 
+#: Length [s] of the time series when ``duration`` is not given: the run's first day (its span if shorter).
+DEFAULT_SERIES_S = 86400.0
 #: Top-level keys of [closed_loop]: name -> (kind, default).  Defaults: ``mission`` None = the spacecraft
-#: architecture; ``fs`` [Hz]; ``duration`` [s] None = the run's span; ``segment`` [s]; ``f_min``, ``f_max``
+#: architecture; ``scheme`` None = the mission's (:data:`MISSION_SCHEME`); ``fs`` [Hz]; ``duration`` [s] None =
+#: :data:`DEFAULT_SERIES_S` or the run's span if shorter; ``segment`` [s]; ``f_min``, ``f_max``
 #: [Hz] and ``n_freq`` the budget's log grid; ``attitude_z_sensor`` one of :data:`ATTITUDE_Z_SENSORS`.
-CLOSED_LOOP_KEYS = {"mission": ("string", None), "fs": ("number", 4.0), "duration": ("duration", None),
-                    "seed": ("integer", 0), "segment": ("duration", 86400.0), "f_min": ("number", 1e-5),
-                    "f_max": ("number", 1.0), "n_freq": ("integer", 300),
+CLOSED_LOOP_KEYS = {"mission": ("string", None), "scheme": ("string", None), "fs": ("number", 4.0),
+                    "duration": ("duration", None), "seed": ("integer", 0), "segment": ("duration", 86400.0),
+                    "f_min": ("number", 1e-5), "f_max": ("number", 1.0), "n_freq": ("integer", 300),
                     "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0])}
 #: Keys of [closed_loop.plant]: name -> number of values (1: a number).
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
-              "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1}
-_POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia")
+              "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1, "tm2_stiffness": 3,
+              "tm2_rotational_stiffness": 3, "tm_separation": 1}
+_POSITIVE = ("sc_mass", "sc_inertia", "tm_mass", "tm_side", "mosa_inertia", "tm_separation")
+#: Where the keys, loops and noise sources are listed.
+_DOC = "docs/scenarios.md#closed_loop"
 
 
 def _num(v) -> bool:
-    return isinstance(v, (int, float, Decimal)) and not isinstance(v, bool) and math.isfinite(float(v))
+    return finite_number(v) is not None
 
 
 @dataclass(frozen=True)
@@ -105,11 +151,14 @@ class ClosedLoopConfig:
         allowed = tuple(CLOSED_LOOP_KEYS) + ("plant", "controllers", "noise")
         for key, v in raw.items():
             name = f"closed_loop.{key}"
-            _require(key in allowed, name, v, "is not a known key", ", ".join(allowed))
+            if key not in allowed:
+                raise _unknown_key(name, allowed, _DOC)
             if key == "mission":
-                _require(v in MISSIONS, name, v, "is not a mission", ", ".join(MISSIONS))
+                _require_choice(v, name, MISSIONS, problem="is not a mission")
+            elif key == "scheme":
+                _require_choice(v, name, SCHEMES, problem="is not a control scheme")
             elif key == "attitude_z_sensor":
-                _require(v in ATTITUDE_Z_SENSORS, name, v, "is not a sensor", _one_of(ATTITUDE_Z_SENSORS))
+                _require_choice(v, name, ATTITUDE_Z_SENSORS, problem="is not a sensor")
             elif key in ("fs", "f_min", "f_max"):
                 _require(_num(v) and float(v) > 0, name, v, "is not a positive number", "a frequency > 0 Hz")
             elif key in ("seed", "n_freq"):
@@ -121,7 +170,8 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.plant]")
                 for pk, pv in v.items():
                     pname = f"{name}.{pk}"
-                    _require(pk in PLANT_KEYS, pname, pv, "is not a plant key", ", ".join(PLANT_KEYS))
+                    if pk not in PLANT_KEYS:
+                        raise _unknown_key(pname, tuple(PLANT_KEYS), _DOC, "is not a plant key")
                     n = PLANT_KEYS[pk]
                     ok = _num(pv) if n == 1 else (isinstance(pv, list) and len(pv) == n and all(_num(x) for x in pv))
                     _require(ok, pname, pv, "is not valid", "a number" if n == 1 else f"{n} numbers")
@@ -132,9 +182,11 @@ class ClosedLoopConfig:
                         _require(0 <= float(pv) < 1, pname, pv, "is out of range", "0 <= crosstalk < 1")
             elif key == "controllers":
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.controllers.<loop>]")
+                loops = SCHEME_LOOPS[self.scheme()]
                 for loop, spec in v.items():
                     lname = f"{name}.{loop}"
-                    _require(loop in LOOPS, lname, spec, "is not a loop", ", ".join(LOOPS))
+                    if loop not in loops:
+                        raise _unknown_key(lname, loops, _DOC, f"is not a loop of the {self.scheme()!r} scheme")
                     _require(isinstance(spec, dict) and set(spec) <= {"zeros", "poles", "gain"}, lname, spec,
                              "is not a controller table", "zeros, poles, gain")
                     self._controller(loop, spec)
@@ -142,10 +194,18 @@ class ClosedLoopConfig:
                 _require(isinstance(v, dict), name, v, "is not a table", "[closed_loop.noise.<source>]")
                 for src, spec in v.items():
                     sname = f"{name}.{src}"
-                    _require(src in SOURCES, sname, spec, "is not a noise source", ", ".join(SOURCES))
+                    if src not in SOURCES:
+                        raise _unknown_key(sname, tuple(SOURCES), _DOC, "is not a noise source", noun="sources")
                     _require(isinstance(spec, dict) and set(spec) <= {"level", "knees"}, sname, spec,
                              "is not a noise table", "level, knees")
                     self._asd(src, spec)
+        lo, hi = (float(raw.get(k, CLOSED_LOOP_KEYS[k][1])) for k in ("f_min", "f_max"))
+        if not lo < hi:
+            given = "f_min" if "f_min" in raw else "f_max"
+            _require(False, f"closed_loop.{given}", raw[given],
+                     f"leaves no band: f_min = {lo:g} Hz, f_max = {hi:g} Hz" + ("" if {"f_min", "f_max"} <= set(raw)
+                                                                               else " (the other one's default)"),
+                     "f_min < f_max [Hz]")
 
     @staticmethod
     def _controller(loop: str, spec: dict):
@@ -164,6 +224,14 @@ class ClosedLoopConfig:
     def mission(self, architecture: str) -> str:
         """The mission whose defaults apply: ``mission`` or the spacecraft architecture."""
         return str(self.raw.get("mission", architecture))
+
+    def scheme(self, architecture: str = "tianqin") -> str:
+        """The control scheme: ``scheme`` or the mission's (:data:`MISSION_SCHEME`; a constellation run's
+        architecture by default)."""
+        raw = self.raw or {}
+        if raw.get("scheme") in SCHEMES:
+            return str(raw["scheme"])
+        return MISSION_SCHEME.get(str(raw.get("mission", architecture)), "constellation")
 
     def value(self, key: str, default):
         """A top-level value as float/int/str (durations in s), or ``default``."""

@@ -28,11 +28,12 @@ __all__ = [
     "SatelliteConfig", "IntegratorConfig", "RunConfig", "ForcesConfig", "SpacecraftConfig",
     "ConstellationConfig", "POINTING_LAWS", "Scenario", "ScenarioError", "CONTROL_MODES", "LIBRATION_MODELS",
     "MAX_EARTH_DEGREE", "MAX_MOON_DEGREE", "MAX_OCEAN_TIDE_DEGREE", "SELF_GRAVITY_MODELS", "THIRD_BODIES",
-    "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig",
+    "TM_AXES", "MAX_STEPS", "BODY_RADII_M", "ClosedLoopConfig", "DEFAULT_METHOD",
 ]
 
 _PRECISIONS, _METHODS, _MODES, _TABLEAUS = ("dd", "float64"), ("dp87", "multistep"), ("fixed", "adaptive"), ("corrected", "published")
 _RTOL_MAX = 1e-3
+DEFAULT_METHOD = "multistep"  #: ``integrator.method`` of a fixed-step run naming none (adaptive: ``"dp87"``, the only one)
 #: Default of ``run.max_steps``: the most integration steps (fixed mode) or output intervals (adaptive mode) a run
 #: may have.  The longest real runs are ~3e6 steps (TianQin, 5 years at 50 s); at ``tqdyn bench``'s rates
 #: (docs/scenarios.md) 1e9 steps take hours (Kepler) to days (full TianQin model) and write ~1e11 bytes per
@@ -43,22 +44,22 @@ from .closed_loop import ClosedLoopConfig  # noqa: F401  ([closed_loop]; re-expo
 from .accelerations import AccelerationsConfig  # noqa: F401  ([accelerations]; re-exported)
 from .initial import AU_M, BODY_RADII_M, check_above_surface, INITIAL_AXES, INITIAL_DESIGNS, ROTATIONS, InitialConfig, SatelliteConfig, epoch_from_label  # noqa: F401
 from .values import (_EXACT, _NOVALUE, ScenarioError, _a, _fmt, _num_array, _one_of, _require,  # noqa: F401  (re-exported)
-                     _require_choice, _set, _to_decimal, _toml_type)
+                     _did_you_mean, _require_choice, _set, _to_decimal, _toml_type)
 
 
 @dataclass(frozen=True)
 class IntegratorConfig:
     """Integrator choice.
 
-    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"``
-    (fixed step; :mod:`tqdyn.numerics.multistep`); ``mode``: ``"fixed"`` or
+    ``method``: ``"dp87"`` (Dormand-Prince 8(7)) or ``"multistep"`` (fixed step; :mod:`tqdyn.numerics.multistep`);
+    None (not given): :data:`DEFAULT_METHOD` in fixed mode, ``"dp87"`` in adaptive mode; ``mode``: ``"fixed"`` or
     ``"adaptive"`` (DP87 only); ``step_s`` [s] (> 0): the fixed step, or in adaptive mode
     the output interval; ``tableau``: ``"corrected"`` or ``"published"``
     coefficients (also of the multistep start-up); ``rtol``: adaptive-mode relative local error tolerance
     (0 < rtol < 1e-3).  Multistep: ``order`` and ``corrector`` (:mod:`tqdyn.numerics.multistep`).
     """
 
-    method: str = "dp87"
+    method: str | None = None
     mode: str = "fixed"
     step_s: Decimal = Decimal(50)
     tableau: str = "corrected"
@@ -67,8 +68,9 @@ class IntegratorConfig:
     corrector: str = _ms.DEFAULT_CORRECTOR
 
     def __post_init__(self) -> None:
-        _require_choice(self.method, "integrator.method", _METHODS)
         _require_choice(self.mode, "integrator.mode", _MODES)
+        _set(self, "method", (DEFAULT_METHOD if self.mode == "fixed" else "dp87") if self.method is None else self.method)
+        _require_choice(self.method, "integrator.method", _METHODS)
         _require(self.method != "multistep" or self.mode == "fixed", "integrator.mode", self.mode,
                  'has no multistep form (integrator.method = "multistep")', '"fixed", or method = "dp87"')
         o = self.order
@@ -119,6 +121,7 @@ class RunConfig:
 #: Bodies available as point-mass third bodies (JPL DE ephemerides): all but
 #: the central body itself ("sun" for geocentric runs, "earth" for heliocentric ones).
 THIRD_BODIES = ("sun", "earth", "moon", "mercury", "venus", "mars", "jupiter", "saturn", "uranus", "neptune")
+_BODIES_DOC = "docs/scenarios.md#forces"
 #: Keys of [forces] that belong to the geocentric model only.
 GEOCENTRIC_ONLY_FORCES = ("earth_degree", "solid_tides", "ocean_tides_degree", "pole_tides", "atmospheric_tides",
                           "moon_degree", "earth_field_indirect")
@@ -221,7 +224,7 @@ class ForcesConfig:
 
     def __post_init__(self) -> None:
         ok = isinstance(self.eop, bool) or (isinstance(self.eop, str) and self.eop.strip().lower() in EOP_SOURCES)
-        _require(ok, "forces.eop", self.eop, "is not an EOP source", EOP_SOURCES_ALLOWED)
+        _require(ok, "forces.eop", self.eop, "is not an EOP source" + _did_you_mean(self.eop, EOP_SOURCES), EOP_SOURCES_ALLOWED)
         _set(self, "eop", normalize_eop_source(self.eop))
         for key in ("earth_monopole", "sun_monopole", "earth_degree2_extended", "third_bodies_gcrs", "solid_tides", "pole_tides",
                     "atmospheric_tides", "sun_j2", "relativity", "earth_field_indirect"):
@@ -238,12 +241,12 @@ class ForcesConfig:
         bodies = tuple(self.third_bodies)
         _set(self, "third_bodies", bodies)
         for body in bodies:
-            _require(body in THIRD_BODIES, "forces.third_bodies", body, "is not a known body", _one_of(THIRD_BODIES))
+            _require_choice(body, "forces.third_bodies", THIRD_BODIES, _BODIES_DOC, "is not a known body")
         _require(len(set(bodies)) == len(bodies), "forces.third_bodies", list(bodies), "lists a body twice", "each body once")
         ext = tuple(self.third_bodies_extended)
         _set(self, "third_bodies_extended", ext)
         for body in ext:
-            _require(body in THIRD_BODIES, "forces.third_bodies_extended", body, "is not a known body", _one_of(THIRD_BODIES))
+            _require_choice(body, "forces.third_bodies_extended", THIRD_BODIES, _BODIES_DOC, "is not a known body")
         _require_choice(self.moon_libration, "forces.moon_libration", LIBRATION_MODELS)
         _require(not self.earth_field_indirect or self.earth_degree >= 2, "forces.earth_field_indirect", True,
                  "needs the Earth's non-central field", "false, or earth_degree >= 2")
@@ -416,10 +419,8 @@ class Scenario:
         c = self.constellation
         given = "satellite given" if n == 1 else "satellites given"
         if c.coupled:
-            raise ScenarioError("satellites", n, f"{given}; a coupled run (constellation.pointing = "
-                                f"{c.pointing!r}) needs exactly 3",
-                                '3 satellites, or constellation.pointing = "none" and control = "off" '
-                                "(point masses: any number)")
+            raise ScenarioError("satellites", n, f"{given}; a coupled run (pointing {c.pointing!r}) needs exactly 3",
+                                '3 satellites, or constellation.pointing = "none" and control = "off" (any number)')
         if self.spacecraft.self_gravity_center is not None:
             raise ScenarioError("satellites", n, f"{given}; spacecraft.self_gravity_center (the pull "
                                 "toward the centre of a triangle) needs exactly 3",
@@ -433,10 +434,10 @@ class Scenario:
             return
         d, h = self.run.duration_s, self.integrator.step_s
         what = "steps" if self.integrator.mode == "fixed" else "output intervals"
-        allowed = f"at most run.max_steps = {top} {what} (more cannot finish; raise run.max_steps to override)"
+        allowed = f"at most run.max_steps = {top} {what} (raise it to run more)"
         if h < 1 and d <= top:
             raise ScenarioError("integrator.step", h, f"s makes run.duration = {d} s {n:.3g} {what}",
-                                f"a step >= {d / top:.3g} s: {allowed}")
+                                f"a step >= {d / top:.3g} s, {allowed}")
         raise ScenarioError("run.duration", d, f"s is {n:.3g} {what} of integrator.step = {h} s", allowed)
 
     def _check_central_body(self) -> None:
@@ -444,7 +445,7 @@ class Scenario:
         f, body = self.forces, self.central_body
         for b in f.third_bodies:
             _require(b != body, "forces.third_bodies", b, f"is the central body (scenario.central_body = {body!r})",
-                     _one_of([x for x in THIRD_BODIES if x != body]))
+                     _one_of([x for x in THIRD_BODIES if x != body], _BODIES_DOC))
         if body == "sun":
             for key in GEOCENTRIC_ONLY_FORCES:
                 v = getattr(f, key)

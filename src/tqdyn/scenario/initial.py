@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
 
+from ..astro.constants import C_LIGHT
 from ..astro.timescales import Epoch
 from .values import _EXACT, ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
 
@@ -54,6 +55,13 @@ class SatelliteConfig:
                 _require(getattr(self, f) is not None, f"satellite.{f}", None, "is missing",
                          f"3 finite numbers [{unit}] (a Cartesian state needs both r and v)")
                 _set(self, f, _num_array(getattr(self, f), f"satellite.{f}", ((3,),), unit))
+            with localcontext() as ctx:
+                ctx.prec = _EXACT
+                r, v = (sum(x * x for x in getattr(self, f)).sqrt() for f in ("r_m", "v_mps"))
+            _require(r > 0, "satellite.r_m", list(self.r_m), "is the centre of the central body",
+                     "|r| > 0 (the point-mass gravity is singular there)")
+            _require(v < _C_LIGHT, "satellite.v_mps", list(self.v_mps), f"has |v| = {float(v):.4g} m/s, not below "
+                     "the speed of light", f"|v| < c = {_C_LIGHT} m/s")
             return
         _require(self.a_m is not None, "satellite.a_m", None, "is missing", "a > 0 m (or a Cartesian state r, v)")
         for f in elements:
@@ -76,6 +84,7 @@ ROTATIONS = ("clockwise", "counterclockwise")
 #: standard), or taken as ICRF axes already (ESA's CReMA 2.0 LISA files, docs/lisa-orbits.md).
 OEM_EME2000 = ("frame-bias", "icrf")
 AU_M = Decimal(149597870700)
+_C_LIGHT = Decimal(repr(C_LIGHT))
 
 
 def epoch_from_label(text: str, name: str) -> Epoch:
@@ -186,10 +195,18 @@ def derived_satellites(initial: InitialConfig, epoch: Epoch, central_body: str,
         rv = []
         for k, path in enumerate(initial.oem, start=1):
             try:
-                r, v = states_at(_heliocentric_oem(path, initial.oem_eme2000), *epoch.tdb)
+                traj = _heliocentric_oem(path, initial.oem_eme2000)
             except (OSError, ValueError) as exc:
-                raise ScenarioError(f"initial.oem.{k}", path, f"cannot give a state at {epoch.iso} ({exc})",
-                                    f"{_OEM_ALLOWED} covering the epoch") from None
+                raise _oem_error(k, path, exc) from None
+            try:
+                r, v = states_at(traj, *epoch.tdb)
+            except ValueError as exc:
+                t = epoch.tdb
+                if (t[0] - traj.start[0]) + (t[1] - traj.start[1]) < 0:
+                    exc = f"starts at {_tdb_text(traj.start)[:19]} TDB, after {epoch.iso}"
+                elif (t[0] - traj.stop[0]) + (t[1] - traj.stop[1]) > 0:
+                    exc = f"ends at {_tdb_text(traj.stop)[:19]} TDB, before {epoch.iso}"
+                raise _oem_error(k, path, exc, allowed="an epoch in every file's span") from None
             rv.append((_decimal_vector(r), _decimal_vector(v)))
     names = list(initial.names) + [f"Sat{k}" for k in range(len(initial.names) + 1, len(rv) + 1)]
     if len(names) > len(rv):
@@ -207,7 +224,7 @@ def oem_first_common_epoch(paths, eme2000: str = "frame-bias") -> str:
             traj = _heliocentric_oem(path, eme2000)
             firsts.append((traj.start, _tdb_text(traj.start)))
         except (OSError, ValueError) as exc:
-            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})", _OEM_ALLOWED) from None
+            raise _oem_error(k, path, exc) from None
     return max(firsts, key=lambda x: x[0][0] + x[0][1])[1]
 
 
@@ -221,15 +238,34 @@ def oem_common_span(paths, eme2000: str = "frame-bias") -> tuple[str, str]:
             traj = _heliocentric_oem(path, eme2000)
             spans.append(((traj.start, _tdb_text(traj.start)), (traj.stop, _tdb_text(traj.stop))))
         except (OSError, ValueError) as exc:
-            raise ScenarioError(f"initial.oem.{k}", path, f"cannot be read ({exc})", _OEM_ALLOWED) from None
+            raise _oem_error(k, path, exc) from None
     first = max((s[0] for s in spans), key=lambda x: x[0][0] + x[0][1])
     last = min((s[1] for s in spans), key=lambda x: x[0][0] + x[0][1])
     return f"{first[1]} TDB", f"{last[1]} TDB"
 
 
 #: What ``initial.oem`` reads (the "allowed" of its messages).
-_OEM_ALLOWED = ("a readable CCSDS OEM file (SUN, EME2000 or ICRF, TDB or TCB; several segments: continuous, "
-                "one starting where the previous one stops or inside it)")
+_OEM_ALLOWED = "see docs/scenarios.md#oem-files"
+
+
+def _oem_error(k: int, path, exc, problem: str | None = None, allowed: str | None = None) -> ScenarioError:
+    """The one-line error of ``initial.oem.k``: the file (its name alone for a file shipped with
+    tqdyn, whose directory is long), then ``problem`` (default: "cannot be read" for an OSError)
+    and what the reader says of it (``exc``: without the file, which it names first, and with its
+    own "allowed" if it gives one, else ``allowed``)."""
+    import os
+
+    if problem is None:
+        problem = "cannot be read" if isinstance(exc, OSError) else ""
+    text = " ".join(str(exc).split())
+    for p in (str(path), os.path.abspath(str(path))):
+        text = text.removeprefix(f"{p}: ").removeprefix(f"{p} ")
+    text, _, own = text.partition("; allowed: ")
+    data = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data") + os.sep
+    shown = os.path.basename(path) if os.path.abspath(str(path)).startswith(data) else path
+    if "(allowed: " not in text:  # else the reader's message says what is allowed itself
+        allowed = allowed or own or _OEM_ALLOWED
+    return ScenarioError(f"initial.oem.{k}", shown, f"{problem}: {text}" if problem else text, allowed)
 
 
 def _heliocentric_oem(path: str, eme2000: str = "frame-bias"):
@@ -296,23 +332,23 @@ def check_above_surface(satellites, initial: "InitialConfig", central_body: str)
             if sat.cartesian:
                 dist = sum(x * x for x in sat.r_m).sqrt()
                 if dist < radius:
-                    inside = f"inside {body}: |r| = {float(dist / 1000):.7g} km < its radius {r_km} km"
+                    inside = f"inside {body} (|r| = {float(dist / 1000):.7g} km < its radius {r_km} km)"
                     if initial.derived:  # the state comes from a design or an OEM file
                         key, value = ((f"initial.oem.{k}", initial.oem[k - 1]) if initial.oem
                                       else ("initial.design", initial.design))
                         raise ScenarioError(key, value, f"puts {where} ({sat.name!r}) {inside}",
-                                            f"states with |r| >= {r_km} km, {override}")
+                                            f"|r| >= {r_km} km, {override}")
                     raise ScenarioError(f"{where}.r_km", [x / 1000 for x in sat.r_m], f"is {inside}",
                                         f"|r| >= {r_km} km, {override}")
                 continue
             if sat.a_m < radius:
                 raise ScenarioError(f"{where}.a_km", sat.a_m / 1000,
                                     f"is inside {body} (its radius {r_km} km)",
-                                    f"a_km >= {r_km} with the pericentre a (1 - e) >= {r_km} km, {override}")
+                                    f"a_km and a (1 - e) >= {r_km} km, {override}")
             peri = sat.a_m * (1 - sat.e)
             if peri < radius:
                 e_max = (1 - radius / sat.a_m).quantize(Decimal("1e-9"), rounding="ROUND_FLOOR")
                 raise ScenarioError(f"{where}.e", sat.e,
                                     f"puts the pericentre a (1 - e) = {float(peri / 1000):.7g} km inside {body} "
-                                    f"(its radius {r_km} km)",
-                                    f"e <= 1 - radius / a = {e_max}, {override}")
+                                    f"(radius {r_km} km)",
+                                    f"e <= {e_max}, {override}")

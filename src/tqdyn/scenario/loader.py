@@ -23,6 +23,7 @@ from typing import Any, Mapping, Sequence
 from ..forces.body_gms import BODY_GM_KEYS
 from .config import (
     EOP_SOURCES_ALLOWED,
+    INITIAL_DESIGNS,
     AccelerationsConfig,
     _EXACT,
     _NOVALUE,
@@ -41,9 +42,12 @@ from .config import (
     _to_decimal,
     _toml_type,
 )
+from .._choices import did_you_mean as _did_you_mean
+from .values import _one_of, _unknown_key
 
 __all__ = [
     "builtin_scenarios",
+    "closed_loop_config",
     "load_scenario",
     "loads_scenario",
     "parse_duration",
@@ -123,6 +127,15 @@ _SAT_SCHEMA: dict[str, str] = {
 }
 _ELEMENT_KEYS = ("a_km", "e", "i_deg", "raan_deg", "argp_deg", "nu_deg")
 _TOP_KEYS = tuple(_SCHEMA) + ("satellites", "closed_loop")
+#: Where the keys of each table are listed (docs/scenarios.md, "Keys"; "" the top level).
+KEYS_DOC = "docs/scenarios.md#"
+
+
+def keys_doc(table: str) -> str:
+    """The page and anchor listing every key of scenario table ``table`` ("" the
+    tables themselves, "satellites.N" a satellite's, "closed_loop..." the closed loop's)."""
+    top = table.split(".", 1)[0]
+    return KEYS_DOC + ({"": "keys"}.get(top, top))
 #: Epoch keys: one of them sets the epoch (a file or override that sets one drops the other).
 _EPOCH_KEYS = ("epoch_utc", "epoch_tdb")
 # TOML key -> dataclass field, where they differ
@@ -176,7 +189,7 @@ def _check_table(table: Any, name: str, allowed: Sequence[str]) -> dict:
     _require(isinstance(table, dict), name, table, f"is {_a(_toml_type(table))}", "a table")
     for key in table:
         if key not in allowed:
-            raise ScenarioError(f"{name}.{key}" if name else key, problem="is not a known key", allowed=", ".join(allowed))
+            raise _unknown_key(f"{name}.{key}" if name else key, allowed, keys_doc(name))
     return table
 
 
@@ -191,7 +204,7 @@ def _build(cls, prefix: str, raw: Mapping[str, Any], schema: Mapping[str, str]):
     except ScenarioError as err:
         key = err.field.rsplit(".", 1)[-1]
         toml_key = {v: k for k, v in _FIELD_OF.items()}.get(key, key)
-        value = raw.get(toml_key, err.value)
+        value = raw.get(toml_key, err.value) if err.has_value else _NOVALUE
         raise ScenarioError(f"{prefix}.{toml_key}", value, err.problem, err.allowed) from None
 
 
@@ -224,8 +237,14 @@ def _build_satellite(raw: Any, k: int, derived: bool) -> SatelliteConfig | str:
         for key in ("r_km", "v_kmps"):
             _require(key in raw, f"{prefix}.{key}", _NOVALUE, "is missing", "r_km and v_kmps, 3 numbers each")
         name = _typed(raw.get("name", f"Sat{k}"), _STR, f"{prefix}.name")
-        return SatelliteConfig(name=name, r_m=_km_vector(raw["r_km"], f"{prefix}.r_km"),
-                               v_mps=_km_vector(raw["v_kmps"], f"{prefix}.v_kmps"))
+        try:
+            return SatelliteConfig(name=name, r_m=_km_vector(raw["r_km"], f"{prefix}.r_km"),
+                                   v_mps=_km_vector(raw["v_kmps"], f"{prefix}.v_kmps"))
+        except ScenarioError as err:
+            key = {"r_m": "r_km", "v_mps": "v_kmps"}.get(err.field.rsplit(".", 1)[-1])
+            if key is None:
+                raise
+            raise ScenarioError(f"{prefix}.{key}", raw[key], err.problem, err.allowed) from None
     _require("a_km" in raw, f"{prefix}.a_km", _NOVALUE, "is missing",
              "a semi-major axis in km (> 0), or a Cartesian state r_km, v_kmps")
     vals = {key: _typed(raw[key], kind, f"{prefix}.{key}") for key, kind in _SAT_SCHEMA.items() if key in raw}
@@ -257,7 +276,8 @@ def _scenario_from_raw(raw: dict, default_name: str) -> Scenario:
     const = _build(ConstellationConfig, "constellation", raw.get("constellation", {}), _SCHEMA["constellation"])
     initial_raw = dict(raw.get("initial", {}))
     sats_raw = raw.get("satellites")
-    derived = initial_raw.get("design", "none") != "none" or bool(initial_raw.get("oem"))
+    # a design that is not one of INITIAL_DESIGNS is named by InitialConfig, not taken as a design
+    derived = initial_raw.get("design", "none") in INITIAL_DESIGNS[1:] or bool(initial_raw.get("oem"))
     if derived and sats_raw is None:
         sats_raw = []
     else:
@@ -302,6 +322,20 @@ def _closed_loop_from_raw(table: Any) -> ClosedLoopConfig:
     return ClosedLoopConfig(raw=table)
 
 
+def closed_loop_config(table: Any = None, overrides: Sequence[str] = ()) -> ClosedLoopConfig:
+    """A validated :class:`ClosedLoopConfig` from a ``[closed_loop]`` table (a dict, e.g. ``{"mission": "lpf"}``)
+    and ``--set closed_loop.KEY=VALUE`` overrides, without a scenario (the closed loop of a mission's static
+    working point, ``tqdyn closed-loop --mission``).  ScenarioError (one line naming the key) otherwise."""
+    raw = {"closed_loop": dict(table or {})}
+    for item in ((overrides,) if isinstance(overrides, str) else overrides):
+        if not isinstance(item, str) or "=" not in item or not item.split("=", 1)[0].strip().startswith("closed_loop."):
+            raise ScenarioError("override", item, "is not a closed-loop key=value",
+                                "closed_loop.KEY=VALUE (docs/scenarios.md#closed-loop)")
+        key, text = item.split("=", 1)
+        _closed_loop_override(raw, key.strip(), text)
+    return _closed_loop_from_raw(raw["closed_loop"])
+
+
 def _closed_loop_override(raw: dict, key: str, text: str) -> None:
     """--set closed_loop.<key>, closed_loop.plant.<key>, closed_loop.controllers.<loop>.<key>,
     closed_loop.noise.<source>.<key>: nested tables created as needed (validated with the scenario)."""
@@ -311,7 +345,7 @@ def _closed_loop_override(raw: dict, key: str, text: str) -> None:
     if len(parts) != depth:
         raise ScenarioError(f"override {key}", problem="is not a [closed_loop] key",
                             allowed="closed_loop.<key>, closed_loop.plant.<key>, closed_loop.controllers.<loop>.<key>, "
-                                    "closed_loop.noise.<source>.<key>")
+                                    f"closed_loop.noise.<source>.<key> ({keys_doc('closed_loop')})")
     table = raw.setdefault("closed_loop", {})
     for p in parts[:-1]:
         _require(isinstance(table, dict), "closed_loop", table, "is not a table", "a table")
@@ -349,13 +383,14 @@ def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
             n = len(sats) if isinstance(sats, list) else 0
             if len(parts) != 3:
                 raise ScenarioError(f"override {key}", problem="is not of the form satellites.N.key",
-                                    allowed=f"satellites.N.key with N in 1..{n} and key in {', '.join(_SAT_SCHEMA)}")
+                                    allowed=f"satellites.N.key with N in 1..{n} and a key of {keys_doc('satellites')}")
             idx_text, sat_key = parts[1], parts[2]
             if not idx_text.isdigit() or not 1 <= int(idx_text) <= n:
                 raise ScenarioError(f"override {key}", idx_text, "is not a satellite index",
                                     f"1..{n} (1-based)" if n else "no satellites defined")
             if sat_key not in _SAT_SCHEMA:
-                raise ScenarioError(f"override {key}", sat_key, "is not a satellite key", ", ".join(_SAT_SCHEMA))
+                raise _unknown_key(f"override {key}", tuple(_SAT_SCHEMA), keys_doc("satellites"),
+                                   "is not a satellite key", sat_key)
             sat = sats[int(idx_text) - 1]
             _require(isinstance(sat, dict), f"satellites.{idx_text}", sat, "is not a table", "a [[satellites]] table")
             sat[sat_key] = _parse_override_value(text, _SAT_SCHEMA[sat_key])
@@ -364,11 +399,11 @@ def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
             _closed_loop_override(raw, key, text)
             continue
         if len(parts) != 2 or parts[0] not in _SCHEMA:
-            allowed = ", ".join(f"{s}.<key>" for s in _SCHEMA) + ", satellites.N.<key>"
-            raise ScenarioError(f"override {key}", problem="is not a known section.key", allowed=allowed)
+            raise ScenarioError(f"override {key}", problem="is not a known section.key" + _did_you_mean(
+                parts[0], _TOP_KEYS), allowed=f"section.key or satellites.N.key, of the tables in {keys_doc('')}")
         sec, sub = parts
         if sub not in _SCHEMA[sec]:
-            raise ScenarioError(f"override {key}", sub, f"is not a key of [{sec}]", ", ".join(_SCHEMA[sec]))
+            raise _unknown_key(f"override {key}", tuple(_SCHEMA[sec]), keys_doc(sec), f"is not a key of [{sec}]", sub)
         table = raw.setdefault(sec, {})
         _require(isinstance(table, dict), sec, table, "is not a table", "a table")
         table[sub] = _parse_override_value(text, _SCHEMA[sec][sub])
@@ -385,6 +420,10 @@ def _apply_overrides(raw: dict, overrides: Sequence[str]) -> None:
 
 def _builtin_dir():
     return resources.files("tqdyn") / "scenario" / "builtin"
+
+
+#: Where the built-in scenarios are listed.
+BUILTIN_DOC = "docs/scenarios.md#built-in-scenarios"
 
 
 def builtin_scenarios() -> tuple[str, ...]:
@@ -438,8 +477,9 @@ def _resolve_extends(raw: dict, source: str, chain: tuple[str, ...]) -> dict:
         return raw
     base_name = meta["extends"]
     builtins = builtin_scenarios()
-    _require(isinstance(base_name, str) and base_name in builtins, "scenario.extends", base_name,
-             "is not a built-in scenario", ", ".join(builtins))
+    if not (isinstance(base_name, str) and base_name in builtins):
+        raise ScenarioError("scenario.extends", base_name, "is not a built-in scenario" + _did_you_mean(base_name, builtins),
+                            _one_of(builtins, BUILTIN_DOC))
     _require(base_name not in chain, "scenario.extends", base_name, f"extends itself ({' -> '.join(chain)})",
              "a chain of built-in scenarios without cycles")
     text = (_builtin_dir() / f"{base_name}.toml").read_text(encoding="utf-8")
@@ -499,7 +539,8 @@ def load_scenario(name_or_path: str | os.PathLike | None = None, overrides: Sequ
     path = Path(text_name)
     if not path.is_file():
         what = "is not a file" if path.exists() else ("does not exist" if looks_like_path else "is neither a built-in scenario nor a file")
-        raise ScenarioError("scenario", text_name, what, f"a path to a .toml file or a built-in scenario: {', '.join(builtins)}")
+        hint = "" if looks_like_path else _did_you_mean(text_name, builtins)
+        raise ScenarioError("scenario", text_name, what + hint, f"a .toml file or a name in {BUILTIN_DOC}")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:

@@ -13,7 +13,8 @@ from decimal import Decimal
 from typing import Any
 
 from .initial import epoch_from_label
-from .values import ScenarioError, _num_array, _require, _require_choice, _set, _to_decimal
+from .values import (MAX_ACCELERATION, _NOVALUE, ScenarioError, _fmt, _num_array, _require, _require_choice, _set,
+                     _to_decimal)
 
 __all__ = ["SELF_GRAVITY_MODELS", "TM_AXES", "SpacecraftConfig"]
 
@@ -113,12 +114,12 @@ class SpacecraftConfig:
             _require_choice(self.self_gravity, "spacecraft.self_gravity", SELF_GRAVITY_MODELS)
         else:
             _set(self, "self_gravity", _num_array(self.self_gravity, "spacecraft.self_gravity",
-                                                  ((2, 3), (3, 2, 3)), "m/s^2 in OA_l"))
+                                                  ((2, 3), (3, 2, 3)), "m/s^2 in OA_l", MAX_ACCELERATION))
         _set(self, "self_gravity_common", _num_array(self.self_gravity_common, "spacecraft.self_gravity_common",
-                                                     ((3,), (3, 3)), "m/s^2 in S"))
+                                                     ((3,), (3, 3)), "m/s^2 in S", MAX_ACCELERATION))
         if self.self_gravity_center is not None:
             _set(self, "self_gravity_center", _num_array(self.self_gravity_center, "spacecraft.self_gravity_center",
-                                                         ((2,),), "m/s^2, positive toward the centre"))
+                                                         ((2,),), "m/s^2, positive toward the centre", MAX_ACCELERATION))
         span = self.self_gravity_center_span
         if span is not None:
             ok = isinstance(span, (list, tuple)) and len(span) == 2 and all(isinstance(x, str) for x in span)
@@ -159,7 +160,10 @@ class SpacecraftConfig:
                                    **kw)
         except ArchitectureError as exc:
             key = _CRAFT_KEYS.get(exc.field, exc.field)
-            raise ScenarioError(f"spacecraft.{key}", exc.value, "is invalid", exc.allowed) from None
+            given = getattr(self, key, None)  # the value as the scenario gives it, if it does
+            value = given if given is not None else exc.value
+            raise ScenarioError(f"spacecraft.{key}", value if len(_fmt(value)) <= 40 else _NOVALUE, exc.problem,
+                                exc.allowed) from None
         return craft
 
     def self_gravity_values(self):

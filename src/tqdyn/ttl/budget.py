@@ -45,6 +45,7 @@ import math
 
 import numpy as np
 
+from .._choices import unknown
 from ..constellation.control import oa_rotation
 from ..closedloop.budget import closed_loop_response
 from ..closedloop.loop import SOURCES, ClosedLoop, source_inputs
@@ -64,7 +65,7 @@ def _where(mosa: str) -> tuple[int, int]:
     for i, row in enumerate(MOSA_NAMES):
         if mosa in row:
             return i, row.index(mosa)
-    raise ValueError(f"mosa = {mosa!r}: not a MOSA (allowed: {', '.join(MOSAS)})")
+    raise ValueError(unknown("mosa", mosa, MOSAS, problem="is not a MOSA"))
 
 
 def angle_map(theta: float) -> np.ndarray:

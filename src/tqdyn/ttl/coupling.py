@@ -52,7 +52,9 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from .._choices import unknown
 from ..numerics import lagrange
+from ..numerics.finite import finite_number
 from ..numerics.lagrange import MARGIN, POINTS
 
 __all__ = ["LINEAR_FIELDS", "LPF_DRIFT_M_PER_RAD_PER_S", "LPF_TEMPERATURE_COEFFICIENT_M_PER_RAD_PER_K", "MOSAS",
@@ -92,19 +94,16 @@ def _check_keys(field: str, d, allowed: tuple) -> None:
         raise ValueError(f"{field} = {d!r}: expected a dict keyed by {', '.join(allowed)}")
     for k in d:
         if k not in allowed:
-            raise ValueError(f"{field}: unknown key {k!r} (allowed: {', '.join(allowed)})")
+            raise ValueError(unknown(field, k, allowed, problem="is not a key"))
     for k in allowed:
         if k not in d:
             raise ValueError(f"{field}: missing key {k!r} (needed: {', '.join(allowed)})")
 
 
 def _finite_float(field: str, v, unit: str) -> float:
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not math.isfinite(x):
-        raise ValueError(f"{field} = {v!r}: must be a finite number ({unit})")
+    x = finite_number(v)
+    if x is None:
+        raise ValueError(f"{field} = {v!r}: must be a finite number ({unit}), not a boolean or a string")
     return x
 
 
@@ -289,9 +288,9 @@ class TimeVaryingTTLCoefficients:
     def coefficient(self, field: str, mosa: str, t) -> np.ndarray:
         """c(t) (m/rad) of linear coefficient ``field`` (:data:`LINEAR_FIELDS`) of ``mosa`` at the times t (s)."""
         if field not in LINEAR_FIELDS:
-            raise ValueError(f"field = {field!r}: allowed: {', '.join(LINEAR_FIELDS)}")
+            raise ValueError(unknown("field", field, LINEAR_FIELDS))
         if mosa not in MOSAS:
-            raise ValueError(f"mosa = {mosa!r}: allowed: {', '.join(MOSAS)}")
+            raise ValueError(unknown("mosa", mosa, MOSAS))
         t = np.asarray(t, dtype=np.float64)
         out = np.full(t.shape, getattr(self.base, field)[mosa])
         if self.rate is not None:

@@ -51,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate
 
+from .._choices import unknown
 from ..closedloop.noise import AsdModel
 from .coupling import _delay
 
@@ -253,7 +254,7 @@ def simulate_link_fit(coefficients, *, dt: float, n: int, seed: int, band, jitte
     manoeuvres = dict(manoeuvres or {})
     for k in manoeuvres:
         if k not in REGRESSORS:
-            raise ValueError(f"manoeuvres: unknown key {k!r} (allowed: {', '.join(REGRESSORS)})")
+            raise ValueError(unknown("manoeuvres", k, REGRESSORS, problem="is not a key"))
     jit = _as_asd("jitter_asd", jitter_asd, "rad")
     dws = _as_asd("dws_asd", dws_asd, "rad")
     ro = _as_asd("readout_asd", readout_asd, "m")

@@ -68,6 +68,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from .._choices import unknown
 from ..closedloop.noise import AsdModel
 from .coupling import MOSAS, SPACECRAFT, TTLCoefficients, _delay, distant_mosa, mosa_angles
 from .estimation import REGRESSORS, _as_asd, _band_asd, _coloured, band_bins, band_variance
@@ -108,7 +109,7 @@ def _join(a: str, b: str) -> str:
 def michelson_terms(channel: str) -> list[tuple[int, str, str]]:
     """(sign, link, chain) of each term of X2, Y2 or Z2: channel = sum sign * D_chain y_link."""
     if channel not in CHANNELS:
-        raise ValueError(f"channel = {channel!r}: allowed {', '.join(CHANNELS)}")
+        raise ValueError(unknown("channel", channel, CHANNELS))
     terms = []
     for sign, (near, far) in ((1, ("13", "12")), (-1, ("12", "13"))):
         a, b = near, far  # round trip along arm a (y_a + D_a y_a'), filter on the other arm b
@@ -420,7 +421,7 @@ def simulate_six_link_fit(coeffs: TTLCoefficients, *, dt: float, n: int, seed: i
     manoeuvres = dict(manoeuvres or {})
     for k in manoeuvres:
         if k not in ANGLES:
-            raise ValueError(f"manoeuvres: unknown key {k!r} (allowed: {', '.join(ANGLES)})")
+            raise ValueError(unknown("manoeuvres", k, ANGLES, problem="is not a key"))
     d = _check_delays(delays, 1)
     jit, dws = _as_asd("jitter_asd", jitter_asd, "rad"), _as_asd("dws_asd", dws_asd, "rad")
     ro, laser = _as_asd("readout_asd", readout_asd, "m"), _as_asd("laser_asd", laser_asd, "m")

@@ -15,16 +15,17 @@ kernels, so the measured run starts as every run after the first does (a
 multistep command: its start-up and two steps).
 
 * ``default-run``: ``tqdyn run``, the README's main job (built-in
-  ``tianqin``, 10 days at 50 s);
+  ``tianqin``, 10 days at 50 s, the default integrator);
 * ``tianqin-5y``: ``tqdyn run tianqin --duration 1826d --set
-  run.output_every=72`` (five years, a row per hour);
+  run.output_every=72 --set integrator.method=dp87`` (five years, a row per hour, DP87);
 * ``tianqin-5y-multistep``: the same with ``--set integrator.method=multistep``;
 * ``lisa-10y``: ``tqdyn run lisa --duration 3653d`` (ten years at 6 h).
 
 :func:`startup_benchmark` (``tqdyn bench --model startup``): ``tqdyn run
---duration 1h`` with an empty kernel cache (``$TQDYN_CACHE_DIR`` a new
-directory: the first run after an install or a change of the sources
-compiles the kernels) and then again with the cache it filled.
+--duration 1h`` with each integrator, with an empty kernel cache
+(``$TQDYN_CACHE_DIR`` a new directory: the first run after an install or a
+change of the sources compiles the kernels) and then again with the cache it
+filled; the compilations are clocked inside the command (:func:`compile_clock`).
 
 ``duration`` replaces the span (to check the pipeline quickly); the
 report records the span that ran.
@@ -32,16 +33,18 @@ report records the span that ran.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["MISSION_RUNS", "MissionRun", "mission_benchmark", "format_mission_report", "startup_benchmark",
-           "format_startup_report", "SAMPLE_S"]
+           "format_startup_report", "SAMPLE_S", "STARTUP_RUNS", "compile_clock"]
 
 #: Interval of the resident-set samples [s].
 SAMPLE_S = 0.5
@@ -61,8 +64,8 @@ class MissionRun:
 #: The benchmarked commands by model name.
 MISSION_RUNS = {
     "default-run": MissionRun(None, (), None, "tqdyn run: the built-in tianqin scenario, 10 days at 50 s"),
-    "tianqin-5y": MissionRun("tianqin", ("--set", "run.output_every=72"), "1826d",
-                             "coupled TianQin, five years at 50 s, a row every 72 steps"),
+    "tianqin-5y": MissionRun("tianqin", ("--set", "run.output_every=72", "--set", "integrator.method=dp87"), "1826d",
+                             "coupled TianQin, five years at 50 s with DP87, a row every 72 steps"),
     "tianqin-5y-multistep": MissionRun("tianqin", ("--set", "run.output_every=72", "--set",
                                                    "integrator.method=multistep"), "1826d",
                                        "coupled TianQin, five years at 50 s with the multistep method, a row every "
@@ -172,48 +175,122 @@ def _timed_command(args, cwd, env) -> dict:
     return {"wall_s": wall, **_parse(out)}
 
 
-def startup_benchmark(duration: str | None = None) -> dict:
-    """``tqdyn run --duration 1h`` (or ``duration``) with a new, empty kernel
-    cache and then with the cache filled: wall time [s] of each command, the
-    JIT time the command reports, and the peak resident set [MB] of the
-    compiling one (children's ``ru_maxrss``, measured from a fresh helper
-    process so that no earlier child counts)."""
+#: The start-up benchmark's commands: ``tqdyn run --duration 1h`` with each integrator (the method named, so
+#: the record means the same whatever the default method).
+STARTUP_RUNS = {"dp87": ("--set", "integrator.method=dp87"), "multistep": ("--set", "integrator.method=multistep")}
+
+#: The child's entry point of the start-up benchmark: the command, with numba's compilations clocked
+#: (:func:`compile_clock`) and their totals written to the file named by $TQDYN_BENCH_JIT_LOG.
+_STARTUP_ENTRY = ("import json, os, sys\n"
+                  "from tqdyn.workflows.bench_mission import compile_clock\n"
+                  "from tqdyn.cli import main\n"
+                  "with compile_clock() as jit:\n"
+                  "    try:\n"
+                  "        status = main()\n"
+                  "    except SystemExit as exc:\n"
+                  "        status = exc.code\n"
+                  "with open(os.environ['TQDYN_BENCH_JIT_LOG'], 'w') as f:\n"
+                  "    json.dump(jit, f)\n"
+                  "sys.exit(status)\n")
+
+
+@contextlib.contextmanager
+def compile_clock():
+    """Context manager clocking numba's compilations in this process: yields
+    a dict whose keys ``"n"`` (compiled functions, outermost only: a kernel
+    compiles what it calls inside its own compilation), ``"wall_s"`` and
+    ``"cpu_s"`` (seconds, wall-clock and CPU of the compiling thread) are
+    updated as compilations end (numba's "numba:compile" events; loading a
+    kernel from the on-disk cache is not a compilation)."""
+    from numba.core import event
+
+    totals = {"n": 0, "wall_s": 0.0, "cpu_s": 0.0}
+    local = threading.local()
+
+    class _Clock(event.Listener):
+        def on_start(self, ev):
+            stack = local.__dict__.setdefault("stack", [])
+            stack.append((time.perf_counter(), time.thread_time()))
+
+        def on_end(self, ev):
+            t0, c0 = local.stack.pop()
+            if not local.stack:
+                totals["n"] += 1
+                totals["wall_s"] += time.perf_counter() - t0
+                totals["cpu_s"] += time.thread_time() - c0
+
+    with event.install_listener("numba:compile", _Clock()):
+        yield totals
+
+
+def _cold_run(args, tmp, env) -> dict:
+    """``tqdyn ARGS`` in ``tmp`` (its kernel cache in ``env``), run by a fresh helper process so that its
+    resource usage is the command's alone: wall time [s], CPU [s], peak resident set [MB], the clocked
+    compilations and the parsed summary."""
     import json
     import subprocess
 
+    log = Path(tmp) / "jit.json"
+    probe = ("import json, resource, subprocess, sys, time\n"
+             "t0 = time.perf_counter()\n"
+             f"p = subprocess.run([sys.executable, '-c', {_STARTUP_ENTRY!r}, *{list(args)!r}], capture_output=True, "
+             "text=True)\n"
+             "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+             "print(json.dumps({'wall_s': time.perf_counter() - t0, 'status': p.returncode, 'stdout': p.stdout, "
+             "'stderr': p.stderr[-2000:], 'cpu_s': u.ru_utime + u.ru_stime, 'peak_rss_mb': u.ru_maxrss / 1024.0}))\n")
+    out = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env={**env, "TQDYN_BENCH_JIT_LOG": str(log)},
+                         capture_output=True, text=True)
+    shown = "tqdyn " + " ".join(args)
+    try:
+        run = json.loads(out.stdout)
+    except ValueError:
+        raise RuntimeError(f"{shown} failed: {out.stderr[-300:]}") from None
+    if run["status"] != 0:
+        last = (run["stderr"].strip().splitlines() or ["no message"])[-1]
+        raise RuntimeError(f"{shown} failed (exit {run['status']}): {last}")
+    jit = json.loads(log.read_text())
+    return {"wall_s": run["wall_s"], "cpu_s": run["cpu_s"], "peak_rss_mb": run["peak_rss_mb"],
+            "jit_n": jit["n"], "jit_wall_s": jit["wall_s"], "jit_cpu_s": jit["cpu_s"], **_parse(run["stdout"])}
+
+
+def startup_benchmark(duration: str | None = None) -> dict:
+    """The first ``tqdyn run`` after an install or a change of the sources:
+    ``tqdyn run --duration 1h`` (or ``duration``) with each integrator of
+    :data:`STARTUP_RUNS`, each with a new, empty kernel cache
+    ($TQDYN_CACHE_DIR a new directory), then again with the cache it
+    filled.  Per command: wall time [s], the child's CPU time [s] and peak
+    resident set [MB], the JIT time the command reports (``compile_s``:
+    compiling or loading the propagation kernels before the propagation),
+    and every compilation of the process clocked from inside (``jit_n``
+    functions, ``jit_wall_s`` and ``jit_cpu_s`` seconds: also the kernels of
+    the time-only inputs, compiled when the inputs are first evaluated).
+    The keys ``cold`` and ``warm`` hold the DP87 command's; ``runs`` both."""
     duration = duration or "1h"
-    with tempfile.TemporaryDirectory(prefix="tqdyn-bench-startup-") as tmp:
-        env = {**os.environ, "TQDYN_CACHE_DIR": str(Path(tmp) / "cache")}
-        args = ["run", "--duration", duration, "--output", "startup.h5", "-q"]
-        probe = ("import json, resource, subprocess, sys, time\n"
-                 "t0 = time.perf_counter()\n"
-                 f"p = subprocess.run([sys.executable, '-c', {_ENTRY!r}, *{args!r}], capture_output=True, text=True)\n"
-                 "print(json.dumps({'wall_s': time.perf_counter() - t0, 'status': p.returncode, 'stdout': p.stdout, "
-                 "'stderr': p.stderr[-2000:], "
-                 "'peak_rss_mb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0}))\n")
-        out = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
-        try:
-            cold = json.loads(out.stdout)
-        except ValueError:
-            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {out.stderr[-300:]}") from None
-        if cold["status"] != 0:
-            last = (cold["stderr"].strip().splitlines() or ["no message"])[-1]
-            raise RuntimeError(f"tqdyn {' '.join(args)} (empty kernel cache) failed: {last}")
-        (Path(tmp) / "startup.h5").unlink(missing_ok=True)
-        warm = _timed_command(args, tmp, env)
-    return {"command": "tqdyn " + " ".join(args[:-3]), "cold": {"wall_s": cold["wall_s"],
-                                                               "peak_rss_mb": cold["peak_rss_mb"],
-                                                               **_parse(cold["stdout"])},
-            "warm": warm}
+    runs = {}
+    for name, extra in STARTUP_RUNS.items():
+        with tempfile.TemporaryDirectory(prefix="tqdyn-bench-startup-") as tmp:
+            env = {**os.environ, "TQDYN_CACHE_DIR": str(Path(tmp) / "cache")}
+            args = ["run", "--duration", duration, *extra, "--output", "startup.h5", "-q"]
+            cold = _cold_run(args, tmp, env)
+            (Path(tmp) / "startup.h5").unlink(missing_ok=True)
+            warm = _timed_command(args, tmp, env)
+        runs[name] = {"command": "tqdyn " + " ".join(args[:-3]), "cold": cold, "warm": warm}
+    first = runs["dp87"]
+    return {"command": first["command"], "cold": first["cold"], "warm": first["warm"], "runs": runs}
 
 
 def format_startup_report(report: dict) -> str:
     """Human-readable lines of a :func:`startup_benchmark` report."""
-    c, w = report["cold"], report["warm"]
-    return (f"start-up: {report['command']}\n"
-            f"  empty kernel cache: {c['wall_s']:.1f} s (JIT {c.get('compile_s', float('nan')):.1f} s), peak resident "
-            f"set {c['peak_rss_mb']:.0f} MB\n"
-            f"  cache filled: {w['wall_s']:.1f} s (JIT {w.get('compile_s', float('nan')):.2f} s)")
+    lines = []
+    for r in report.get("runs", {"dp87": report}).values():
+        c, w = r["cold"], r["warm"]
+        lines += [f"start-up: {r['command']}",
+                  f"  empty kernel cache: {c['wall_s']:.1f} s, CPU {c.get('cpu_s', float('nan')):.1f} s (JIT "
+                  f"{c.get('compile_s', float('nan')):.1f} s as the command reports; all compilations "
+                  f"{c.get('jit_wall_s', float('nan')):.1f} s, CPU {c.get('jit_cpu_s', float('nan')):.1f} s), peak "
+                  f"resident set {c['peak_rss_mb']:.0f} MB",
+                  f"  cache filled: {w['wall_s']:.1f} s (JIT {w.get('compile_s', float('nan')):.2f} s)"]
+    return "\n".join(lines)
 
 
 def format_mission_report(report: dict) -> str:

@@ -29,8 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from .._version import __version__ as _TQDYN_VERSION
 from ..formats import trajectory as _io
+from ..formats.atomic import check_output
 from ..formats.lisa import (AXES, FRAMES, TIME_ORIGINS, GCRS_FRAME_NOTE, GCRS_TIME_NOTE, GCRS_TPS_DEFINITION, uniform_grid, tcb_jd_of_epoch,
                             time_convention, write_lisa_orbits)
 from ..lightpath import light_travel_times_of
@@ -70,11 +72,11 @@ def _resolve_frame(traj, frame, axes, time_origin, src) -> str:
     if frame is None:
         frame = "bcrs" if helio else "gcrs"
     if frame not in FRAMES:
-        raise ValueError(f"frame = {frame!r} is not allowed; allowed: {', '.join(FRAMES)}")
+        raise ValueError(unknown("frame", frame, FRAMES))
     if axes not in AXES:
-        raise ValueError(f"axes = {axes!r} is not allowed; allowed: {', '.join(AXES)}")
+        raise ValueError(unknown("axes", axes, AXES))
     if time_origin not in TIME_ORIGINS:
-        raise ValueError(f"time_origin = {time_origin!r} is not allowed; allowed: {', '.join(TIME_ORIGINS)}")
+        raise ValueError(unknown("time_origin", time_origin, TIME_ORIGINS))
     if helio and frame == "gcrs":
         raise ValueError(f"{src}: a heliocentric trajectory (origin 'sun', BCRS, TDB) exports with frame = 'bcrs' "
                          "only (origin the solar-system barycentre, TCB)")
@@ -148,9 +150,7 @@ def export_lisa(trajectory, out_path, *, shapiro: bool | None = None, gm: float 
     else:
         traj = trajectory
         src = str(getattr(trajectory, "path", ""))
-    out = _io.check_writable(out_path)
-    if src and out.exists() and os.path.exists(src) and os.path.samefile(src, out):
-        raise ValueError(f"output {str(out)!r} is the input trajectory; choose another output path")
+    out = check_output(out_path, "OUT", {"RUN.h5": src or None})
     if traj.n_sat != 3:
         raise ValueError(f"{src}: n_sat = {traj.n_sat}; a LISA orbit file needs 3 satellites (its six links); "
                          f"allowed: a trajectory of 3 satellites (--format oem takes any number)")

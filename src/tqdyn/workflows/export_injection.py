@@ -32,14 +32,21 @@ from ..ttl.coupling import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTL
 from ..ttl.budget import ANGLE_OUTPUTS
 from ..ttl.injection import CENTRAL_FREQ_HZ, readout_injections, tm_velocity_injections
 from ..formats import trajectory as _io
+from ..formats.atomic import check_output
 from ..formats.closed_loop import read_closed_loop
 from ..formats.lisa_injection import write_lisa_injection
 from ..lightpath import light_travel_times_of
 from ..lightpath.proper_time import scenario_gm_earth
 from .closed_loop import file_sha256
 from .export_ttl import coefficient_set
+from .memory import check_memory
 
 __all__ = ["LisaInjection", "export_lisa_injection"]
+
+#: Memory per sample of the closed-loop file [bytes]: about 115 float64 measured at the peak (the
+#: angles' series, the light travel times on their grid, the injections and their derivatives, the
+#: file's image); 128 with a margin.
+BYTES_PER_SAMPLE = 128 * 8
 
 
 @dataclass(frozen=True)
@@ -115,10 +122,8 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
     nu0 = float(central_freq)
     if not (math.isfinite(nu0) and nu0 > 0):
         raise ValueError(f"central_freq = {central_freq!r}: must be a finite frequency > 0 (Hz)")
-    out = _io.check_writable(out_path)
-    for src in (closed_loop_file, run_file):
-        if out.exists() and os.path.exists(src) and os.path.samefile(src, out):
-            raise ValueError(f"output {str(out)!r} is an input file; choose another output path")
+    out = check_output(out_path, "OUT", {"CL.h5": closed_loop_file, "--run": run_file,
+                                         "--coefficients": model.get("file") and coefficients})
     cl = read_closed_loop(closed_loop_file)
     if not os.path.isfile(run_file):
         raise FileNotFoundError(f"run file {str(run_file)!r} not found")
@@ -131,6 +136,9 @@ def export_lisa_injection(closed_loop_file, run_file, out_path, coefficients: st
     if traj.n_sat != 3:
         raise ValueError(f"{run_file}: n_sat = {traj.n_sat}; the six links need 3 satellites")
     signs = _axis_signs(traj, run_file) if tm else None
+    n = int(cl.attrs.get("n_samples", 0))
+    check_memory(n * BYTES_PER_SAMPLE, f"CL.h5: the injection of its {n} samples",
+                 lambda budget: f"at most {budget / BYTES_PER_SAMPLE:.3g} samples (closed-loop --duration, --fs)")
     ts = cl.timeseries(list(ANGLE_OUTPUTS) + (["tm1_acceleration", "tm2_acceleration"] if tm else []))
     t = np.asarray(ts["time"].values, dtype=np.float64)
     dt = 1.0 / float(cl.attrs["fs"])

@@ -20,6 +20,7 @@ import pathlib
 
 from ..astro.timescales import tdb_after, tt_jd
 from ..formats import trajectory as _io
+from ..formats.atomic import check_output
 from ..formats.oem import OemSegment, write_oem_files
 
 __all__ = ["export_oem"]
@@ -47,4 +48,6 @@ def export_oem(run_file, out_file) -> list[pathlib.Path]:
                  comments=(f"tqdyn trajectory {pathlib.Path(run_file).name}, satellite {k + 1} of {len(names)}",))
             for k, name in enumerate(names)]
     pattern = out.name if len(names) == 1 else f"{out.stem}-{{object_name}}.oem"
+    for name in names:
+        check_output(out.parent / pattern.format(object_name=name), "OUT", {"RUN.h5": run_file})
     return write_oem_files(out.parent if str(out.parent) else ".", segs, name=pattern)

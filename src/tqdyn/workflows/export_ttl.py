@@ -22,9 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._choices import unknown
 from ..analysis.ttl_budget import worst_case_coefficients
 from ..ttl.coupling import LINEAR_FIELDS, MOSAS, TimeVaryingTTLCoefficients, TTLCoefficients
+from ..formats.atomic import check_output
 from ..formats.closed_loop import read_closed_loop
+from .memory import check_memory
 from ..formats.ttl import write_ttl_file
 from .closed_loop import file_sha256
 
@@ -32,6 +35,9 @@ __all__ = ["COEFFICIENT_KINDS", "TTLExport", "coefficient_set", "export_ttl", "r
 
 #: Built-in coefficient sets (anything else is a TOML or JSON file of per-MOSA coefficients).
 COEFFICIENT_KINDS = ("worst-case", "random")
+#: Memory per sample of an export [bytes]: 51 float64 measured at the peak (24 coefficient series,
+#: their drifting values, t, the file's image), with --drift (27 without); 52 with a margin.
+BYTES_PER_SAMPLE = 52 * 8
 
 
 @dataclass(frozen=True)
@@ -67,7 +73,7 @@ def read_coefficient_file(path) -> TTLCoefficients:
         raise ValueError(f"{p}: expected tables {', '.join(LINEAR_FIELDS)}")
     for k in data:
         if k not in LINEAR_FIELDS:
-            raise ValueError(f"{p}: unknown key {k!r} (allowed: {', '.join(LINEAR_FIELDS)})")
+            raise ValueError(unknown(str(p), k, LINEAR_FIELDS, problem="is not a key"))
     try:
         return TTLCoefficients(**{f: data.get(f) for f in LINEAR_FIELDS})
     except ValueError as exc:
@@ -95,11 +101,17 @@ def coefficient_set(coefficients, seed=None) -> tuple[TTLCoefficients, dict]:
 
 def _grid(t: np.ndarray, step) -> np.ndarray:
     if step is None:
+        check_memory(t.size * BYTES_PER_SAMPLE, f"the TTL file of the closed-loop file's {t.size} samples",
+                     "a --step coarser than the closed-loop file's grid")
         return t
     s = float(step)
     if not math.isfinite(s) or s <= 0:
         raise ValueError(f"--step = {step!r}: must be a finite number > 0 (s)")
     span = float(t[-1] - t[0])
+    n = math.floor(span / s) + 2
+    check_memory(n * BYTES_PER_SAMPLE, f"--step = {step!r}: the TTL file of {n:.3g} samples",
+                 lambda budget: f"--step >= {span / max(budget / BYTES_PER_SAMPLE - 2, 1):.3g} s over the closed-loop "
+                                f"file's {span:g} s")
     k = np.arange(int(math.floor(span / s)) + 1)
     g = t[0] + s * k
     if g[-1] < t[-1]:
@@ -123,6 +135,7 @@ def export_ttl(cl_file, out_file, *, coefficients: str = "worst-case", seed: int
     base, model = coefficient_set(coefficients, seed)
     model["base_m_per_rad"] = {f: getattr(base, f) for f in LINEAR_FIELDS}
     src = pathlib.Path(cl_file)
+    check_output(out_file, "OUT", {"CL.h5": src, "--coefficients": model.get("file") and coefficients})
     cl = read_closed_loop(src)
     names = [str(o) for o in cl.timeseries(stop=1)["output"].values]
     if not names:

@@ -23,9 +23,10 @@ import math
 import os
 import platform
 import sys
-import tempfile
 from importlib import metadata
 from pathlib import Path
+
+from ..formats.atomic import replacing
 
 __all__ = ["FORMAT_VERSION", "LIBRARIES", "machine", "libraries", "provenance", "to_json", "read_record",
            "write_record", "merge_section"]
@@ -146,17 +147,8 @@ def write_record(path, data: dict) -> Path:
     p = Path(path)
     text = json.dumps(to_json(data), indent=1, ensure_ascii=False, allow_nan=False) + "\n"
     p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary file (mkstemp makes it private)
-        os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with replacing(p, "the JSON record") as tmp:
+        tmp.write_text(text, encoding="utf-8")
     return p
 
 

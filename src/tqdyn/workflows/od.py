@@ -25,8 +25,9 @@ from typing import Callable
 
 import numpy as np
 
+from .._choices import allowed as allowed_names, did_you_mean, unknown
 from ..formats import trajectory as io
-from ..formats.atomic import replacing
+from ..formats.atomic import check_output, replacing, same_file
 from ..formats.od_estimate import estimate_contents, write_estimate_file
 from ..formats.od_tdm import read_measurements_tdm, write_measurements_tdm
 from .closed_loop import file_sha256
@@ -52,10 +53,10 @@ def parse_tracking(text, option: str = "--tracking") -> tuple[str, ...]:
     allowed = _problem().TRACKING_KINDS
     kinds = tuple(k.strip() for k in (text.split(",") if isinstance(text, str) else text))
     if not kinds or any(not k for k in kinds):
-        raise ValueError(f"{option}: {text!r} is empty; allowed: a comma-separated list of {', '.join(allowed)}")
+        raise ValueError(f"{option}: {text!r} is empty; allowed: a comma-separated list of {allowed_names(allowed)}")
     for k in kinds:
         if k not in allowed:
-            raise ValueError(f"{option}: {k!r} is not a tracking type; allowed: {', '.join(allowed)}")
+            raise ValueError(unknown(option, k, allowed, problem="is not a tracking type"))
     if len(set(kinds)) != len(kinds):
         raise ValueError(f"{option}: {text!r} names a tracking type twice")
     return kinds
@@ -99,9 +100,10 @@ def parse_biases(items, option: str = "--bias") -> dict:
     allowed = _problem().BIAS_TYPES
     out = {}
     for key, value in _key_values(items, option, "TYPE=VALUE or TYPE/STATION=VALUE"):
-        if key.removeprefix("bias/").split("/")[0] not in allowed:
-            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(allowed)} "
-                             f"(or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
+        typ = key.removeprefix("bias/").split("/")[0]
+        if typ not in allowed:
+            raise ValueError(f"{option}: {key!r} is not allowed{did_you_mean(typ, allowed)}; allowed: "
+                             f"{', '.join(allowed)} (or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
         out[key] = _number(value, option, key, positive=False)
     return out
 
@@ -120,9 +122,10 @@ def parse_a_priori(items, option: str = "--a-priori") -> dict:
     out: dict = {}
     for key, value in pairs:
         group, _, typ = key.partition("/")
-        if group not in groups or (typ and (group != "bias" or typ not in _problem().BIAS_TYPES)):
-            raise ValueError(f"{option}: {key!r} is not allowed; allowed: {', '.join(groups)} (or bias/TYPE, TYPE "
-                             f"one of {', '.join(_problem().BIAS_TYPES)})")
+        if group not in groups:
+            raise ValueError(unknown(option, key, groups) + " (or bias/TYPE)")
+        if typ and (group != "bias" or typ not in _problem().BIAS_TYPES):
+            raise ValueError(unknown(option, key, [f"bias/{t}" for t in _problem().BIAS_TYPES]))
         parts = value.split(",") if isinstance(value, str) else [value]
         if len(parts) != (2 if group == "state" else 1):
             raise ValueError(f"{option}: {key} = {value!r} is not allowed; allowed: "
@@ -174,27 +177,42 @@ def parameter_unit(name: str) -> str:
     return "m/s^2" if last in PARAMETER_NAMES or last in COMMON_NAMES else ""
 
 
-def _same(a, b) -> bool:
-    pa, pb = pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(a)))), \
-        pathlib.Path(os.path.abspath(os.path.expanduser(os.fspath(b))))
-    if pa.exists() and pb.exists():
-        return os.path.samefile(pa, pb)
-    return pa == pb
-
-
-def _check_output(output, option: str, inputs: dict) -> pathlib.Path:
-    out = io.check_writable(output)
-    for label, path in inputs.items():
-        if path is not None and os.path.exists(os.fspath(path)) and _same(out, path):
-            raise ValueError(f"{option}: {str(out)!r} is the input {label}; allowed: another file")
-    return out
-
-
 def _check_arc(scen, arc_s: float, source: str) -> None:
     span = float(scen.run.duration_s)
     if arc_s > span:
         raise ValueError(f"--arc: {arc_s:g} s is outside the run {source} ({span:g} s from its epoch); allowed: "
                          f"0 < arc <= {span:g} s (or --set run.duration=...)")
+
+
+def _check_rows(scen, fields, arc_s: float, tdm) -> None:
+    """Every measurement row against the run, before any propagation: its satellite is one of the
+    scenario's, its epoch t [s] lies in [0, arc] (the header's ``tqdyn arc_s``, at most the run's
+    span) and on the run's step grid (``integrator.step``).  One line naming the file's line."""
+    from ..od.variational import off_grid
+
+    t, sat, line = fields["t"], fields["sat"], fields["line"]
+    n_sat, span, step = len(scen.satellites), float(scen.run.duration_s), float(scen.integrator.step_s)
+    end = min(arc_s, span)
+
+    def first(mask):
+        i = np.flatnonzero(mask)
+        return int(i[np.argmin(line[i])]) if i.size else None
+
+    i = first(sat >= n_sat)
+    if i is not None:
+        raise ValueError(f"{tdm}, line {line[i]}: tqdyn sat = {sat[i]}; allowed: 0..{n_sat - 1} (the scenario's "
+                         f"{n_sat} satellites)")
+    i = first(~((t >= 0) & (t <= end + 1e-9 * max(1.0, end))))
+    if i is not None:
+        what = (f"the arc 0..{end:g} s (header tqdyn arc_s; the run spans {span:g} s)" if arc_s <= span
+                else f"the run, 0..{span:g} s")
+        raise ValueError(f"{tdm}, line {line[i]}: epoch at t = {t[i]:.12g} s (from the scenario epoch) is outside "
+                         f"{what}; allowed: epochs in it")
+    i = first(off_grid(t, step))
+    if i is not None:
+        d = t[i] - round(t[i] / step) * step
+        raise ValueError(f"{tdm}, line {line[i]}: epoch at t = {t[i]:.12g} s (from the scenario epoch) is {d:+.3g} s "
+                         f"off the step grid (integrator.step = {step:g} s); allowed: multiples of {step:g} s")
 
 
 def _scenario(scenario, overrides):
@@ -244,6 +262,12 @@ def _sp3_paths(sp3, kinds) -> list:
         if not os.path.isfile(os.fspath(path)):
             raise FileNotFoundError(f"--sp3: SP3 file {str(path)!r} does not exist or is not a file")
     return paths
+
+
+def _sp3_inputs(sp3) -> dict:
+    """{"--sp3 FILE": path} of the ``--sp3`` files (inputs an output must not be)."""
+    paths = [sp3] if isinstance(sp3, (str, os.PathLike)) else list(sp3 or ())
+    return {f"--sp3 {os.fspath(p)}": p for p in paths}
 
 
 def _sp3_orbits(paths, scen, arc_s: float) -> dict:
@@ -312,7 +336,7 @@ def simulate_to_tdm(run_file, tracking, arc, *, output, seed: int = 0, interval=
         raise (FileNotFoundError(f"RUN.h5: trajectory file {str(run_file)!r} does not exist or is not a file")
                if not os.path.isfile(os.fspath(run_file)) else
                ValueError(f"RUN.h5: {str(run_file)!r} is not a trajectory file; allowed: a file written by tqdyn run"))
-    out = _check_output(output, "--output", {"RUN.h5": run_file})
+    out = check_output(output, "--output", {"RUN.h5": run_file, **_sp3_inputs(sp3_paths)})
     scen, notes, label = _scenario(run_file, overrides)
     _check_arc(scen, arc_s, label)
     p = _problem()
@@ -372,8 +396,9 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         raise ValueError(f"--edit-sigma: {edit_sigma!r} is not allowed; allowed: a number > 0")
     if not os.path.isfile(os.fspath(tdm)):
         raise FileNotFoundError(f"MEAS.tdm: measurement file {str(tdm)!r} does not exist or is not a file")
-    inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
-    out = _check_output(output, "--output", inputs) if output is not None else None
+    inputs = {"MEAS.tdm": tdm, "SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None,
+              **_sp3_inputs(sp3)}
+    out = check_output(output, "--output", inputs) if output is not None else None
     if figure is not None:
         from ..analysis.figures_od import check_residual_figure_path
 
@@ -382,20 +407,20 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         except ImportError as exc:
             raise ValueError(f"--figure: {str(figure)!r} cannot be drawn ({exc}); allowed: no --figure, or install "
                              "matplotlib") from None
-        if out is not None and _same(out, figure):
+        if out is not None and same_file(out, figure):
             raise ValueError(f"--figure: {str(figure)!r} is the output EST.h5; allowed: another file")
-        for label, path in inputs.items():
-            if path is not None and _same(figure, path):
-                raise ValueError(f"--figure: {str(figure)!r} is the input {label}; allowed: another file")
+        check_output(figure, "--figure", inputs)
     scen, notes, label = _scenario(scenario, overrides)
     say("reading")
-    fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale)
+    fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale,
+                                         with_lines=True)
     kinds = tuple(info["tracking"].split(",")) if info.get("tracking") else \
         tuple(dict.fromkeys(KIND_OF_TYPE[t] for t in fields["type"]))
     parse_tracking(kinds, f"{tdm}: header tqdyn tracking")
     sp3_paths = _sp3_paths(sp3, kinds)
     sp3_record = _check_sp3_against(info, sp3_paths, tdm)
     arc_s = _header_number(info, "arc_s", tdm) if "arc_s" in info else float(np.max(fields["t"]))
+    _check_rows(scen, fields, arc_s, tdm)
     _check_arc(scen, arc_s, label)
     interval_s = _header_number(info, "interval_s", tdm) if "interval_s" in info else None
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,
@@ -424,7 +449,12 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
         say("plotting")
         try:
             plot_od_residuals(estimate_contents(fit, meas, attrs=attrs, units=units, residual_rows=rows), figure)
-        except (OSError, RuntimeError) as exc:  # a full disk, a directory removed since the check
+        except io.OutputIOError as exc:  # a full disk: status 3, the estimate file stays
+            err = io.OutputIOError(f"--figure: {exc}")
+            err.tqdyn_note = ("the figure was not written" + (f", the estimate file {str(out)!r} was"
+                                                              if out is not None else ""))
+            raise err from None
+        except (OSError, RuntimeError) as exc:  # a directory removed since the check, a missing LaTeX
             raise ValueError(f"--figure: {str(figure)!r} could not be written ({exc}); nothing was written there"
                              + (f", the estimate file {str(out)!r} was" if out is not None else "")
                              + "; allowed: a writable file with space for the figure") from None
@@ -444,8 +474,8 @@ def covariance_of(scenario, tracking, arc, *, interval=None, estimate=None, cons
     est_names, con_names = parse_names(estimate, "--estimate"), parse_names(consider, "--consider")
     sig = parse_a_priori(a_priori)
     _check_consider(con_names, sig)
-    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None}
-    out = _check_output(json_out, "--json", inputs) if json_out is not None else None
+    inputs = {"SCENARIO": scenario if scenario and os.path.isfile(str(scenario)) else None, **_sp3_inputs(sp3_paths)}
+    out = check_output(json_out, "--json", inputs) if json_out is not None else None
     scen, notes, label = _scenario(scenario, overrides)
     _check_arc(scen, arc_s, label)
     plan = _tracking(kinds, arc_s, interval_s, est_names, con_names, a_priori_sigma=sig or None,

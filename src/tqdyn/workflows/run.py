@@ -13,6 +13,8 @@ another run) raises ``ValueError`` /
 Any exception during the propagation (including ``KeyboardInterrupt``) is
 re-raised after clean-up; its attribute ``tqdyn_checkpoint`` is the
 checkpoint path if the run can be resumed (``--resume``), else None.  A
+state that stops being finite (:class:`tqdyn.dynamics.NonFiniteStateError`) leaves no file and no
+checkpoint (resuming would meet it again).  A
 failed write (disk full, file-size limit) is an
 :class:`tqdyn.formats.trajectory.OutputIOError`; the last checkpoint (if
 any) and its partial trajectory stay valid for ``--resume``.
@@ -22,6 +24,7 @@ work starts (the CLI calls it before its banner).
 
 from __future__ import annotations
 
+import os
 import time
 import traceback
 from dataclasses import dataclass
@@ -31,12 +34,13 @@ from typing import Callable
 from ..formats import trajectory as io
 from .. import dynamics
 from ..dynamics import Checkpoint, RunResult, row_names
+from ..formats.atomic import same_file
 from ..formats.checkpoint import read_checkpoint, write_checkpoint
 from .heap import bound_heap_retention
 
 __all__ = ["RunSummary", "run_to_file", "run_scenario_text", "one_line", "output_fields", "output_attrs",
            "spacecraft_attrs", "checkpoint_path", "check_checkpoint", "eop_attrs", "eop_warning", "load_run_scenario",
-           "scenario_of_trajectory"]
+           "scenario_inputs", "scenario_of_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -184,8 +188,6 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
     ``writes``: the run will write ``run.output``, which must not be ``path``.
     Raises FileNotFoundError, ValueError (one line: not a trajectory, no
     scenario, the output would replace ``path``) or ScenarioError."""
-    import os
-
     from ..scenario import loads_scenario
     from ..scenario.record import compare_constants, run_constants
 
@@ -214,11 +216,24 @@ def scenario_of_trajectory(path, overrides=(), *, writes: bool = False):
             notes.append(f"{path}: this tqdyn will not reproduce the file's run: {diffs[0]}{more}")
     if overrides:
         scen = loads_scenario(text, [*legacy, *overrides], source=src)
-    out = os.path.abspath(os.path.expanduser(scen.run.output))
-    if writes and os.path.exists(out) and os.path.samefile(out, path):
+    if writes and os.path.exists(os.path.expanduser(scen.run.output)) and same_file(scen.run.output, path):
         raise ValueError(f"run.output: {scen.run.output!r} is the trajectory the scenario is read from; allowed: "
                          "another file (-o OUT.h5, or --set run.output=OUT.h5)")
     return scen, notes
+
+
+def scenario_inputs(scenario, scen) -> dict:
+    """The files a run of ``scen`` reads, {label: path}: the scenario argument ``scenario`` when it is
+    a file (a TOML file or a run file), ``forces.ephemeris`` when it is a path, ``initial.oem.N``; an
+    output must be none of them (:func:`tqdyn.formats.atomic.check_output`)."""
+    files = {}
+    if scenario is not None and os.path.isfile(os.fspath(scenario)):
+        files["SCENARIO"] = scenario
+    if scen.forces.ephemeris != "de421":
+        files["forces.ephemeris"] = scen.forces.ephemeris
+    for k, path in enumerate(scen.initial.oem, start=1):
+        files[f"initial.oem.{k}"] = path
+    return files
 
 
 def load_run_scenario(scenario=None, overrides=(), *, writes: bool = False):
@@ -252,8 +267,7 @@ def check_checkpoint(scen, resume: bool) -> None:
         try:
             io.TrajectoryWriter.check_partial(data.partial, data.rows)
         except io.OutputError as exc:
-            raise ValueError(f"--resume: {exc} (checkpoint {ckpt}); remove the checkpoint and run again "
-                             f"without --resume") from None
+            raise ValueError(f"--resume: {exc}; remove the checkpoint {ckpt} to start again") from None
     elif ckpt.exists():
         raise ValueError(f"{ckpt} holds the checkpoint of an interrupted run: continue it with "
                          f"--resume, or delete it to start again")
@@ -297,7 +311,7 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         writer_factory = None
     t0 = time.perf_counter()
     try:
-        dynamics.warm_up(scen.run.precision, scen.integrator.method)
+        dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
     except OSError as exc:  # numba could not write its cache (disk full, file-size limit)
         raise io.OutputIOError(f"JIT compilation could not write numba's cache: {exc.strerror or exc}; free "
                                f"space, or set NUMBA_CACHE_DIR to a writable directory") from None
@@ -335,7 +349,10 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         rows = writer.rows_written
         writer.close()
     except BaseException as exc:
-        # keep the partial trajectory while a checkpoint refers to it; else discard it
+        # keep the partial trajectory while a checkpoint refers to it; else discard it.  A state that is
+        # not finite would come back on resuming: nothing is kept (no file, no checkpoint).
+        if isinstance(exc, dynamics.NonFiniteStateError):
+            ckpt.unlink(missing_ok=True)
         resumable = ckpt.exists()
         writer.keep_partial() if resumable else writer.abort()
         try:

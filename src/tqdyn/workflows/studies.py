@@ -28,6 +28,12 @@ Y_S . v / |v| on a run and the report prints it from every coupled run.
 The "+flight" common self-gravity of 1e-9 m/s^2 is therefore
 ``[0, -1e-9, 0]`` in S.
 
+Every run integrates with DP87 at the scenario's step (:data:`STUDY_INTEGRATOR`, applied before the
+run's own overrides): the paper's section V was computed with it, so the studies reproduce it with
+the paper's method rather than the default of ``tqdyn run`` (the multistep method, which agrees with
+DP87 to DP87's own reproducibility: docs/precision.md), and the runs' files (their digests) and
+records are those measured before that default changed.
+
 Runs live in a runs directory as ``<run name>-<digest>.h5``, the digest a
 short SHA-256 of the resolved scenario (with ``run.output`` normalised), so a
 scaled ("quick") set and the full set can coexist.  A run whose file is a
@@ -51,9 +57,12 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from .._choices import unknown
+
 __all__ = [
     "BASE_SCENARIO",
     "COARSE_EVERY",
+    "STUDY_INTEGRATOR",
     "FLIGHT_DIRECTION_S",
     "QUICK_SCALE",
     "RUNS",
@@ -72,6 +81,8 @@ __all__ = [
 
 #: Base scenario of every study run (full force model, Table I elements).
 BASE_SCENARIO = "tianqin"
+#: Overrides of every study run, before its own: the paper's integrator, DP87 (the module docstring).
+STUDY_INTEGRATOR = ("integrator.method=dp87",)
 #: Output decimation of the 90-day runs (rows every 12 x 50 s = 600 s).
 COARSE_EVERY = 12
 #: Duration scale of ``tqdyn report --studies --quick``: 90 days -> 1 day, 30 days -> 8 h.
@@ -88,7 +99,7 @@ _DIGEST_CHARS = 12
 @dataclass(frozen=True)
 class RunSpec:
     """One study run: ``scenario`` (built-in name) + ``overrides`` (as for
-    ``tqdyn run --set``), ``days`` nominal duration [days],
+    ``tqdyn run --set``; after :data:`STUDY_INTEGRATOR`), ``days`` nominal duration [days],
     ``output_every`` (output row every N integrator steps), ``description``."""
 
     name: str
@@ -109,10 +120,11 @@ class RunSpec:
         """
         from ..scenario import load_scenario
 
-        base = load_scenario(self.scenario, [*self.overrides, *extra])
+        own = [*STUDY_INTEGRATOR, *self.overrides, *extra]
+        base = load_scenario(self.scenario, own)
         step = float(base.integrator.step_s)
         dur = scaled_duration_s(self.days, duration_scale, step * self.output_every)
-        return load_scenario(self.scenario, [*self.overrides, *extra, f"run.duration={dur}",
+        return load_scenario(self.scenario, [*own, f"run.duration={dur}",
                                              f"run.output_every={self.output_every}",
                                              f"run.output={output or _PLACEHOLDER}"])
 
@@ -186,6 +198,8 @@ RUNS: dict[str, RunSpec] = _runs()
 _SG_RUNS = tuple(f"sg{label}-90d" for label in SG_DIRECTIONS)
 
 #: The studies of the paper's section V by name (in report order).
+#: Where the studies are listed.
+STUDIES_DOC = "docs/report.md#studies"
 STUDIES: dict[str, Study] = {s.name: s for s in [
     Study("pointing", "Pointing error of the global and Taylor laws vs the iterative law", "Fig. 5",
           ("dragfree-global-30d-50s",),
@@ -258,7 +272,7 @@ def _check_names(studies, catalogue=None) -> tuple[str, ...]:
         studies = (studies,)
     for s in studies:
         if s not in catalogue:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(catalogue)}")
+            raise ValueError(unknown("study", s, catalogue, STUDIES_DOC, problem="is not a study"))
     return tuple(studies)
 
 

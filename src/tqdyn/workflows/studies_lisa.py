@@ -19,7 +19,8 @@ built-in scenarios as bases and overrides only:
 
 Every run is one year (365 d; ESA's whole file span, 3926.5 d, for the
 ``esa-ramp-span`` study) at the scenarios' 6 h step with a row at every step
-(1461 rows per year).  The "no self-gravity" coupled
+(1461 rows per year), integrated with DP87 as the TianQin set
+(:data:`~tqdyn.workflows.studies.STUDY_INTEGRATOR`).  The "no self-gravity" coupled
 runs switch ESA's ramp off with ``spacecraft.self_gravity_center=[0, 0]``
 (the scenario key has no "off" value; zero adds nothing).
 

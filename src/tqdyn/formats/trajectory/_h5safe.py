@@ -151,15 +151,15 @@ def check_partial(partial, rows: int) -> None:
     ``partial`` of a checkpoint can be continued (:meth:`reopen`): it
     exists, HDF5 opens it and its time field holds at least ``rows``
     rows.  Raises :class:`OutputError` (one line) otherwise."""
+    name = os.path.basename(partial)
     if not os.path.isfile(partial):
-        raise OutputError(f"partial trajectory {str(partial)!r} of the checkpoint is missing; cannot resume")
+        raise OutputError(f"partial trajectory {name!r} is missing")
     try:
         with h5py.File(partial, "r") as h5:
             t = h5["t"] if "t" in h5 else None
             n = rows if t is None else (t.shape[0] if isinstance(t, h5py.Dataset) else t["hi"].shape[0])
     except Exception as exc:  # noqa: BLE001 - damaged by a crash in the middle of a write
-        raise OutputError(f"partial trajectory {str(partial)!r} of the checkpoint cannot be read "
-                          f"({_io_reason(exc)}); cannot resume") from None
+        reason = re.sub(r"^[^(]*\((.*)\)$", r"\1", _io_reason(exc)).split(",")[0]
+        raise OutputError(f"partial trajectory {name!r} cannot be read ({reason})") from None
     if n < rows:
-        raise OutputError(f"partial trajectory {str(partial)!r} holds {n} rows, the checkpoint needs "
-                          f"{rows}; cannot resume")
+        raise OutputError(f"partial trajectory {name!r} holds {n} rows, the checkpoint needs {rows}")

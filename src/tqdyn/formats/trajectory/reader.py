@@ -10,6 +10,7 @@ from typing import Any, Mapping
 import h5py
 import numpy as np
 
+from ..._choices import allowed, did_you_mean
 from ..._version import __version__ as _TQDYN_VERSION
 from ...numerics.dd import np_two_sum
 from ...astro.reference import GEOCENTRIC, GEOCENTRIC_V1, REFERENCE_SYSTEMS, ReferenceSystem
@@ -289,9 +290,10 @@ class Trajectory:
             return self._data[path]
         except KeyError:
             if path in FIELDS:
-                msg = f"{self._where} has no field {path!r}; it has: {', '.join(self.fields)}"
+                msg = f"{self._where} has no field {path!r}; it has: {allowed(self.fields, noun='fields')}"
             else:
-                msg = f"unknown field {path!r}; fields of {self._where}: {', '.join(self.fields)}"
+                msg = (f"unknown field {path!r}{did_you_mean(path, self.fields)}; fields of {self._where}: "
+                       f"{allowed(self.fields, noun='fields')}")
             raise KeyError(msg) from None
 
     def __getitem__(self, path: str) -> np.ndarray:

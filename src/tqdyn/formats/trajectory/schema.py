@@ -17,6 +17,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..._choices import unknown
 from ..._version import __version__ as _TQDYN_VERSION
 from ...astro.reference import GEOCENTRIC, REFERENCE_SYSTEMS
 
@@ -120,6 +121,8 @@ def field_frame(spec: FieldSpec, time_scale: str, frame: str) -> str:
     return frame if spec.frame == "GCRS" else spec.frame
 
 
+#: Where the fields are listed.
+FIELDS_DOC = "docs/trajectory-format.md#fields"
 FIELDS: dict[str, FieldSpec] = {
     "t": _f("dd", (), (), "s", "time_scale",
             "time since epoch_utc in the root attribute time_scale (TT: seconds of TT since the epoch's TT)"),
@@ -330,7 +333,7 @@ def _spec(path: str, where: str) -> FieldSpec:
     try:
         return FIELDS[path]
     except KeyError:
-        raise ValueError(f"{where}: unknown field {path!r}; allowed: {', '.join(FIELDS)}") from None
+        raise ValueError(unknown(where, path, FIELDS, FIELDS_DOC, problem="is not a field", noun="fields")) from None
 
 
 def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
@@ -364,7 +367,7 @@ def _check_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
     out["format"], out["format_version"] = FORMAT, FORMAT_VERSION  # exact types (str, int)
     for key, allowed in _CHOICES.items():
         if out[key] not in allowed:
-            raise ValueError(f"attrs[{key!r}] = {out[key]!r}; allowed: {' | '.join(allowed)}")
+            raise ValueError(unknown(f"attrs[{key!r}]", out[key], allowed))
     if (out["origin"], out["frame"], out["time_scale"]) not in {(r.origin, r.frame, r.time_scale)
                                                                 for r in REFERENCE_SYSTEMS}:
         raise ValueError(f"attrs: origin / frame / time_scale = {out['origin']!r} / {out['frame']!r} / "

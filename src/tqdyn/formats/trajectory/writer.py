@@ -23,6 +23,7 @@ import numpy as np
 from . import _h5safe
 from ._h5safe import _cleanup, _close_h5, _fsync_strict, _io_reason, _neutralize, _vfd, check_partial, headroom_errno
 from .schema import FIELDS, FieldSpec, OutputError, OutputIOError, _check_attrs, _fmt_shape, _spec, _symbolic, dataset_attrs
+from ..stop import check_stop
 
 __all__ = ["check_writable", "hdf5_poisoned", "TrajectoryWriter"]
 
@@ -426,6 +427,7 @@ class TrajectoryWriter:
         if self._status == "failed":
             raise self._failure
         h5 = self._require_open("close")
+        check_stop()  # a stop signal that arrived: the partial file stays as it is (a checkpoint may need it)
         try:
             if self._static_pending:
                 raise ValueError(f"close: declared static field(s) {', '.join(sorted(self._static_pending))} "
@@ -512,7 +514,7 @@ class TrajectoryWriter:
         self = cls.__new__(cls)
         self._path = check_writable(path)
         if not os.path.isfile(partial):
-            raise OutputError(f"partial trajectory {str(partial)!r} of the checkpoint is missing; cannot resume")
+            raise OutputError(f"partial trajectory {os.path.basename(partial)!r} is missing")
         self._state = {"tmp": str(partial)}
         self._finalizer = weakref.finalize(self, _cleanup, self._state)
         try:

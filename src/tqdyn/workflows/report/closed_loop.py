@@ -28,6 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..._choices import unknown
 from ...analysis.closed_loop import BANDS
 from ...analysis.closed_loop_paths import DC_SUSPENSION_LIMIT, dc_paths
 from ...analysis.figures_closed_loop import (plot_budget_stack, plot_link_budget, plot_loop_gains,
@@ -36,7 +37,7 @@ from ...analysis.ttl_budget import ttl_budget_values
 from ...closedloop.budget import dominant_sources, loop_gains, loop_margins, noise_budget
 from ...closedloop.controllers import LOOPS
 from ...closedloop.loop import OUTPUTS, output_names
-from ...closedloop.missions import MISSIONS, requirement
+from ...closedloop.missions import CONSTELLATION_MISSIONS, requirement
 from ...closedloop.model import closed_loop_model
 from .summary import Report, SummaryRow, _e, _finish, check_out_dir
 
@@ -87,7 +88,7 @@ def _coupled_run(name: str, overrides):
 
     scen = load_scenario(name, list(overrides))
     model = dynamics.check_inputs(scen)
-    dynamics.warm_up(scen.run.precision, scen.integrator.method)
+    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
     blocks: list = []
     dynamics.propagate(scen, sink=blocks.append, model=model)
     return Trajectory.from_rows(dynamics.Rows.concatenate(blocks), output_attrs(scen, model),
@@ -154,7 +155,7 @@ def _mission_values(mission: str, model, run_text: str) -> tuple[dict, dict]:
     return values, arrays
 
 
-def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
+def report_closed_loop(out_dir: str | os.PathLike, missions=CONSTELLATION_MISSIONS, *,
                        progress: Callable[[str], None] | None = None, figures: bool = True) -> Report:
     """Figures (unless ``figures`` is False), summary rows and values of the closed loop of ``missions``
     (module docstring).
@@ -163,8 +164,8 @@ def report_closed_loop(out_dir: str | os.PathLike, missions=MISSIONS, *,
     frequencies, bands and limit they refer to)."""
     say = progress or (lambda msg: None)
     for m in missions:
-        if m not in MISSIONS:
-            raise ValueError(f"mission: {m!r} is not a mission; allowed: {', '.join(MISSIONS)}")
+        if m not in CONSTELLATION_MISSIONS:
+            raise ValueError(unknown("mission", m, CONSTELLATION_MISSIONS, problem="is not a constellation mission"))
     rep = Report(out_dir=check_out_dir(out_dir))
     fig_dir = check_out_dir(rep.out_dir / "closed-loop")
     rep.values = {"frequencies_hz": list(FREQUENCIES_HZ), "link_frequencies_hz": list(LINK_FREQUENCIES_HZ),

@@ -12,8 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..._choices import unknown
 from ...analysis.metrics import times_s
 from ...formats import trajectory as io
+from ..studies import STUDIES_DOC
 
 __all__ = ["Report", "RunFiles", "evaluate_studies", "SummaryRow", "check_out_dir", "format_summary",
            "write_summary_json"]
@@ -174,7 +176,7 @@ def evaluate_studies(catalogue, funcs, run_paths, out_dir, studies=None, progres
     names = tuple(catalogue) if studies is None else tuple(studies)
     for s in names:
         if s not in catalogue:
-            raise ValueError(f"study: {s!r} is not a study; allowed: {', '.join(catalogue)}")
+            raise ValueError(unknown("study", s, catalogue, STUDIES_DOC, problem="is not a study"))
     rep = Report(out_dir=check_out_dir(out_dir))
     runs = RunFiles({k: (Path(v) if v is not None else None) for k, v in run_paths.items()})
     for s in names:

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ...formats import trajectory as io
+from ...formats.atomic import same_file
 from ...formats.netcdf import netcdf_engine
 from .integrity import write_sweep_netcdf
 from .gathering import gather
@@ -107,13 +108,13 @@ def connect(scheduler, *, security=None, timeout: float = DEFAULT_CONNECT_TIMEOU
 
         if not dask.config.get("distributed.comm.tls.ca-file", None):
             raise _err("scheduler", scheduler, "is a tls:// address but no TLS certificates are configured",
-                       "--tls-ca-file/--tls-cert/--tls-key, or Dask's distributed.comm.tls.ca-file / "
-                       "distributed.comm.tls.client.cert / .key configuration")
+                       "--tls-* options, or Dask's distributed.comm.tls configuration")
     kwargs = {} if security is None else {"security": security}
     try:
         return Client(scheduler, timeout=timeout, **kwargs)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
-        raise _err("scheduler", scheduler, f"cannot be reached within {timeout:g} s ({one_line(exc)})",
+        why = "timed out" if "timed out" in str(exc).lower() else one_line(exc)
+        raise _err("scheduler", scheduler, f"cannot be reached within {timeout:g} s ({why})",
                    "the address of a running Dask scheduler, e.g. tcp://host:8786") from None
 
 
@@ -216,8 +217,17 @@ def _execute(pending: Sequence[Member], client, progress) -> list[MemberOutcome]
 def check_output_dir(plan: SweepPlan) -> None:
     """Check, creating nothing, that ``<output_dir>`` is (or can be created
     as) a writable directory and ``<output_dir>/<name>.nc`` can be written
-    there.  :class:`SweepError` (one line) otherwise."""
+    there, and that neither it nor a member file is one of the sweep's inputs (the sweep file, the
+    base scenario file: :func:`tqdyn.formats.atomic.same_file`).  :class:`SweepError` (one line)
+    otherwise."""
     out_dir = Path(os.path.abspath(plan.spec.output_dir))
+    inputs = {"sweep file": plan.spec.source,
+              "sweep.scenario": plan.spec.scenario if os.path.isfile(plan.spec.scenario) else None}
+    for path in [plan.spec.output] + [m.path for m in plan.members]:
+        for label, src in inputs.items():
+            if src is not None and os.path.exists(path) and same_file(path, src):
+                raise _err("sweep.output_dir", str(out_dir), f"holds the output {Path(path).name}, which is the "
+                           f"{label} {str(src)!r}", "a directory where no output is an input")
 
     def bad(why):
         return _err("sweep.output_dir", str(out_dir), why, "a directory that can be created and written")

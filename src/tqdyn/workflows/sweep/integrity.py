@@ -32,8 +32,13 @@ def checksum_encoding(dataset) -> dict:
 def write_sweep_netcdf(dataset, path: str | os.PathLike) -> Path:
     """Write ``dataset`` atomically as netCDF-4 (temporary file in the same
     directory, then renamed) with Fletcher-32 checksums (:func:`checksum_encoding`).
-    Returns the absolute path."""
-    return write_netcdf(dataset, path, encoding=checksum_encoding(dataset))
+    Returns the absolute path.  The file is built in memory (:func:`tqdyn.formats.netcdf.write_netcdf`)
+    with dask's synchronous scheduler: under a distributed client xarray would take a distributed
+    lock named after the file, which an in-memory file cannot give."""
+    import dask
+
+    with dask.config.set(scheduler="synchronous"):
+        return write_netcdf(dataset, path, encoding=checksum_encoding(dataset))
 
 
 def read_sweep_netcdf(path: str | os.PathLike):

@@ -100,10 +100,10 @@ def _resolve_members(spec: SweepSpec) -> tuple[Member, ...]:
         if grid0 is None:
             grid0 = grid
         elif grid != grid0:
-            raise _err(label, problem=f"has another time grid (run.duration {grid[0]} s, integrator.step {grid[1]} s, "
-                       f"run.output_every {grid[2]}) than member 1 ({grid0[0]} s, {grid0[1]} s, {grid0[2]})",
-                       allowed="one time grid for all members: set run.duration, integrator.step and "
-                               "run.output_every in sweep.set, not as parameters")
+            names = ("run.duration", "integrator.step", "run.output_every")
+            diff = ", ".join(f"{n} {g} vs {g0}" for n, g, g0 in zip(names, grid, grid0) if g != g0)
+            raise _err(label, problem=f"has another time grid than member 1 ({diff})",
+                       allowed="these keys in sweep.set, not varied")
         canonical = scen.to_toml()
         digest = hashlib.sha256(canonical.encode("utf-8")).hexdigest()[:_DIGEST_CHARS]
         if digest in by_digest:

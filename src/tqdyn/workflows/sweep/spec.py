@@ -20,7 +20,9 @@ from typing import Any
 import numpy as np
 
 from ...formats import trajectory as io
+from ..._choices import allowed, did_you_mean
 from ...scenario import DEFAULT_SCENARIO, ScenarioError, builtin_scenarios
+from ...scenario.loader import BUILTIN_DOC
 from ...scenario.toml_text import toml_str, toml_value
 
 __all__ = ["MODES", "Parameter", "SweepError", "SweepSpec", "load_sweep", "loads_sweep"]
@@ -31,6 +33,8 @@ MODES = ("product", "zip")
 
 _SWEEP_KEYS = ("name", "scenario", "output_dir", "set", "mode", "parameter")
 _PARAM_KEYS = ("key", "values", "labels", "name")
+#: Where the keys of a sweep file are listed.
+_DOC = "docs/sweeps.md#the-sweep-file"
 _NAME_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*$")
 _IDENT_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _KEY_RE = re.compile(r"^(?:[A-Za-z_][A-Za-z0-9_]*\.[A-Za-z_][A-Za-z0-9_]*|satellites\.[0-9]+\.[A-Za-z_][A-Za-z0-9_]*)$")
@@ -163,7 +167,8 @@ class SweepSpec:
                            "any other key: the sweep names the member files (sweep.output_dir)")
             common_keys[key] = k
         if self.mode not in MODES:
-            raise _err("sweep.mode", self.mode, "is not a valid choice", ", ".join(repr(m) for m in MODES))
+            raise _err("sweep.mode", self.mode, "is not a valid choice" + did_you_mean(self.mode, MODES),
+                       allowed(MODES, quote=repr))
         params = self.parameters
         if isinstance(params, Parameter):
             params = (params,)
@@ -323,9 +328,9 @@ def _resolve_scenario(name: str, base_dir: Path) -> str:
         path = base_dir / path
     path = Path(os.path.abspath(path))
     if not path.is_file():
-        raise _err("sweep.scenario", name, f"is neither a built-in scenario nor a file (looked for {str(path)!r})",
-                   "a built-in scenario (" + ", ".join(builtin_scenarios()) + ") or a .toml path "
-                   "(relative paths: relative to the sweep file)")
+        where = f"({str(path)!r})" if looks_like_path else did_you_mean(name, builtin_scenarios()).strip()
+        raise _err("sweep.scenario", name, f"is neither a built-in scenario nor a file {where}".rstrip(),
+                   f"a .toml path or a name in {BUILTIN_DOC}")
     return str(path)
 
 
@@ -353,7 +358,8 @@ def loads_sweep(text: str, *, base_dir: str | os.PathLike = ".", default_name: s
                    allowed="a [sweep] table with scenario, set, mode and [[sweep.parameter]] tables")
     for key in table:
         if key not in _SWEEP_KEYS:
-            raise _err(f"sweep.{key}", problem="is not a known key", allowed=", ".join(_SWEEP_KEYS))
+            raise _err(f"sweep.{key}", problem="is not a known key" + did_you_mean(key, _SWEEP_KEYS),
+                       allowed=allowed(_SWEEP_KEYS, _DOC, noun="keys"))
 
     def string(key, default):
         value = table.get(key, default)
@@ -382,7 +388,8 @@ def loads_sweep(text: str, *, base_dir: str | os.PathLike = ".", default_name: s
     for i, p in enumerate(raw_params, start=1):
         for key in p:
             if key not in _PARAM_KEYS:
-                raise _err(f"sweep.parameter.{i}.{key}", problem="is not a known key", allowed=", ".join(_PARAM_KEYS))
+                raise _err(f"sweep.parameter.{i}.{key}", problem="is not a known key" + did_you_mean(key, _PARAM_KEYS),
+                           allowed=allowed(_PARAM_KEYS, _DOC, noun="keys"))
         for key in ("key", "values"):
             if key not in p:
                 raise _err(f"sweep.parameter.{i}.{key}", problem="is missing",
