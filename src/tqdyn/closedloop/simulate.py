@@ -158,7 +158,7 @@ class _Segment:
     """The two bands of one satellite's loop in one frozen-coefficient segment."""
 
     def __init__(self, cl: ClosedLoop, noise: dict, fs: float, f_lo: float, outputs: list):
-        sys = reduced_system(cl, outputs)
+        sys = reduced_system(cl, outputs, noise)
         self.low = LowBand(sys, 1.0 / fs)
         self.high = HighBand(sys, noise, cl.source_components(), fs, f_lo)
 
@@ -212,7 +212,7 @@ def simulate(loops: list, noise: dict, fs: float, n_samples: int, seed: int = 0,
                     xt = sg.low.state(np.zeros(sg.low.A.shape[0]), u[:, j0])
                 else:                                     # the continuous state carried across a segment boundary
                     xt, prev = states[s]
-                    xt = xt if prev is sg.low else sg.low.state(prev.physical(xt, u[:, j0]), u[:, j0])
+                    xt = xt if prev is sg.low else sg.low.carried(prev, xt, u[:, j0])
                 y, xt = sg.low.run(xt, u[:, j0:j1])
                 states[s] = (xt, sg.low)
                 y += sg.high.apply(gens[s].buf, gens[s].buf0, k + j0, k + j1)

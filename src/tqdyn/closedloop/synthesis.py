@@ -140,16 +140,31 @@ def low_band_sos(model: AsdModel, fs: float, f_lo: float) -> np.ndarray:
     return signal.zpk2sos(zd, pd, kd)
 
 
-def reduced_system(cl, outputs: list) -> control.StateSpace:
+def reduced_system(cl, outputs: list, noise: dict | None = None) -> control.StateSpace:
     """The continuous closed loop ``cl`` (:class:`~tqdyn.closedloop.loop.ClosedLoop`) restricted to the noise
-    inputs (``cl.source_components()`` order) and the named ``outputs``, without the spacecraft's orbit
-    displacement states (nothing feeds back from them)."""
+    inputs (``cl.source_components()`` order) and the named ``outputs``, without the states that no input
+    reaches: the spacecraft's orbit displacement (nothing feeds back from it) and, with ``noise`` ({source:
+    AsdModel}), every state outside the structural reach (the nonzero pattern of A and B) of the sources of
+    nonzero level (a single-spacecraft loop's idle MOSA or second test mass: its outputs are then exactly 0,
+    as the budget's, not the round-off of a modal form that mixes them with driven modes)."""
     sys = cl.system
     keep = [k for k, s in enumerate(sys.state_labels) if not (s.startswith("plant_u[") or s.startswith("plant_du["))]
     ii = [sys.input_labels.index(f"{src}[{k}]") for src, n in cl.source_components().items() for k in range(n)]
     oi = [sys.output_labels.index(o) for o in outputs]
-    return control.ss(sys.A[np.ix_(keep, keep)], sys.B[np.ix_(keep, ii)], sys.C[np.ix_(oi, keep)],
-                      sys.D[np.ix_(oi, ii)])
+    A, B = sys.A[np.ix_(keep, keep)], sys.B[np.ix_(keep, ii)]
+    if noise is not None:
+        on = np.array([noise.get(src) is not None and noise[src].level > 0
+                       for src, n in cl.source_components().items() for _k in range(n)], dtype=bool)
+        reach = np.any(B[:, on] != 0, axis=1)
+        while True:                                   # states driven by a reached state
+            more = reach | np.any(A[:, reach] != 0, axis=1)
+            if np.array_equal(more, reach):
+                break
+            reach = more
+        keep = [k for k, r in zip(keep, reach) if r]
+        A, B = sys.A[np.ix_(keep, keep)], sys.B[np.ix_(keep, ii)]
+    return control.ss(A, B, sys.C[np.ix_(oi, keep)], sys.D[np.ix_(oi, ii)],
+                      states=[sys.state_labels[k] for k in keep])
 
 
 def _modal(A: np.ndarray):
@@ -218,7 +233,7 @@ class LowBand:
         self.M, self.hB = M, 0.5 * dt * B
         self.A, self.B = Mi @ (np.eye(n) + 0.5 * dt * A), Mi @ B * dt
         self.C, self.D = C @ Mi, D + C @ Mi @ self.hB
-        self.dt = dt
+        self.dt, self.states = dt, list(sys.state_labels)
         modes = _modal(self.A) if n else None
         self.modal = modes is not None
         if self.modal:                            # one mode of each complex-conjugate pair, weight 2
@@ -236,6 +251,13 @@ class LowBand:
     def state(self, x: np.ndarray, u: np.ndarray) -> np.ndarray:
         """The discrete state xd of the continuous state x and the input u at the same sample."""
         return self.M @ x - self.hB @ u
+
+    def carried(self, prev: "LowBand", xd: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """This band's discrete state at the first sample of its segment from ``prev``'s discrete state ``xd``
+        at that sample (u the input there): the continuous state carried by state name (a state that
+        ``prev`` does not have starts at 0)."""
+        x = dict(zip(prev.states, prev.physical(xd, u)))
+        return self.state(np.array([x.get(s, 0.0) for s in self.states]), u)
 
     def system(self) -> control.StateSpace:
         """The discrete system (sample time dt) u -> y."""
@@ -316,6 +338,18 @@ class _Source:
         return bool(np.all((err <= FIR_TOL ** 2 * ref)[:, keep]))
 
 
+def _double_zero(h: np.ndarray, taper: np.ndarray) -> np.ndarray:
+    """The filters ``h`` (..., n) less the combination of ``taper`` (n,) and k ``taper`` (k centred) that makes
+    their DTFT vanish with its slope at f = 0 (sum h = sum k h = 0), as the target does (module docstring: a
+    zero of order n_split - 2 >= 2): the truncation's error then falls as f^2 towards f = 0 instead of
+    staying flat (after the pre-filter Q, as f^4 in amplitude)."""
+    k = np.arange(h.shape[-1]) - h.shape[-1] // 2
+    basis = np.stack([taper, k * taper])                                  # (2, n)
+    moments = np.stack([np.ones_like(k, dtype=np.float64), k.astype(np.float64)])
+    coef = np.linalg.solve(moments @ basis.T, np.moveaxis(h @ moments.T, -1, 0).reshape(2, -1))
+    return h - (coef.T @ basis).reshape(h.shape)
+
+
 def _design(tr: _Transfer, sources: list, fs: float) -> None:
     """The high band's FIR filters of every source (sets ``h`` (n_out, n_col, n_fir) of each :class:`_Source`;
     module docstring): centred, their DTFT on the n_fir-point grid is the source's target G gain
@@ -354,7 +388,8 @@ def _design(tr: _Transfer, sources: list, fs: float) -> None:
             G2 = np.empty(src.G.shape[:2] + (n + 1,), dtype=complex)
             G2[..., 0::2], G2[..., 1::2] = src.G, Go[:, k:k + len(src.cols)]
             k += len(src.cols)
-            h = np.roll(sfft.irfft(src.target(f, src.G, fs), n, axis=-1), n // 2, axis=-1) * taper
+            h = _double_zero(np.roll(sfft.irfft(src.target(f, src.G, fs), n, axis=-1), n // 2, axis=-1) * taper,
+                             taper)
             if src.accepts(h, f2, G2, fs):
                 src.h, src.G = h, None
             elif 2 * n > FIR_MAX:
@@ -427,14 +462,15 @@ def series_psd(cl, noise: dict, fs: float, f, n_samples: int | None = None, f_lo
     """One-sided PSD (n_out, n_f) [(output unit)^2/Hz] at ``f`` [Hz] (0 < f <= fs/2) of the stationary series
     that :func:`tqdyn.closedloop.simulate.simulate` realises for the loop ``cl`` and the sources ``noise``
     at ``fs`` [Hz], computed exactly from its two bands: sum_j |G_d,oj(e^{i w dt})|^2 |F_j(e^{i w dt})|^2
-    level_j^2 (low band: the discrete loop and shaping filters) plus the DTFT of the high band's FIR
-    autocorrelation.  ``f_lo`` [Hz] as in ``simulate`` (default 0.1 fs / n_samples; n_samples default 2^20)."""
+    level_j^2 (low band: the discrete loop and shaping filters) plus sum_j |h_oj(e^{i w dt})|^2 |Q|^2 (high band:
+    its FIR filters' DTFT summed directly, so that an output's PSD many decades below its largest value is
+    not lost in the rounding of that value).  ``f_lo`` [Hz] as in ``simulate`` (default 0.1 fs / n_samples; n_samples default 2^20)."""
     f = np.asarray(f, dtype=np.float64)
     outputs = cl.time_outputs() if outputs is None else list(outputs)
     comps = cl.source_components()
     n_samples = 2 ** 20 if n_samples is None else n_samples
     f_lo = 0.1 * fs / n_samples if f_lo is None else f_lo
-    sys = reduced_system(cl, outputs)
+    sys = reduced_system(cl, outputs, noise)
     from .budget import frequency_response
 
     w = 2 * math.pi * f / fs
@@ -448,10 +484,8 @@ def series_psd(cl, noise: dict, fs: float, f, n_samples: int | None = None, f_lo
             out += np.sum(np.abs(Gd[:, k:k + n]) ** 2, axis=1) * (np.abs(hf) * model.level) ** 2
         k += n
     hb = HighBand(sys, noise, comps, fs, f_lo)
-    if hb.cols:
-        P = np.sum(np.abs(hb.Hf) ** 2, axis=2).T                                      # (n_out, F): frames >= 2 n_c
-        r = sfft.irfft(P, hb.m, axis=-1)[:, :hb.nc]                                   # autocorrelation, lags 0..nc-1
-        c = np.cos(np.outer(w, np.arange(hb.nc)))
-        c[:, 1:] *= 2.0
-        out += (c @ r.T).T * np.abs(_high_pass(f, fs)) ** 2
+    if hb.cols:                  # the filters' DTFT summed directly: no cancellation of a small PSD in a large one
+        h = sfft.irfft(np.moveaxis(hb.Hf, 0, -1), hb.m, axis=-1)[..., :hb.nc]          # (n_out, n_col, nc)
+        E = np.exp(-1j * np.outer(np.arange(hb.nc), w))                                 # (nc, n_f)
+        out += np.sum(np.abs(h @ E) ** 2, axis=1) * np.abs(_high_pass(f, fs)) ** 2
     return out
