@@ -64,6 +64,9 @@ def test_the_series_spectrum_is_the_budget_for_every_output_of_every_mission(fs,
         assert worst[mission] < SYSTEMATIC, (mission, np.array(outs)[~zero][int(np.argmax(np.max(dev, axis=1)))])
         hb = HighBand(reduced_system(cl, outs, noise), noise, cl.source_components(), fs, 0.1 * fs / N)
         n_fir[mission], mb[mission] = hb.nc, hb.Hf.nbytes / 1e6
+        if mission == "lpf" and fs == FS:
+            lam = np.linalg.eigvals(reduced_system(cl, outs, noise).A)
+            record_number("closed_loop_series.lpf.slowest_mode_hz", float(np.min(np.abs(lam))) / (2 * math.pi), "Hz")
     key = "closed_loop_series" if fs == FS else f"closed_loop_series.fs_{fs:g}"
     record_number(f"{key}.psd_max_deviation", [worst[m] for m in MISSIONS], "")
     record_number(f"{key}.fir_length", [n_fir[m] for m in MISSIONS], "samples")
@@ -127,15 +130,16 @@ def test_the_welch_asd_of_every_output_is_the_budget_in_every_band(realisations,
     0.8-0.9 and 0.9-0.99 fs/2 (the rising TM force noise near Nyquist).  The band mean of independent
     chi-square ordinates with the segments' degrees of freedom (overlap and adjacent-bin correlations of the
     Hann window) is chi-square with nu = 2 / var; bounds its 1e-3/(10 n_out) quantiles times (1 -+ 1 %).
-    Before this method LISA's TM acceleration was 7.7x (PSD) the budget at 0.75-1.6 Hz and 3e4x at 1.8-2 Hz.  The outputs whose budget is 0 (the idle
-    MOSAs and second TM of LISA Pathfinder and TianQin-1) are exactly 0."""
-    cl, outs, v, S, vzero = realisations[mission]
+    Before this method LISA's TM acceleration was 7.7x (PSD) the budget at 0.75-1.6 Hz and 3e4x at 1.8-2 Hz.
+    The outputs whose budget is 0 (the idle MOSAs and second TM of LISA Pathfinder and TianQin-1) are
+    exactly 0.  Recorded: the ASD ratios' range over the outputs in the top three bands."""
+    _cl, outs, v, S, vzero = realisations[mission]
     assert vzero.shape[1] == {"lpf": 4, "tianqin-1": 19}.get(mission, 0) and np.all(vzero == 0)
     f, P = signal.welch(v, fs=FS, nperseg=NPER, axis=0)
     k_seg = (v.shape[0] - NPER) // (NPER // 2) + 1
     c_ov, cf, off, kern = _hann_stats(NPER, k_seg)
     alpha = 1e-3 / (len(_bands()) * len(outs))
-    ratios, worst = [], 0.0
+    ratios, worst, top = [], 0.0, []
     for lo, hi in _bands():
         sel = np.where((f >= lo) & (f < hi))[0]
         E = np.stack([S(f[k] + off * FS / NPER) @ kern for k in sel], axis=1)       # (n_out, n_bins)
@@ -149,8 +153,11 @@ def test_the_welch_asd_of_every_output_is_the_budget_in_every_band(realisations,
         assert not bad, (mission, lo, hi, (round(a, 4), round(b, 4)), bad)
         worst = max(worst, float(np.max(np.abs(np.log(r)) / np.where(r > 1, math.log(b), -math.log(a)))))
         ratios.append(float(r[outs.index("tm1_acceleration")]))
+        if lo >= 0.2 * FS:                   # 0.41-0.8, 0.8-0.9, 0.9-0.99 of fs/2: the ASD ratios over the outputs
+            top.append([float(np.sqrt(r.min())), float(np.sqrt(r.max()))])
     record_number(f"closed_loop_series.{mission}.tm1_acceleration_band_psd_ratios", ratios, "")
     record_number(f"closed_loop_series.{mission}.worst_band_ratio_fraction_of_bound", worst, "")
+    record_number(f"closed_loop_series.{mission}.near_nyquist_asd_ratio_ranges", top, "")
 
 
 @pytest.mark.parametrize("mission", MISSIONS)
@@ -166,7 +173,7 @@ def test_the_rms_of_every_resolved_output_is_the_budget_integrated_to_nyquist(re
     nu >= 800.  The outputs of the top of the band (thrusts, electrostatic forces and torques, accelerations
     whose budget has more than half of E above 0.1 Hz: white or rising towards fs/2) are all resolved but
     LISA Pathfinder's TM accelerations."""
-    cl, outs, v, S, _vzero = realisations[mission]
+    _cl, outs, v, S, _vzero = realisations[mission]
     n = v.shape[0]
     fk = np.arange(1, n // 2 + 1) * FS / n
     Sk = S(fk)
@@ -192,6 +199,8 @@ def test_the_rms_of_every_resolved_output_is_the_budget_integrated_to_nyquist(re
     rms = np.sqrt(ratio[resolved])
     record_number(f"closed_loop_series.{mission}.rms_ratio_tm1_acceleration", math.sqrt(ratio[i]), "")
     rt = np.sqrt(ratio[[outs.index(o) for o in top if o not in unresolved]])
+    if mission == "lpf":
+        record_number("closed_loop_series.lpf.tm1_acceleration_power_below_1_over_t", float(sub[i] / E[i]), "")
     record_number(f"closed_loop_series.{mission}.rms_ratio_top_of_band_range", [float(rt.min()), float(rt.max())], "")
     record_number(f"closed_loop_series.{mission}.rms_budget_tm1_acceleration", math.sqrt(E[i]), "m/s^2")
     record_number(f"closed_loop_series.{mission}.rms_resolved_outputs", [int(resolved.sum()), len(outs)], "")

@@ -8,21 +8,22 @@ it and the method; docs/closed-loop.md, "Time series").
 * Noise: for each satellite and source, one ``numpy.random.SeedSequence(seed, spawn_key=(sat,
   crc32(source)))`` and its two children (0: the low band, 1: the high band): a source's realisation
   depends only on the seed, the satellite and its own name, so adding or removing a source changes no
-  other (a source that reaches no output in any segment draws nothing).  Every component is white Gaussian noise of one-sided PSD 1 (variance fs/2), drawn time-major
-  (the block size does not matter).  Low band: through the source's shaping filter times the band's
+  other (a source that reaches no output in any segment draws nothing).  Every component is white
+  Gaussian noise of one-sided PSD 1 (variance fs/2), drawn time-major (the block size does not matter).  Low band: through the source's shaping filter times the band's
   low-pass (:func:`~tqdyn.closedloop.synthesis.low_band_sos`, ``scipy.signal.sosfilt``, state carried
   across blocks) times the level.  High band: through the fixed pre-filter
   (:func:`~tqdyn.closedloop.synthesis.high_pass_ba`), drawn from FIR_MAX samples before the first one
   so that the band is stationary from the start.
 * Loop: the continuous closed loop of each frozen-coefficient segment, restricted to the noise
   inputs and the time-domain outputs (the spacecraft's orbit displacement ``u`` is left out: nothing
-  feeds back from it).  Low band: discretised with the bilinear transform
+  feeds back from it; so is every state that no source of nonzero level reaches, whose outputs are
+  then exactly 0).  Low band: discretised with the bilinear transform
   (:class:`~tqdyn.closedloop.synthesis.LowBand`), run in modal form (each mode a first-order
   recursion, ``scipy.signal.lfilter``; a direct recursion when the decomposition is poor), started
   at rest.  High band: FIR filters of the continuous transfer functions by FFT overlap-save
   (:class:`~tqdyn.closedloop.synthesis.HighBand`).  At a segment boundary the low band's state is carried
-  in the loop's continuous coordinates and the high band's filters change at the first sample of the
-  new segment (they act on the same noise): the coefficients change piecewise in time.
+  in the loop's continuous coordinates, by state name, and the high band's filters change at the first
+  sample of the new segment (they act on the same noise): the coefficients change piecewise in time.
 * Streaming: blocks of ``block_size`` samples go to a sink (:class:`Sink`): memory is bounded by the
   block size and the filters whatever the duration.  :class:`MemorySink` keeps everything.
 

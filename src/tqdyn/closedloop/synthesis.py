@@ -24,12 +24,17 @@ add in power: |L|^2 S + |H|^2 S = S.
   continuous G_oj(i 2 pi f) level_j R_j(i 2 pi f) H(i 2 pi f) (R the same shaping filter, H the
   Butterworth high-pass) on an n_fir-point grid, centred and applied by FFT overlap-save to white
   noise through a fixed discrete high-pass Q (:func:`high_pass_ba`, divided out of the filters'
-  target; it keeps their interpolation error away from f = 0).  n_fir doubles from :data:`FIR_MIN`
+  target; it keeps their interpolation error away from f = 0; each filter's DTFT is made to vanish with
+  its slope at f = 0, :func:`_double_zero`, as the target does).  n_fir doubles from :data:`FIR_MIN`
   until the filters' DTFT between the grid points is within :data:`FIR_TOL` of the target (for each
   source separately: a source's filters do not depend on the others).  The band needs no long memory:
-  H removes the loop's slow modes.  In the top :data:`NYQUIST_BAND` of the band each transfer's phase
-  turns to the nearest real value at fs/2 (a real series has a real response there), which leaves the
-  ASDs exact and changes cross-spectra only there.
+  H removes the loop's slow modes (LISA Pathfinder's guidance loop, its crossover some uHz, decades below
+  f_c at any rate of a series, is the low band's), so one split serves every mission.  In the top
+  :data:`NYQUIST_BAND` of the band each transfer's phase turns to the nearest real value at fs/2 (a real
+  series has a real response there), which leaves the ASDs exact and changes cross-spectra only there.
+
+Both bands run the loop without the states that no source of nonzero level reaches
+(:func:`reduced_system`): an output the budget gives 0 is exactly 0.
 
 The rational shaping filters are exact for knees with an even 2 s (Butterworth) and within
 :func:`~tqdyn.closedloop.noise.shaping_error` (<= 0.5 %) of the ASD model for the fitted ladders.
@@ -252,7 +257,7 @@ class LowBand:
         """The discrete state xd of the continuous state x and the input u at the same sample."""
         return self.M @ x - self.hB @ u
 
-    def carried(self, prev: "LowBand", xd: np.ndarray, u: np.ndarray) -> np.ndarray:
+    def carried(self, prev: LowBand, xd: np.ndarray, u: np.ndarray) -> np.ndarray:
         """This band's discrete state at the first sample of its segment from ``prev``'s discrete state ``xd``
         at that sample (u the input there): the continuous state carried by state name (a state that
         ``prev`` does not have starts at 0)."""
@@ -464,7 +469,8 @@ def series_psd(cl, noise: dict, fs: float, f, n_samples: int | None = None, f_lo
     at ``fs`` [Hz], computed exactly from its two bands: sum_j |G_d,oj(e^{i w dt})|^2 |F_j(e^{i w dt})|^2
     level_j^2 (low band: the discrete loop and shaping filters) plus sum_j |h_oj(e^{i w dt})|^2 |Q|^2 (high band:
     its FIR filters' DTFT summed directly, so that an output's PSD many decades below its largest value is
-    not lost in the rounding of that value).  ``f_lo`` [Hz] as in ``simulate`` (default 0.1 fs / n_samples; n_samples default 2^20)."""
+    not lost in the rounding of that value).  ``f_lo`` [Hz] as in ``simulate`` (default 0.1 fs / n_samples;
+    n_samples default 2^20)."""
     f = np.asarray(f, dtype=np.float64)
     outputs = cl.time_outputs() if outputs is None else list(outputs)
     comps = cl.source_components()
