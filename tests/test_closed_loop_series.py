@@ -92,7 +92,8 @@ def _hann_stats(nper: int, k_seg: int):
 def realisations():
     """Per mission: the loop, its outputs of nonzero budget, one satellite's series of them (N samples at 4 Hz,
     the first SKIP dropped), the continuous budget S(f) on a log grid (and an evaluator of it at any f >= 0
-    with the periodic, even extension of a sampled spectrum; 0 below the series' resolution) and the series
+    with the periodic, even extension of a sampled spectrum; 0 below the series' resolution unless ``cut``
+    is False) and the series
     of the outputs whose budget is 0."""
     out = {}
     for mission in MISSIONS:
@@ -100,17 +101,18 @@ def realisations():
         outs = cl.time_outputs()
         v = simulate([[(0.0, cl)]], noise, FS, N, seed=SEEDS[mission]).values[SKIP:, 0, :]
         f0 = 0.5 * FS / v.shape[0]
-        fl = np.logspace(math.log10(f0), math.log10(FS / 2), 3000)
+        fl = np.logspace(math.log10(0.1 * FS / N), math.log10(FS / 2), 3000)
         b, _ = noise_budget(cl, noise, fl, outputs=outs)
         S2 = np.sum(b ** 2, axis=1)
         live = np.any(S2 > 0, axis=1)
         outs, v, vzero, lS = [o for o, k in zip(outs, live) if k], v[:, live], v[:, ~live], np.log(S2[live])
 
-        def S(f, lS=lS, fl=fl, f0=f0):
+        def S(f, lS=lS, fl=fl, f0=f0, cut=True):
             f = np.abs(np.asarray(f, dtype=np.float64))
             f = np.where(f > FS / 2, FS - f, f)
-            s = np.exp(np.array([np.interp(np.log(np.maximum(f, f0)), np.log(fl), r) for r in lS]))
-            s[:, f < f0] = 0.0
+            s = np.exp(np.array([np.interp(np.log(np.maximum(f, fl[0])), np.log(fl), r) for r in lS]))
+            if cut:
+                s[:, f < f0] = 0.0
             return s
 
         out[mission] = (cl, outs, v, S, vzero)
@@ -180,7 +182,7 @@ def test_the_rms_of_every_resolved_output_is_the_budget_integrated_to_nyquist(re
     E = np.sum(Sk, axis=1) * FS / n
     nu = 2 * np.sum(Sk, axis=1) ** 2 / np.sum(Sk ** 2, axis=1)
     f_sub = np.logspace(math.log10(0.1 * FS / N), math.log10(FS / n), 200)
-    sub = np.trapezoid(S(f_sub), f_sub, axis=1)
+    sub = np.trapezoid(S(f_sub, cut=False), f_sub, axis=1)
     ratio = np.var(v, axis=0) / E
     resolved = (sub < 0.01 * E) & (nu >= 100)
     alpha = 1e-3 / len(outs)
