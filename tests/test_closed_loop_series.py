@@ -46,8 +46,8 @@ def test_the_series_spectrum_is_the_budget_for_every_output_of_every_mission(fs,
     rising TM force noise of LISA and Taiji, ASD ~ f^2, and the falling displacements; LISA Pathfinder's
     guidance loop, crossover 4.3 uHz, and its relative acceleration 22 decades below its largest value at
     1e-5 Hz).  Outputs whose budget is 0 (the idle MOSAs and second TM of the single-spacecraft missions)
-    are exactly 0.  Measured at 4 Hz: <= 3.1e-3 (TianQin's fitted sqrt(1 + 0.1 mHz/f) ladder below 10 mHz),
-    <= 1.2e-3 the others; bound 1e-2."""
+    are exactly 0.  Measured: <= 3.1e-3 (TianQin's fitted sqrt(1 + 0.1 mHz/f) ladder below 10 mHz), <= 1.2e-3
+    the others (LISA Pathfinder at 1 Hz; <= 9e-4 at 4 Hz); bound 1e-2."""
     f = np.concatenate([np.logspace(-5, math.log10(0.4 * fs), 300), np.linspace(0.4 * fs, 0.495 * fs, 60)])
     worst, n_fir, mb = {}, {}, {}
     for mission in MISSIONS:
