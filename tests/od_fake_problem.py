@@ -50,6 +50,7 @@ class Measurements:
     peer: np.ndarray
     value: np.ndarray
     sigma: np.ndarray
+    tau_down: np.ndarray | None = None
 
 
 def schedule(scenario, tracking) -> Measurements:
@@ -63,8 +64,10 @@ def schedule(scenario, tracking) -> Measurements:
                 for typ, peer, sig in _ROWS[kind]:
                     rows.append((t, typ, k, str((k + 1) % n) if peer is None else peer, 0.0, sig))
     cols = list(zip(*rows))
-    return Measurements(np.array(cols[0]), np.array(cols[1]), np.array(cols[2], dtype=np.int64), np.array(cols[3]),
+    meas = Measurements(np.array(cols[0]), np.array(cols[1]), np.array(cols[2], dtype=np.int64), np.array(cols[3]),
                         np.array(cols[4]), np.array(cols[5]))
+    _light_times(meas)
+    return meas
 
 
 def names(scenario) -> list:
@@ -95,7 +98,21 @@ def simulate(scenario, tracking, truth=None, seed=0, *, bias=None) -> Measuremen
     meas.value = design(scenario, meas) @ q + meas.sigma * np.random.default_rng(seed).standard_normal(len(meas.t))
     for typ, v in (bias or {}).items():
         meas.value[meas.type == typ] += v
+    _light_times(meas)
     return meas
+
+
+def _light_times(meas) -> None:
+    """The two-way rows' downlink light times, consistent with their ranges (half the round trip,
+    value / c; a range rate: its range row's), as a reader of the TDM takes them."""
+    tau = np.full(len(meas.t), np.nan)
+    rng = np.isin(meas.type, ["slr_range", "dsn_range"])
+    tau[rng] = meas.value[rng] / 299792458.0
+    key = {(t, k): x for t, k, x in zip(meas.t[meas.type == "dsn_range"], meas.sat[meas.type == "dsn_range"],
+                                        tau[meas.type == "dsn_range"])}
+    rate = np.flatnonzero(meas.type == "dsn_range_rate")
+    tau[rate] = [key.get((meas.t[i], meas.sat[i]), 0.0) for i in rate]
+    meas.tau_down = tau
 
 
 def _select(scenario, groups, what):

@@ -22,12 +22,14 @@ from tqdyn.formats.od_tdm import measurements_to_tdm, read_measurements_tdm, tdm
 from tqdyn.formats.tdm import format_tdm, parse_tdm, read_tdm
 
 EPOCH = Epoch.from_utc("2004-06-06T00:00:00")
+C = 299792458.0   # m/s, the SI definition
 FIELDS = ("t", "type", "sat", "peer", "value", "sigma")
 
 
 def _table(m=60, seed=1):
     """A table of every type, satellite and a few peers, in time order; values of every magnitude
-    from 1e-13 m (sub-pm) to 1e11 m with random mantissas, and some random float64 bit patterns."""
+    from 1e-13 m (sub-pm) to 1e11 m with random mantissas, and some random float64 bit patterns
+    (one-way rows)."""
     rng = np.random.default_rng(seed)
     kinds = [("gnss_pseudorange", "G07", 3.0), ("slr_range", "Monument Peak", 0.01), ("isr_range", "0", 0.5),
              ("dsn_range", "DSS-14", 1.0), ("dsn_range_rate", "DSS-14", 1e-3), ("gnss_pseudorange", "C12", 2.5)]
@@ -37,10 +39,21 @@ def _table(m=60, seed=1):
     sigma = np.array([k[2] for k in kinds] * (m // 6))
     sat = np.array([0, 1, 2, 0, 1, 2] * (m // 6))
     value = rng.uniform(-1, 1, m) * 10.0 ** rng.uniform(-13, 11, m)
-    bits = rng.integers(0, 2 ** 62, 10, dtype=np.int64).view(np.float64)
-    value[:10] = np.where(np.isfinite(bits), bits, 1.0)
-    value[10] = 1e-12  # 1 pm
-    return types.SimpleNamespace(t=t, type=typ, sat=sat, peer=peer, value=value, sigma=sigma)
+    one_way = np.flatnonzero(np.isin(typ, ["gnss_pseudorange", "isr_range"]))[:10]
+    bits = rng.integers(0, 2 ** 62, one_way.size - 1, dtype=np.int64).view(np.float64)
+    value[one_way[:-1]] = np.where(np.isfinite(bits), bits, 1.0)
+    value[one_way[-1]] = 1e-12  # 1 pm
+    # downlink light times [s] of the two-way rows: a range's half round trip (what a reader takes
+    # back), a range rate's a few 10 ms (its range row is of another satellite here)
+    tau = np.where(typ == "dsn_range_rate", rng.uniform(0.01, 0.05, m), np.nan)
+    rng_rows = np.isin(typ, ["slr_range", "dsn_range"])
+    tau[rng_rows] = value[rng_rows] / C
+    return types.SimpleNamespace(t=t, type=typ, sat=sat, peer=peer, value=value, sigma=sigma, tau_down=tau)
+
+
+def _seconds_after(text: str, t0: datetime.datetime) -> float:
+    """Seconds from t0 to an epoch text YYYY-MM-DDThh:mm:ss.fffffffff (its ns digits kept)."""
+    return (datetime.datetime.fromisoformat(text[:26]) - t0).total_seconds() + float("0." + text[26:]) * 1e-6
 
 
 def test_tdm_round_trip_is_exact():
@@ -50,7 +63,7 @@ def test_tdm_round_trip_is_exact():
     tdm = measurements_to_tdm(meas, epoch=EPOCH, time_scale="TT", satellite_names=["TQ1", "TQ2", "TQ3"],
                               info={"tracking": "gnss,slr,isr,dsn"}, creation_date="2026-01-01T00:00:00")
     text = format_tdm(tdm)
-    fields, info = tdm_to_measurements(parse_tdm(text), epoch=EPOCH, time_scale="TT")
+    fields, info = tdm_to_measurements(parse_tdm(text), epoch=EPOCH, time_scale="TT", grid_s=600.0)
     for f in FIELDS:
         assert np.array_equal(fields[f], getattr(meas, f)), f
     assert fields["value"].view(np.int64).tolist() == meas.value.view(np.int64).tolist()
@@ -58,10 +71,11 @@ def test_tdm_round_trip_is_exact():
     for seg in tdm.segments:
         for kw, _, v in seg.data:
             assert kw == ("DOPPLER_INSTANTANEOUS" if "rate" in seg.meta_comments[0] else "RANGE")
-    # each km text is the shortest decimal of the value (repr) divided by 1000 exactly
-    texts = {v for seg in tdm.segments for _, _, v in seg.data}
-    for x in meas.value:
-        assert str(Decimal(repr(float(x))).scaleb(-3)) in texts
+    # each one-way km text is the shortest decimal of the value (repr) divided by 1000 exactly
+    one_way = {v for seg in tdm.segments if seg.metadata["PATH"] == "1,2" for _, _, v in seg.data}
+    for x in meas.value[np.isin(meas.type, ["gnss_pseudorange", "isr_range"])]:
+        assert str(Decimal(repr(float(x))).scaleb(-3)) in one_way
+    texts = one_way
     for v in texts:
         assert Decimal(repr(float(Decimal(v) * 1000))) == Decimal(v) * 1000
 
@@ -82,7 +96,12 @@ def test_tdm_epochs_and_keywords():
     assert isr.metadata["PARTICIPANT_1"] == "TQ1" and isr.metadata["PARTICIPANT_2"] == "TQ3"
     assert "tqdyn peer = 0" in isr.meta_comments
     rr = seg["tqdyn type = dsn_range_rate"]
-    assert rr.metadata["PATH"] == "1,2,1" and "RANGE_UNITS" not in rr.metadata and "TIMETAG_REF" not in rr.metadata
+    assert rr.metadata["PATH"] == "1,2,1" and "RANGE_UNITS" not in rr.metadata and rr.metadata["TIMETAG_REF"] == "RECEIVE"
+    slr = seg["tqdyn type = slr_range"]
+    assert slr.metadata["RANGE_UNITS"] == "s" and slr.metadata["TIMETAG_REF"] == "RECEIVE"
+    # tagged at reception: the bounce (t = 0 at the UTC epoch, TT 00:01:04.184) plus the downlink light time
+    assert abs(_seconds_after(slr.data[0][1], datetime.datetime(2004, 6, 6, 0, 1, 4, 184000))
+               - meas.tau_down[1]) <= 1e-9
     assert "tqdyn sigma = 0.001 m/s" in rr.meta_comments
     assert seg["tqdyn type = slr_range"].metadata["PARTICIPANT_1"] == "Monument Peak"
 
@@ -95,6 +114,10 @@ def test_tdm_heliocentric_times_within_a_nanosecond(tmp_path):
     meas.t = meas.t + np.linspace(0.0, 1.0, meas.t.size) * 1e-3
     path = write_measurements_tdm(tmp_path / "m.tdm", meas, epoch=epoch, time_scale="TDB")
     fields, _ = read_measurements_tdm(path, epoch=epoch, time_scale="TDB")
+    one = np.isin(fields["type"], ["gnss_pseudorange", "isr_range"])
+    fields = {k: v[one] for k, v in fields.items()}
+    meas = types.SimpleNamespace(**{k: getattr(meas, k)[np.isin(meas.type, ["gnss_pseudorange", "isr_range"])]
+                                    for k in FIELDS})
     err = np.max(np.abs(fields["t"] - meas.t))
     assert err <= 1.0e-9, err
     assert np.array_equal(fields["value"], meas.value)
@@ -105,6 +128,8 @@ def test_tdm_heliocentric_times_within_a_nanosecond(tmp_path):
     (lambda s: s.replace("COMMENT tqdyn epoch", "COMMENT epoch"), r"header: no 'COMMENT tqdyn epoch'"),
     (lambda s: s.replace("  COMMENT tqdyn type = slr_range\n", ""), r"segment 2: metadata: no 'COMMENT tqdyn type'"),
     (lambda s: s.replace("RANGE_UNITS = km", "RANGE_UNITS = s", 1), r"segment 1: RANGE_UNITS = 's'; allowed: km"),
+    (lambda s: s.replace("TIMETAG_REF = RECEIVE", "TIMETAG_REF = BOUNCE", 1),
+     r"segment 1: TIMETAG_REF: 'BOUNCE' is not allowed; allowed: TRANSMIT, RECEIVE"),
     (lambda s: s.replace("tqdyn sigma = 3.0 m", "tqdyn sigma = -3.0 m"), r"segment 1: tqdyn sigma = '-3.0 m'"),
     (lambda s: s.replace("TIME_SYSTEM = TT", "TIME_SYSTEM = UTC", 1), r"segment 1: TIME_SYSTEM = 'UTC'"),
     (lambda s: s.replace("DATA_STOP", "", 1), r"line \d+: META_START: unexpected here"),
@@ -245,15 +270,22 @@ def test_tdm_read_by_ccsds_ndm(tmp_path):
         assert md.participant_2 == names[sat]
         assert md.participant_1 == (names[int(peer)] if typ == "isr_range" else peer)
         assert md.path == paths[typ]
-        assert _text(md.range_units) == ("None" if typ == "dsn_range_rate" else "km")
-        assert (md.timetag_ref is None) == (paths[typ] == "1,2,1")
+        two = paths[typ] == "1,2,1"
+        assert _text(md.range_units) == ("None" if typ == "dsn_range_rate" else "s" if two else "km")
+        assert _text(md.timetag_ref) == "RECEIVE"
         obs = seg.data.observation
-        value = np.array([(o.doppler_instantaneous if typ == "dsn_range_rate" else o.range) for o in obs]) * 1e3
-        assert np.allclose(value, meas.value[rows], rtol=4.5e-16, atol=0), typ
+        v = meas.value[rows]
+        if typ == "dsn_range_rate":   # d/dt_receive = (d/dt_bounce) / (1 + v / c)
+            value, want_v = np.array([o.doppler_instantaneous for o in obs]) * 1e3, v * C / (C + v)
+        elif two:                     # the round-trip light time 2 v / c
+            value, want_v = np.array([o.range for o in obs]), 2.0 * v / C
+        else:
+            value, want_v = np.array([o.range for o in obs]) * 1e3, v
+        assert np.allclose(value, want_v, rtol=1.5e-15, atol=0), typ
         tt0 = datetime.datetime(2004, 6, 6, 0, 1, 4, 184000)     # the UTC epoch + 32 s + 32.184 s
-        want = [(tt0 + datetime.timedelta(seconds=float(x))).strftime("%Y-%m-%dT%H:%M:%S.%f") + "000"
-                for x in meas.t[rows]]
-        assert [o.epoch for o in obs] == want
+        tag = meas.t[rows] + (meas.tau_down[rows] if two else 0.0)   # two-way: at reception
+        got = np.array([_seconds_after(o.epoch, tt0) for o in obs])
+        assert np.max(np.abs(got - tag)) <= 1e-9, typ
 
 
 def test_tdm_written_by_ccsds_ndm_is_read(tmp_path):
@@ -270,7 +302,7 @@ def test_tdm_written_by_ccsds_ndm_is_read(tmp_path):
     other = tmp_path / "ndm.tdm"
     NdmIo().to_file(NdmIo().from_path(path), NDMFileFormats.KVN, other)
     assert other.read_text() != path.read_text()
-    fields, _ = read_measurements_tdm(other, epoch=EPOCH, time_scale="TT")
+    fields, _ = read_measurements_tdm(other, epoch=EPOCH, time_scale="TT", grid_s=600.0)
     for f in ("t", "type", "sat", "peer", "sigma"):
         assert np.array_equal(fields[f], getattr(meas, f)), f
-    assert np.allclose(fields["value"], meas.value, rtol=4.5e-16, atol=0)
+    assert np.allclose(fields["value"], meas.value, rtol=1.5e-15, atol=0)

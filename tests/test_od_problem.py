@@ -142,11 +142,11 @@ def test_self_gravity_recovered_gauss_newton_20_seeds(recovery, record_number):
 
 def test_partials_against_central_differences(record_number):
     """compute()'s H against central differences of compute()'s h between dd propagations
-    (tianqin-gravity, 1 day every 3 h, GNSS + SLR + ISR + DSN): the columns of Sat1's x
+    (tianqin-gravity, 1 day every 3 h, GNSS + SLR + ISR + DSN + TT&C): the columns of Sat1's x
     (steps +-1 m) and Sat2's s_y (+-1e-9 m/s^2).  Expected: the float64 variational equations
     (~1e-10 relative, docs/orbit-determination.md) and the differences' round-off (~1e-8 m
     on 1e8 m ranges over ~1-4 m of change, ~1e-8)."""
-    tr = odp.Tracking(("gnss", "slr", "isr", "dsn"), DAY, 3 * 3600.0)
+    tr = odp.Tracking(("gnss", "slr", "isr", "dsn", "ttc"), DAY, 3 * 3600.0)
     meas = odp.schedule(SCEN, tr)
     assert np.all(np.diff(meas.t) >= 0) and np.all(np.isnan(meas.value))
     assert set(meas.type) == set(odp.MEASUREMENT_TYPES)
@@ -189,7 +189,7 @@ def test_lisa_dsn_and_isr_covariance():
 @pytest.mark.parametrize("make, match", [
     (lambda: odp.Tracking(("gps",), DAY), "tracking.kinds: 'gps' is not allowed"),
     (lambda: odp.Tracking(("slr",), DAY, estimate=("state", "j2")), "tracking.estimate: 'j2'"),
-    (lambda: odp.Tracking(("slr",), DAY, consider=("rtn",)), "tracking.consider: 'rtn' has no a priori sigma"),
+    (lambda: odp.Tracking(("slr",), DAY, consider=("rtn",)), "tracking.consider: 'rtn' needs an a priori sigma"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), 60 * 365.25 * DAY, DAY)),
      "tracking.arc_s: .* ends beyond the span of the ephemeris"),
     (lambda: odp.schedule(SCEN, odp.Tracking(("slr",), DAY, 625.0)),

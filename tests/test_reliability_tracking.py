@@ -29,17 +29,19 @@ T0 = "2004-06-06T00:01:04.184000000"               # t = 0 s in TT
 T1 = "2004-06-06T00:11:04.184000000"               # t = 600 s
 
 
-def _table(t):
+def _table(t, typ="slr_range", peer="Yarragadee"):
     t = np.asarray(t, np.float64)
     n = t.size
-    return types.SimpleNamespace(t=t, type=np.array(["slr_range"] * n), sat=np.zeros(n, int),
-                                 peer=np.array(["Yarragadee"] * n), value=np.linspace(1e8, 1.1e8, n),
+    return types.SimpleNamespace(t=t, type=np.array([typ] * n), sat=np.zeros(n, int),
+                                 peer=np.array([peer] * n), value=np.linspace(1e8, 1.1e8, n),
                                  sigma=np.full(n, 0.01))
 
 
 def _text(m=6):
     info = {"tracking": "slr", "arc_s": "43200.0", "interval_s": "600.0"}
-    return format_tdm(measurements_to_tdm(_table(np.arange(m) * 600.0), epoch=EPOCH, time_scale="TT",
+    # a one-way type: its tags are the table's t (two-way rows are tagged at the station's reception)
+    return format_tdm(measurements_to_tdm(_table(np.arange(m) * 600.0, "gnss_pseudorange", "G07"), epoch=EPOCH,
+                                          time_scale="TT",
                                           satellite_names=["Sat1", "Sat2", "Sat3"], info=info,
                                           creation_date="2026-01-01T00:00:00"))
 
@@ -175,12 +177,12 @@ def _fit(tmp_path, capsys, t, sat=None, arc="43200.0"):
 
 
 @pytest.mark.parametrize("t, sat, pattern", [
-    ([0, 600, 601, 1200], None, r"line 27: epoch at t = 601 s \(from the scenario epoch\) is \+1 s off the step grid "
+    ([0, 600, 601, 1200], None, r"line 28: epoch at t = 601 s \(from the scenario epoch\) is \+1 s off the step grid "
                                 r"\(integrator.step = 600 s\); allowed: multiples of 600 s$"),
-    ([0, 600, 1200, 86400 + 600], None, r"line 28: epoch at t = 87000 s \(from the scenario epoch\) is outside the arc "
+    ([0, 600, 1200, 86400 + 600], None, r"line 29: epoch at t = 87000 s \(from the scenario epoch\) is outside the arc "
                                         r"0..43200 s \(header tqdyn arc_s; the run spans 86400 s\); allowed: epochs in it$"),
-    ([-600, 0, 600], None, r"line 25: epoch at t = -600 s \(from the scenario epoch\) is outside the arc 0..43200 s"),
-    ([0, 600, 1200], [0, 0, 3], r"line 44: tqdyn sat = 3; allowed: 0..2 \(the scenario's 3 satellites\)$"),
+    ([-600, 0, 600], None, r"line 26: epoch at t = -600 s \(from the scenario epoch\) is outside the arc 0..43200 s"),
+    ([0, 600, 1200], [0, 0, 3], r"line 46: tqdyn sat = 3; allowed: 0..2 \(the scenario's 3 satellites\)$"),
 ])
 def test_fit_refuses_epochs_off_the_run_before_propagating(tmp_path, capsys, no_propagation, t, sat, pattern):
     """An epoch 1 s off the 600 s grid, one beyond the arc (a day after the run's start: today it made
@@ -200,7 +202,7 @@ def test_fit_without_an_arc_refuses_an_epoch_beyond_the_run(tmp_path, capsys, no
     refused naming the run's span, before any propagation."""
     (status, _, err), tdm, out = _fit(tmp_path, capsys, [0, 600, 86400 + 1200], arc=None)
     assert status == 2
-    assert err.strip() == (f"tqdyn: error: {tdm}, line 26: epoch at t = 87600 s (from the scenario epoch) is outside "
+    assert err.strip() == (f"tqdyn: error: {tdm}, line 27: epoch at t = 87600 s (from the scenario epoch) is outside "
                            "the run, 0..86400 s; allowed: epochs in it")
     assert not out.exists()
 

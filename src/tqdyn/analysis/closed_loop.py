@@ -64,8 +64,9 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, 
     ``phase_margin`` [deg] and ``crossover`` [Hz].  Every loop of the model is evaluated in the frequency
     domain at once (:mod:`tqdyn.closedloop.frequency`; loops without their blocks: each state space by
     :func:`tqdyn.closedloop.budget.noise_budget`).  ``dt`` [s]: the zero-order-hold discretised loops' budget
-    (what the time domain runs; one state space at a time).  ``progress``: called with 1 after each (segment,
-    satellite) loop.  Coordinates carry units and frames (attrs)."""
+    (a sampled loop on held noise; the time series realise the continuous budget:
+    :mod:`tqdyn.closedloop.synthesis`; one state space at a time).  ``progress``: called with 1 after each
+    (segment, satellite) loop.  Coordinates carry units and frames (attrs)."""
     import xarray as xr
 
     s = model.settings

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..od.registry import TYPES
 from .figures import _DPI, SAT_COLORS, _pyplot, _savefig_atomic, check_figure_path
 
 __all__ = ["FIGURE_SUFFIXES", "HIST_LIMIT", "ResidualFigure", "check_residual_figure_path", "plot_od_residuals",
@@ -128,10 +129,11 @@ def plot_od_residuals(est, path, title: str | None = None) -> ResidualFigure:
         zk = rows["z"][sel & kept]
         top = max(4.0, float(np.max(np.abs(rows["z"][sel]))) * 1.1) if sel.any() else 4.0
         ax.set_ylim(-top, 1.45 * top)  # room for the legend
-        res_unit = "m/s" if typ.endswith("rate") else "m"
+        mtype = TYPES.get(typ)
+        res_unit = mtype.unit if mtype else "m"
         rms_z = float(np.sqrt(np.mean(zk ** 2))) if zk.size else math.nan
         rms_r = float(np.sqrt(np.mean(rows["residual"][sel & kept] ** 2))) if zk.size else math.nan
-        what = " (clock-free combinations)" if typ == "gnss_pseudorange" else ""
+        what = " (clock-free combinations)" if mtype and mtype.receiver_clock else ""
         ax.set_title(f"{typ}{what}: {int((sel & kept).sum())} kept, {int((sel & ~kept).sum())} edited; "
                      f"rms {rms_r:.3g} {res_unit}, normalised rms {rms_z:.3f}", fontsize=8.5)
         ax.set_ylabel("normalised residual [1]", fontsize=8)

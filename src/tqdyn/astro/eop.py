@@ -502,42 +502,27 @@ def _lagrange4_table(x, table, out):
             out[i, c] = w0 * table[k, c] + w1 * table[k + 1, c] + w2 * table[k + 2, c] + w3 * table[k + 3, c]
 
 
-@njit(cache=True)
 def _cubic_table(x, coef, out):
     """out[i, c] = the piecewise cubic of coef (n, 4, m) (row k: Horner
-    coefficients in s = x - k on [k, k+1)) at x[i], k clamped to 0..n-1."""
-    n, _, m = coef.shape
-    for i in range(x.size):
-        k = int(math.floor(x[i]))
-        if k < 0:
-            k = 0
-        if k > n - 1:
-            k = n - 1
-        s = x[i] - k
-        for c in range(m):
-            out[i, c] = ((coef[k, 0, c] * s + coef[k, 1, c]) * s + coef[k, 2, c]) * s + coef[k, 3, c]
+    coefficients in s = x - k on [k, k+1)) at x[i], k clamped to 0..n-1
+    (vectorised: numpy, nothing to compile)."""
+    k = np.clip(np.floor(x), 0, coef.shape[0] - 1).astype(np.int64)
+    s = (x - k)[:, None]
+    c = coef[k]
+    out[...] = ((c[:, 0] * s + c[:, 1]) * s + c[:, 2]) * s + c[:, 3]
 
 
-@njit(cache=True)
 def _utc_from_tai(tai, dat0, daylen, out):
     """UTC quasi-MJD (relative to the first node) of TAI MJDs (same origin):
-    day i starts at TAI i + dat0[i]/86400 and lasts daylen[i] s of TAI."""
+    day i starts at TAI i + dat0[i]/86400 and lasts daylen[i] s of TAI
+    (vectorised: numpy, nothing to compile)."""
     n = dat0.size
-    for q in range(tai.size):
-        t = tai[q]
-        i = int(math.floor(t))
-        if i < 0:
-            i = 0
-        if i > n - 1:
-            i = n - 1
-        sec = (t - i) * 86400.0 - dat0[i]
-        if sec < 0.0 and i > 0:
-            i -= 1
-            sec = (t - i) * 86400.0 - dat0[i]
-        elif sec >= daylen[i] and i < n - 1:
-            i += 1
-            sec = (t - i) * 86400.0 - dat0[i]
-        out[q] = i + sec / daylen[i]
+    i = np.clip(np.floor(tai), 0, n - 1).astype(np.int64)
+    sec = (tai - i) * 86400.0 - dat0[i]
+    back = (sec < 0.0) & (i > 0)  # before the day's start: the day before
+    ahead = ~back & (sec >= daylen[i]) & (i < n - 1)  # past its end: the next day
+    i = i - back + ahead
+    out[...] = i + np.where(back | ahead, (tai - i) * 86400.0 - dat0[i], sec) / daylen[i]
 
 
 def _mjd_iso(mjd: float) -> str:

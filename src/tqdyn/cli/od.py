@@ -90,15 +90,17 @@ def od():
 
 @od.command("simulate")
 @click.argument("run_file", metavar="RUN.h5")
-@click.option("--tracking", required=True, help="Tracking types, comma-separated: gnss, slr, isr, dsn.")
+@click.option("--tracking", required=True,
+              help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
+                   "docs/orbit-determination.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
 @click.option("--stations", help="Ground stations (SLR, deep-space), comma-separated [default: the plan's].")
 @click.option("--bias", "biases", multiple=True, metavar="TYPE[/PEER]=VALUE",
-              help="A constant measurement bias (m; m/s for dsn_range_rate) added to every station or link of a "
-                   "type (slr_range, isr_range, dsn_range, dsn_range_rate) or to one (slr_range/Graz, "
-                   "isr_range/Sat2->Sat1); repeatable.")
+              help="A constant measurement bias (the type's unit: m, m/s for range rates) added to every station "
+                   "or link of a type with biases (TYPE=VALUE) or to one (slr_range/Graz, isr_range/Sat2->Sat1); "
+                   "repeatable.")
 @click.option("--sp3", "sp3", multiple=True, metavar="FILE",
               help="GNSS transmitter orbits from this SP3-c/d file instead of the nominal GPS and BeiDou "
                    "constellations (repeatable: files of other satellites, or consecutive days of the same ones, "
@@ -164,7 +166,9 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
 
 @od.command("covariance")
 @click.argument("scenario", metavar="SCENARIO")
-@click.option("--tracking", required=True, help="Tracking types, comma-separated: gnss, slr, isr, dsn.")
+@click.option("--tracking", required=True,
+              help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
+                   "docs/orbit-determination.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
 @click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "

@@ -8,7 +8,8 @@ and frozen-coefficient segment), :mod:`~tqdyn.closedloop.plant` (the linearised 
 :mod:`~tqdyn.closedloop.controllers`, :mod:`~tqdyn.closedloop.noise` (one-sided ASD models),
 :mod:`~tqdyn.closedloop.loop` (the named interconnection), :mod:`~tqdyn.closedloop.missions` (the
 defaults of TianQin, LISA and Taiji), :mod:`~tqdyn.closedloop.budget` (frequency domain: budgets,
-margins), :mod:`~tqdyn.closedloop.simulate` (time domain), :mod:`~tqdyn.closedloop.one_dof` (the
+margins), :mod:`~tqdyn.closedloop.simulate` (time domain), :mod:`~tqdyn.closedloop.synthesis` (how
+the time series realise the budget), :mod:`~tqdyn.closedloop.one_dof` (the
 one-axis reference loop), :mod:`~tqdyn.closedloop.schemes` (the single-spacecraft control schemes),
 :mod:`~tqdyn.closedloop.flown` (LISA Pathfinder and TianQin-1 as configurations, their static working
 points) and :mod:`~tqdyn.closedloop.flight_observables` (Delta g, the six-DOF stability, the measured
@@ -37,6 +38,7 @@ _HOME = {
     "default_controllers": "missions", "default_noise": "missions", "default_plant": "missions",
     "representative_plant": "missions", "representative_working_point": "missions", "requirement": "missions",
     "working_points": "working_point",
+    "series_psd": "synthesis",
 }
 
 __all__ = sorted(_HOME)

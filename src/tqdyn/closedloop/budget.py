@@ -73,7 +73,8 @@ def frequency_response(sys: control.StateSpace, w) -> np.ndarray:
 def closed_loop_response(cl: ClosedLoop, f, outputs=None, inputs=None, dt: float | None = None) -> np.ndarray:
     """Complex closed-loop transfer functions G (n_out, n_in, n_f) at ``f`` [Hz] between the named
     ``outputs`` (default all of :func:`~tqdyn.closedloop.loop.output_names`) and ``inputs`` (default all
-    noise inputs); ``dt`` [s]: of the zero-order-hold discretisation instead (what the time domain runs)."""
+    noise inputs); ``dt`` [s]: of the zero-order-hold discretisation instead (a sampled loop on held noise; the time
+    series realise the continuous loop: :mod:`tqdyn.closedloop.synthesis`)."""
     sys = cl.system
     outputs = output_names() if outputs is None else list(outputs)
     inputs = [s for src in SOURCES for s in source_inputs(src)] if inputs is None else list(inputs)

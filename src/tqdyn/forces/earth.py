@@ -80,25 +80,19 @@ def _frames_rotation(epoch, t_hi, t_lo):
     return earth_orientation(epoch, t_hi, t_lo).T_ITRS_GCRS
 
 
-@njit(cache=True)
 def _pack(out, col, c, filled, lt):
     """Packed lower triangle of c (n_inst, k+1, k+1) into out[:, col:col+lt]
     (index n (n+1)/2 + m): added to the entries of degree <= filled, stored
     into the others; entries beyond degree k are zeroed if filled < 0."""
-    k1 = c.shape[1]
-    f = (filled + 1) * (filled + 2) // 2  # entries already holding data
-    for i in range(c.shape[0]):
-        j = col
-        for n in range(k1):
-            for m in range(n + 1):
-                if j - col < f:
-                    out[i, j] += c[i, n, m]
-                else:
-                    out[i, j] = c[i, n, m]
-                j += 1
-        if filled < 0:
-            for jj in range(j, col + lt):
-                out[i, jj] = 0.0
+    j = col
+    for n in range(c.shape[1]):  # row n: entries n (n+1)/2 .. n (n+1)/2 + n, held iff n <= filled
+        if n <= filled:
+            out[:, j:j + n + 1] += c[:, n, :n + 1]
+        else:
+            out[:, j:j + n + 1] = c[:, n, :n + 1]
+        j += n + 1
+    if filled < 0:
+        out[:, j:col + lt] = 0.0
 
 
 def _provider_degree(p):

@@ -70,8 +70,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from numba import njit
-
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..astro.constants import GM_EARTH_EGM2008, R_EARTH_EGM2008
 from ..astro.tidal_arguments import delaunay_arguments, doodson_arguments, tidal_harmonic_sum
@@ -116,60 +114,56 @@ for _n in (2, 3):
 del _n, _m
 
 
-@njit(cache=True)
 def _step1_kernel(pos, ratio, r_ref, kre, kim, kplus, degree4, dc, ds):
-    """Compiled eq. 6.6/6.7: pos (n, n_b, 3) [m], ratio (n_b,), kre/kim (4, 4),
-    kplus (3,); dc, ds (n, 5, 5) overwritten."""
-    n, nb = pos.shape[0], pos.shape[1]
+    """Eq. 6.6/6.7 vectorised over the instants (numpy: nothing to compile;
+    each instant's operations in the order of a per-instant loop): pos
+    (n, n_b, 3) [m], ratio (n_b,), kre/kim (4, 4), kplus (3,); dc, ds
+    (n, 5, 5) overwritten."""
     n20, n21, n22 = _N[2, 0], _N[2, 1], _N[2, 2]
     n30, n31, n32, n33 = _N[3, 0], _N[3, 1], _N[3, 2], _N[3, 3]
-    tr = np.empty((4, 4))  # real and imaginary parts of sum_j rho Pbar_nm e^{-i m lambda}
-    ti = np.empty((4, 4))
-    for i in range(n):
-        tr[:, :] = 0.0
-        ti[:, :] = 0.0
-        for j in range(nb):
-            x, y, z = pos[i, j, 0], pos[i, j, 1], pos[i, j, 2]
-            r = math.sqrt(x * x + y * y + z * z)
-            u = z / r                                  # sin(latitude)
-            w1r, w1i = x / r, -y / r                   # cos(lat) e^{-i lon}
-            w2r, w2i = w1r * w1r - w1i * w1i, 2.0 * w1r * w1i
-            w3r, w3i = w2r * w1r - w2i * w1i, w2r * w1i + w2i * w1r
-            q = r_ref / r
-            rho2 = ratio[j] * q * q * q                # (GM_j/GM_E)(R/r_j)^3
-            rho3 = rho2 * q
-            u2 = u * u
-            a = rho2 * n20 * 0.5 * (3.0 * u2 - 1.0)
-            tr[2, 0] += a
-            a = rho2 * n21 * 3.0 * u
-            tr[2, 1] += a * w1r
-            ti[2, 1] += a * w1i
-            a = rho2 * n22 * 3.0
-            tr[2, 2] += a * w2r
-            ti[2, 2] += a * w2i
-            a = rho3 * n30 * 0.5 * (5.0 * u2 - 3.0) * u
-            tr[3, 0] += a
-            a = rho3 * n31 * 1.5 * (5.0 * u2 - 1.0)
-            tr[3, 1] += a * w1r
-            ti[3, 1] += a * w1i
-            a = rho3 * n32 * 15.0 * u
-            tr[3, 2] += a * w2r
-            ti[3, 2] += a * w2i
-            a = rho3 * n33 * 15.0
-            tr[3, 3] += a * w3r
-            ti[3, 3] += a * w3i
-        dc[i, :, :] = 0.0
-        ds[i, :, :] = 0.0
-        for nn in range(2, 4):
-            f = 1.0 / (2 * nn + 1)
-            for m in range(nn + 1):
-                # dC - i dS = k T / (2n+1), k = kre + i kim, T = tr + i ti
-                dc[i, nn, m] = f * (kre[nn, m] * tr[nn, m] - kim[nn, m] * ti[nn, m])
-                ds[i, nn, m] = -f * (kre[nn, m] * ti[nn, m] + kim[nn, m] * tr[nn, m])
-        if degree4:
-            for m in range(3):
-                dc[i, 4, m] = 0.2 * kplus[m] * tr[2, m]
-                ds[i, 4, m] = -0.2 * kplus[m] * ti[2, m]
+    # real and imaginary parts of sum_j rho Pbar_nm e^{-i m lambda}, per instant
+    tr = np.zeros((4, 4, pos.shape[0]))
+    ti = np.zeros((4, 4, pos.shape[0]))
+    for j in range(pos.shape[1]):
+        x, y, z = pos[:, j, 0], pos[:, j, 1], pos[:, j, 2]
+        r = np.sqrt(x * x + y * y + z * z)
+        u = z / r                                  # sin(latitude)
+        w1r, w1i = x / r, -y / r                   # cos(lat) e^{-i lon}
+        w2r, w2i = w1r * w1r - w1i * w1i, 2.0 * w1r * w1i
+        w3r, w3i = w2r * w1r - w2i * w1i, w2r * w1i + w2i * w1r
+        q = r_ref / r
+        rho2 = ratio[j] * q * q * q                # (GM_j/GM_E)(R/r_j)^3
+        rho3 = rho2 * q
+        u2 = u * u
+        tr[2, 0] += rho2 * n20 * 0.5 * (3.0 * u2 - 1.0)
+        a = rho2 * n21 * 3.0 * u
+        tr[2, 1] += a * w1r
+        ti[2, 1] += a * w1i
+        a = rho2 * n22 * 3.0
+        tr[2, 2] += a * w2r
+        ti[2, 2] += a * w2i
+        tr[3, 0] += rho3 * n30 * 0.5 * (5.0 * u2 - 3.0) * u
+        a = rho3 * n31 * 1.5 * (5.0 * u2 - 1.0)
+        tr[3, 1] += a * w1r
+        ti[3, 1] += a * w1i
+        a = rho3 * n32 * 15.0 * u
+        tr[3, 2] += a * w2r
+        ti[3, 2] += a * w2i
+        a = rho3 * n33 * 15.0
+        tr[3, 3] += a * w3r
+        ti[3, 3] += a * w3i
+    dc[...] = 0.0
+    ds[...] = 0.0
+    for nn in range(2, 4):
+        f = 1.0 / (2 * nn + 1)
+        for m in range(nn + 1):
+            # dC - i dS = k T / (2n+1), k = kre + i kim, T = tr + i ti
+            dc[:, nn, m] = f * (kre[nn, m] * tr[nn, m] - kim[nn, m] * ti[nn, m])
+            ds[:, nn, m] = -f * (kre[nn, m] * ti[nn, m] + kim[nn, m] * tr[nn, m])
+    if degree4:
+        for m in range(3):
+            dc[:, 4, m] = 0.2 * kplus[m] * tr[2, m]
+            ds[:, 4, m] = -0.2 * kplus[m] * ti[2, m]
 
 
 def step1_coefficients(bodies_itrs, gm_ratio, love: LoveNumbers, r_ref: float = R_EARTH_EGM2008,
@@ -184,7 +178,7 @@ def step1_coefficients(bodies_itrs, gm_ratio, love: LoveNumbers, r_ref: float = 
     Returns (dC, dS), each float64 S + (5, 5) indexed [n, m], dimensionless,
     fully normalised; degrees 0, 1 are zero, degree 4 only if ``degree4``.
 
-    Evaluated per instant in a compiled loop with P_nm(sin Phi) e^{-i m lambda}
+    Evaluated for all instants at once (numpy) with P_nm(sin Phi) e^{-i m lambda}
     written as Q_nm(u) w^m, u = z/r, w = (x - i y)/r (no trigonometric calls);
     the spherical-coordinate form of eq. 6.6 is the test's reference.
     """

@@ -81,6 +81,7 @@ def install_cache_locator() -> bool:
 
         def __init__(self, py_func, py_file):
             self._lineno = py_func.__code__.co_firstlineno
+            self._py_file = py_file  # numba's warning of an uncachable function names it
             # one folder per package version (stamp) and source folder: every
             # install of the same sources shares it, old versions' folders are
             # simply never read again

@@ -1,4 +1,4 @@
-"""Lagrange interpolation on a uniform grid (compiled), for slowly varying tabulated quantities.
+"""Lagrange interpolation on a uniform grid, for slowly varying tabulated quantities.
 
 Slow, expensive series (precession-nutation X, Y, s; TDB - TT; the sub-daily
 EOP terms) are evaluated at the nodes of a uniform grid and interpolated to
@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 
@@ -38,36 +37,28 @@ def _denominators() -> np.ndarray:
 _DENOM = _denominators()
 
 
-@njit(cache=True)
-def _interp(u, k0, vals, denom, out):
-    npts = denom.size
-    half = npts // 2
-    m = vals.shape[1]
-    w = np.empty(npts)
-    for i in range(u.size):
-        kq = math.floor(u[i])
-        x = u[i] - kq
-        for j in range(npts):
-            p = 1.0
-            for q in range(npts):
-                if q != j:
-                    p *= x - (q - half + 1)
-            w[j] = p / denom[j]
-        b = int(kq) - (half - 1) - k0
-        for c in range(m):
-            acc = 0.0
-            for j in range(npts):
-                acc += w[j] * vals[b + j, c]
-            out[i, c] = acc
-
-
 def grid_interp(u: np.ndarray, k0: int, vals: np.ndarray, out: np.ndarray) -> None:
     """out[i, c] = the 8-point Lagrange interpolant of vals[:, c] at u[i].
 
     u : (n,) positions in units of the grid step; vals : (m_nodes, n_cols)
     values at the nodes k0, k0 + 1, ... (it must hold floor(u) - 3 ..
-    floor(u) + 4 for every u); out : (n, n_cols), written."""
-    _interp(np.ascontiguousarray(u, dtype=np.float64), int(k0), np.ascontiguousarray(vals), _DENOM, out)
+    floor(u) + 4 for every u); out : (n, n_cols), written.  Vectorised over
+    the instants (numpy: nothing to compile); each weight is the product
+    over the other nodes in node order, divided by its denominator, and the
+    sum runs over the nodes in order."""
+    u = np.asarray(u, dtype=np.float64)
+    vals = np.asarray(vals, dtype=np.float64)
+    kq = np.floor(u)
+    x = u - kq
+    b = kq.astype(np.int64) - (_HALF - 1) - int(k0)
+    acc = np.zeros(out.shape)
+    for j in range(POINTS):
+        p = np.ones_like(x)
+        for q in range(POINTS):
+            if q != j:
+                p *= x - float(q - _HALF + 1)
+        acc += (p / _DENOM[j])[:, None] * vals[b + j]
+    out[...] = acc
 
 
 def weights(x, offsets, derivative: bool = False):

@@ -64,9 +64,10 @@ from ..astro.ephemeris import ephemeris_named
 from ..scenario import load_scenario
 from . import coupled, estimator
 from .parameters import OrbitParameters, parameter_names, state_names
+from .registry import TYPES, unit_text
 from .tracking import (BIAS_TYPES, COUPLED_GROUPS, DEFAULT_SIGMA, GROUPS, HELIOCENTRIC_KINDS, KIND_TYPES,
-                       MEASUREMENT_TYPES, TRACKING_KINDS, Measurements, Tracking, bias_design, bias_keys, bias_type,
-                       evaluate, fail, is_heliocentric, jacobian, match, row_order)
+                       MEASUREMENT_TYPES, STATION_KINDS, TRACKING_KINDS, Measurements, Tracking, bias_design, bias_keys,
+                       bias_type, evaluate, fail, is_heliocentric, jacobian, match, row_order)
 from .variational import Partials, propagate_dd, propagate_with_partials
 
 __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking",
@@ -78,6 +79,8 @@ __all__ = ["DEFAULT_SIGMA", "GROUPS", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Me
 _PARTIALS_STEP_GEOCENTRIC = 600.0
 #: Standard deviation [m] of the simulated receiver clock bias per epoch (eliminated by the fit).
 CLOCK_SIGMA_M = 1000.0
+#: The measurement types whose rows carry a receiver clock bias per epoch and satellite.
+CLOCK_TYPES = tuple(n for n, x in TYPES.items() if x.receiver_clock)
 
 
 def _scenario(scenario, tracking: Tracking | None = None):
@@ -189,21 +192,23 @@ def _measurements(scen, tracking: Tracking, t, states) -> tuple[Measurements, np
             fail(f"tracking.kinds: {kind!r} gives no visible measurement on the arc of {tracking.arc_s} s "
                  f"of scenario {scen.name!r}")
     if tracking.stations is not None:
-        seen = {p for x in rows if x.type in ("slr_range", "dsn_range") for p in x.peer[x.visible]}
-        for kind in ("slr", "dsn"):
+        seen = {p for x in rows if TYPES[x.type].stations_label for p in x.peer[x.visible]}
+        for kind in STATION_KINDS:
             if kind in tracking.kinds:
                 for s in tracking.station_names(kind):
                     if s not in seen:
                         fail(f"tracking.stations: {s!r} is below its elevation mask for the whole arc "
                              f"({tracking.arc_s} s) of every satellite; leave it out")
     cols = [np.concatenate(a) for a in zip(*[(t[x.t_idx][x.visible], np.full(x.visible.sum(), x.type, object),
-                                               x.sat[x.visible], x.peer[x.visible], x.value[x.visible])
+                                               x.sat[x.visible], x.peer[x.visible], x.value[x.visible],
+                                               np.full(x.visible.sum(), np.nan) if x.tau_down is None
+                                               else x.tau_down[x.visible])
                                               for x in rows])]
-    tt, ty, sat, peer, val = cols
+    tt, ty, sat, peer, val, tau = cols
     k = row_order(tt, ty, sat, peer)
     sigma = np.array([tracking.sigma_of(x) for x in ty[k]])
     meas = Measurements(tt[k], ty[k].astype(str), sat[k].astype(np.int64), peer[k].astype(str),
-                        np.full(k.size, np.nan), sigma)
+                        np.full(k.size, np.nan), sigma, tau[k].astype(np.float64))
     return meas, val[k]
 
 
@@ -225,7 +230,7 @@ def measurement_biases(scen, meas: Measurements, bias: dict) -> np.ndarray:
     for key in sorted(bias, key=lambda k: "/" in k):        # types first, single biases override them
         v = bias[key]
         if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
-            fail(f"bias[{key!r}] = {v!r}; allowed: a finite number (m, m/s for dsn_range_rate)")
+            fail(f"bias[{key!r}] = {v!r}; allowed: a finite number ({unit_text(BIAS_TYPES)})")
         if key in BIAS_TYPES:
             out[meas.type == key] = v
             continue
@@ -255,7 +260,7 @@ def simulate(scenario, tracking: Tracking, truth: OrbitParameters | None = None,
         rng = np.random.default_rng(seed)
         value = value + meas.sigma * rng.standard_normal(len(meas))
         clock = CLOCK_SIGMA_M * rng.standard_normal((t.size, len(scen.satellites)))
-        g = meas.type == "gnss_pseudorange"
+        g = np.isin(meas.type, CLOCK_TYPES)
         ti = np.rint(meas.t / tracking.interval_s).astype(np.int64)
         value[g] += clock[ti[g], meas.sat[g]]
     meas.value = value
@@ -300,7 +305,7 @@ def compute(scenario, parameters: OrbitParameters | None, meas: Measurements, tr
 def _clock_elimination(meas: Measurements):
     """Sparse transform T (m', m), sigmas (m',) and labels (m',) eliminating the GNSS receiver
     clock of each (epoch, satellite) (module docstring); other rows pass unchanged."""
-    g = meas.type == "gnss_pseudorange"
+    g = np.isin(meas.type, CLOCK_TYPES)
     other = np.flatnonzero(~g)
     rows, cols, vals = [np.arange(other.size)], [other], [np.ones(other.size)]
     sig, lab = [meas.sigma[other]], [meas.type[other]]
@@ -320,7 +325,7 @@ def _clock_elimination(meas: Measurements):
             cols.append(np.tile(idx, M.shape[0]))
             vals.append(M.ravel())
             sig.append(np.full(M.shape[0], s0))
-            lab.append(np.full(M.shape[0], "gnss_pseudorange"))
+            lab.append(np.full(M.shape[0], meas.type[idx[0]]))
             out += M.shape[0]
     T = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(out, len(meas)))

@@ -1,9 +1,8 @@
 """Tracking plans and measurement rows of orbit determination (:mod:`.problem` puts them
-together): the tracking kinds and measurement types, the :class:`Tracking` plan, the
-:class:`Measurements` table, and the measurement models of :mod:`.measurements_gnss`,
-:mod:`.measurements_slr`, :mod:`.measurements_isr`, :mod:`.measurements_dsn` evaluated on a grid
-of states (every computable row with its partials with respect to the satellites' position and
-velocity at the time tag, chained with the full-system state transition matrix and
+together): the tracking kinds and measurement types (those of :mod:`.registry`), the
+:class:`Tracking` plan, the :class:`Measurements` table, and the registered measurement types
+evaluated on a grid of states (every computable row with its partials with respect to the
+satellites' position and velocity at the time tag, chained with the full-system state transition matrix and
 sensitivities by :func:`jacobian`).  Time tags t [s since the epoch, the run's time scale: TT
 geocentric, TDB heliocentric]; states [m, m/s] in the run's frame.
 """
@@ -16,27 +15,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._choices import allowed, shown, unknown
-from ..astro.ephemeris import ephemeris_named, planetary_gm
-from ..constellation.indices import LINK_EMITTER, LINK_RECEIVER
 from ..dynamics.empirical import PARAMETER_NAMES
-from .measurements_dsn import DEEP_SPACE_STATIONS, DSN_DOPPLER_SIGMA_M_S, DSN_RANGE_SIGMA_M, dsn_tracking
-from .measurements_gnss import BEIDOU_MEO, GNSS_SIGMA_M, GPS, pseudorange
-from .measurements_isr import ISR_ABSOLUTE_SIGMA_M, isr_range
-from .measurements_slr import ILRS_STATIONS, SLR_SIGMA_M, slr_range
+from .measurement_type import Context, Rows, scenario_eop
 from .parameters import STATE_NAMES
+from .registry import BIAS_TYPES, KIND_TYPES, MEASUREMENT_TYPES, TRACKING_KINDS, TYPES, unit_text
 
 __all__ = ["BIAS_TYPES", "COUPLED_GROUPS", "DEFAULT_ESTIMATE", "DEFAULT_ESTIMATE_COUPLED", "DEFAULT_SIGMA", "GROUPS",
            "KIND_TYPES", "MEASUREMENT_TYPES", "TRACKING_KINDS", "Measurements", "Tracking", "bias_design", "bias_keys",
-           "bias_type", "evaluate", "jacobian", "match", "row_order"]
+           "bias_type", "evaluate", "jacobian", "match", "parameter_unit", "row_order"]
 
-TRACKING_KINDS = ("gnss", "slr", "isr", "dsn")
-MEASUREMENT_TYPES = ("gnss_pseudorange", "slr_range", "isr_range", "dsn_range", "dsn_range_rate")
-#: Measurement types of each tracking kind.
-KIND_TYPES = {"gnss": ("gnss_pseudorange",), "slr": ("slr_range",), "isr": ("isr_range",),
-              "dsn": ("dsn_range", "dsn_range_rate")}
-#: Default noise per measurement type [m, m/s for dsn_range_rate] (the models' defaults).
-DEFAULT_SIGMA = {"gnss_pseudorange": GNSS_SIGMA_M, "slr_range": SLR_SIGMA_M, "isr_range": ISR_ABSOLUTE_SIGMA_M,
-                 "dsn_range": DSN_RANGE_SIGMA_M, "dsn_range_rate": DSN_DOPPLER_SIGMA_M_S}
+#: Default noise per measurement type [its unit] (the registry's, :mod:`.registry`).
+DEFAULT_SIGMA = {n: x.sigma for n, x in TYPES.items()}
 #: Parameter groups: name -> the per-satellite parameter names it holds ("self_gravity_common":
 #: the rows of ``spacecraft.self_gravity_common`` of a coupled run, :mod:`.coupled`; "bias": the
 #: measurement biases, per station or link rather than per satellite, :func:`bias_design`).
@@ -45,21 +34,29 @@ GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETE
           "self_gravity_common": ("sgc_x", "sgc_y", "sgc_z"), "bias": ()}
 #: The groups of a coupled run (the others but "bias" are those of point-mass runs).
 COUPLED_GROUPS = ("state", "self_gravity_common", "bias")
-#: Measurement types with a constant bias parameter (group "bias", :func:`bias_design`): one per
-#: ground station and type (SLR and deep-space: the station's range calibration, its frequency
-#: offset) and one per one-way inter-satellite link (the ranging offsets of its two ends).
-#: GNSS pseudoranges have none: a bias common to a receiver's pseudoranges is its clock.
-#: Where the SLR and deep-space stations are listed.
+#: Where the stations are listed.
 STATIONS_DOC = "docs/orbit-determination.md#measurement-models"
-BIAS_TYPES = ("slr_range", "isr_range", "dsn_range", "dsn_range_rate")
+#: Measurement types with a constant bias parameter (group "bias", :func:`bias_design`):
+#: :data:`tqdyn.od.registry.BIAS_TYPES` (one per ground station and type, one per one-way link).
 #: The groups estimated when a plan names none: point-mass runs, coupled runs.
 DEFAULT_ESTIMATE = ("state", "s_frame")
 DEFAULT_ESTIMATE_COUPLED = ("state", "self_gravity_common")
-HELIOCENTRIC_KINDS = ("dsn", "isr")
+HELIOCENTRIC_KINDS = tuple(k for k in sorted(TRACKING_KINDS) if all(TYPES[n].heliocentric for n in KIND_TYPES[k]))
+#: Tracking kinds with ground stations, and their station names.
+STATION_KINDS = tuple(k for k in TRACKING_KINDS if TYPES[KIND_TYPES[k][0]].stations_label)
 
 
 def fail(msg: str):
     raise ValueError(" ".join(msg.split()))
+
+
+def check_consider(consider, a_priori, field: str = "tracking.consider",
+                   how: str = "tracking.a_priori_sigma[{g!r}]") -> None:
+    """Every considered group has an a priori sigma: ValueError (one line naming ``field``, and
+    ``how`` to give it, ``{g}`` the group) otherwise."""
+    for g in consider:
+        if g not in a_priori:
+            fail(f"{field}: {g!r} needs an a priori sigma; allowed: with {how.format(g=g)}")
 
 
 @dataclass(frozen=True)
@@ -68,8 +65,10 @@ class Tracking:
 
     kinds: subset of :data:`TRACKING_KINDS`; arc_s [s] from the epoch; interval_s [s] sampling
     interval, a multiple of ``integrator.step``; sigma: {measurement type: sigma [m or m/s]}
-    overriding :data:`DEFAULT_SIGMA`; stations: SLR (:data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`)
-    and deep-space (:data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`) station names (None:
+    overriding :data:`DEFAULT_SIGMA`; stations: station names of the station kinds
+    (:data:`STATION_KINDS`: SLR :data:`~tqdyn.od.measurements_slr.ILRS_STATIONS`, deep-space
+    :data:`~tqdyn.od.measurements_dsn.DEEP_SPACE_STATIONS`, TT&C the stations file of
+    :mod:`~tqdyn.od.measurements_ttc`) (None:
     all of them); estimate, consider: parameter groups (:data:`GROUPS`; estimate None: the
     run's defaults, :meth:`estimated`); a_priori_sigma: {group:
     sigma} a priori sigmas per group (``"state"``: (sigma_r [m], sigma_v [m/s]); the acceleration
@@ -132,23 +131,21 @@ class Tracking:
                         fail(unknown("tracking.a_priori_sigma['bias']", typ, BIAS_TYPES))
                     if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
                         fail(f"tracking.a_priori_sigma['bias'][{typ!r}] = {x!r}; allowed: a finite number > 0 "
-                             f"(m, m/s for dsn_range_rate)")
+                             f"({TYPES[typ].unit})")
                 continue
             vals = np.atleast_1d(np.asarray(v, np.float64))
             if vals.shape != ((2,) if g == "state" else (1,)) or not np.all(vals > 0):
                 fail(f"tracking.a_priori_sigma[{g!r}] = {v!r}; allowed: "
                      + ("(sigma_r m, sigma_v m/s) > 0" if g == "state" else
-                        "a number > 0 (m, m/s for dsn_range_rate) or {type: number}" if g == "bias" else
+                        f"a number > 0 ({unit_text(BIAS_TYPES)}) or {{type: number}}" if g == "bias" else
                         "a number > 0 (m/s^2)"))
-        for g in self.consider:
-            if g not in (self.a_priori_sigma or {}):
-                fail(f"tracking.consider: {g!r} has no a priori sigma; give tracking.a_priori_sigma[{g!r}]")
+        check_consider(self.consider, self.a_priori_sigma or {})
         if self.stations is not None:
             st = (self.stations,) if isinstance(self.stations, str) else tuple(self.stations)
+            every = [n for k in STATION_KINDS for n in station_catalogue(k)]
             for s in st:
-                if s not in ILRS_STATIONS and s not in DEEP_SPACE_STATIONS:
-                    fail(unknown("tracking.stations", s, [*ILRS_STATIONS, *DEEP_SPACE_STATIONS], STATIONS_DOC,
-                                 noun="stations"))
+                if s not in every:
+                    fail(unknown("tracking.stations", s, every, STATIONS_DOC, noun="stations"))
             object.__setattr__(self, "stations", st)
         if self.gnss_orbits is not None:
             orbits = tuple(self.gnss_orbits) if isinstance(self.gnss_orbits, (list, tuple)) else (self.gnss_orbits,)
@@ -188,13 +185,13 @@ class Tracking:
         return np.arange(n + 1) * float(self.interval_s)
 
     def station_names(self, kind: str):
-        """Station names of an SLR or DSN kind (None: the model's defaults)."""
+        """Station names of a station kind (:data:`STATION_KINDS`; None: the model's defaults)."""
         if self.stations is None:
             return None
-        cat = ILRS_STATIONS if kind == "slr" else DEEP_SPACE_STATIONS
+        cat = station_catalogue(kind)
         names = [s for s in self.stations if s in cat]
         if not names:
-            fail(f"tracking.stations: {shown(list(self.stations))} has no {'SLR' if kind == 'slr' else 'deep-space'} "
+            fail(f"tracking.stations: {shown(list(self.stations))} has no {TYPES[KIND_TYPES[kind][0]].stations_label} "
                  f"station (tracking {kind!r}); allowed: {allowed(cat, STATIONS_DOC, noun='stations')}")
         return names
 
@@ -205,7 +202,10 @@ class Measurements:
 
     t (m,) [s since the epoch, the run's time scale]; type (m,) str of :data:`MEASUREMENT_TYPES`;
     sat (m,) int satellite index; peer (m,) str: station name, GNSS id ("G07", "C12") or the
-    emitting satellite's index; value (m,) [m or m/s] (NaN before simulation); sigma (m,)."""
+    emitting satellite's index; value (m,) [m or m/s] (NaN before simulation); sigma (m,);
+    tau_down (m,) [s] or None: the downlink light time of two-way rows (from the bounce at the
+    satellite, the time tag, to the reception at the station; NaN on other rows), which the TDM
+    writer needs to tag the rows at reception (CCSDS ``TIMETAG_REF = RECEIVE``)."""
 
     t: np.ndarray
     type: np.ndarray
@@ -213,6 +213,7 @@ class Measurements:
     peer: np.ndarray
     value: np.ndarray
     sigma: np.ndarray
+    tau_down: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -220,93 +221,55 @@ class Measurements:
     def select(self, mask) -> "Measurements":
         """The rows where mask is true (or the given row indices)."""
         return Measurements(*(np.asarray(a)[mask] for a in (self.t, self.type, self.sat, self.peer, self.value,
-                                                              self.sigma)))
+                                                              self.sigma)),
+                            tau_down=None if self.tau_down is None else np.asarray(self.tau_down)[mask])
 
+
+
+def station_catalogue(kind: str) -> tuple:
+    """The station names a plan may give for a station kind (:data:`STATION_KINDS`)."""
+    return TYPES[KIND_TYPES[kind][0]].station_catalogue()
+
+
+def parameter_unit(name: str) -> str:
+    """The unit of an estimated parameter from its name ``"<sat>/<component>"``: the initial state's
+    x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters and a coupled run's common
+    self-gravity [m/s^2] (:data:`GROUPS`), the measurement biases ``"bias/<type>/..."`` [the type's
+    unit, :mod:`.registry`]; "" otherwise."""
+    if name.startswith("bias/"):
+        return TYPES[name.split("/")[1]].unit
+    last = name.rsplit("/", 1)[-1]
+    if last in STATE_NAMES:
+        return "m" if last in STATE_NAMES[:3] else "m/s"
+    return "m/s^2" if any(last in v for g, v in GROUPS.items() if g != "state") else ""
 
 
 def is_heliocentric(scen) -> bool:
     return scen.reference.central_body == "sun"
 
 
-@dataclass
-class _Rows:
-    """Computed measurements of one type on a time grid: row arrays (r,)."""
-
-    type: str
-    t_idx: np.ndarray
-    sat: np.ndarray
-    peer: np.ndarray
-    value: np.ndarray
-    visible: np.ndarray
-    d: np.ndarray        # (r, 2, 6): partials wrt the satellite's and the emitter's (r, v)
-    sat2: np.ndarray     # (r,) emitter index (ISR) or -1
-
-
-def _flat(mtype, b, names, obs_value, d_r, d_v, visible):
-    """Rows of an (N, S) observable of satellite b toward peers ``names``."""
-    n, s = obs_value.shape
-    d = np.zeros((n * s, 2, 6))
-    d[:, 0, :3] = d_r.reshape(-1, 3)
-    d[:, 0, 3:] = d_v.reshape(-1, 3)
-    return _Rows(mtype, np.repeat(np.arange(n), s), np.full(n * s, b), np.tile(np.asarray(names, object), n),
-                 obs_value.ravel(), visible.ravel(), d, np.full(n * s, -1))
-
-
-def _gnss_sources(tracking: Tracking):
-    """(constellation, id prefix or None: the constellation's own ids) of the plan's GNSS transmitters."""
-    if tracking.gnss_orbits is None:
-        return ((GPS, "G"), (BEIDOU_MEO, "C"))
-    return tuple((o, None) for o in tracking.gnss_orbits)
-
-
-def evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[_Rows]:
+def evaluate(scen, tracking: Tracking, t, states, types, stations=None) -> list[Rows]:
     """Every computable measurement of ``types`` at t (n,) [s] from states (n, n_sat, 6)
-    [m, m/s]; stations: {kind: names} overriding the tracking plan's."""
-    stations = stations or {}
-    helio = is_heliocentric(scen)
+    [m, m/s] (each type's :meth:`~tqdyn.od.measurement_type.MeasurementType.evaluate`, with the
+    scenario's Earth orientation); stations: {kind: names} overriding the tracking plan's."""
+    ctx = Context(scen, tracking, dict(stations or {}), **scenario_eop(scen))
     out = []
-    n_sat = states.shape[1]
-    r, v = states[..., :3], states[..., 3:]
-    if "gnss_pseudorange" in types:
-        for b in range(n_sat):
-            for const, prefix in _gnss_sources(tracking):
-                o = pseudorange(t, r[:, b], v[:, b], const, mode=tracking.gnss_mode)
-                ids = list(const.ids) if prefix is None else [f"{prefix}{k + 1:02d}" for k in range(o.value.shape[1])]
-                out.append(_flat("gnss_pseudorange", b, ids, o.value, o.d_r, o.d_v, o.visible))
-    if "slr_range" in types:
-        names = stations.get("slr", tracking.station_names("slr"))
-        for b in range(n_sat):
-            o = slr_range(scen.epoch, t, r[:, b], v[:, b], names)
-            out.append(_flat("slr_range", b, o.extra["stations"], o.value, o.d_r, o.d_v, o.visible))
-    if "dsn_range" in types or "dsn_range_rate" in types:
-        names = stations.get("dsn", tracking.station_names("dsn"))
-        eph = ephemeris_named(scen.forces.ephemeris)
-        for b in range(n_sat):
-            rng, rate = dsn_tracking(scen.epoch, t, r[:, b], v[:, b], names, heliocentric=helio, ephemeris=eph)
-            for mtype, o in (("dsn_range", rng), ("dsn_range_rate", rate)):
-                if mtype in types:
-                    out.append(_flat(mtype, b, o.extra["stations"], o.value, o.d_r, o.d_v, o.visible))
-    if "isr_range" in types:
-        gm = planetary_gm()["sun"] if helio else float(scen.forces.gm_earth)
-        o = isr_range(t, r, v, gm=gm)
-        n, nl = o.value.shape
-        d = np.concatenate([o.d_r, o.d_v], axis=-1).reshape(n * nl, 2, 6)
-        rec, emi = np.asarray(LINK_RECEIVER), np.asarray(LINK_EMITTER)
-        out.append(_Rows("isr_range", np.repeat(np.arange(n), nl), np.tile(rec, n),
-                         np.tile(np.array([str(e) for e in emi], object), n), o.value.ravel(),
-                         o.visible.ravel(), d, np.tile(emi, n)))
+    for name in MEASUREMENT_TYPES:
+        if name in types:
+            out += TYPES[name].evaluate(ctx, t, states)
     return out
 
 
 def bias_keys(meas: "Measurements", satellite_names) -> list[str]:
-    """The name of the bias parameter of each measurement row: ``"bias/<type>/<station>"`` (SLR,
-    deep-space), ``"bias/isr_range/<emitter>-><receiver>"`` (satellite names); "" for a type
-    without a bias (:data:`BIAS_TYPES`)."""
+    """The name of the bias parameter of each measurement row: ``"bias/<type>/<station>"`` (the
+    station types), ``"bias/<type>/<emitter>-><receiver>"`` (the link types; satellite names); ""
+    for a type without a bias (:data:`BIAS_TYPES`)."""
     out = []
     for mtype, sat, peer in zip(meas.type.tolist(), meas.sat.tolist(), meas.peer.tolist()):
-        if mtype not in BIAS_TYPES:
+        conv = TYPES[mtype].bias
+        if not conv:
             out.append("")
-        elif mtype == "isr_range":
+        elif conv == "link":
             out.append(f"bias/{mtype}/{satellite_names[int(peer)]}->{satellite_names[int(sat)]}")
         else:
             out.append(f"bias/{mtype}/{peer}")
@@ -342,8 +305,8 @@ def match(scen, tracking, t_grid, states, meas: Measurements):
     """(rows index table): for each measurement, its computed value, partials and emitter."""
     types = tuple(sorted(set(meas.type), key=MEASUREMENT_TYPES.index))
     stations = {}
-    for kind, mtypes in (("slr", ("slr_range",)), ("dsn", ("dsn_range", "dsn_range_rate"))):
-        sel = np.isin(meas.type, mtypes)
+    for kind in STATION_KINDS:
+        sel = np.isin(meas.type, KIND_TYPES[kind])
         if sel.any():
             stations[kind] = list(dict.fromkeys(meas.peer[sel]))
     rows = evaluate(scen, tracking, t_grid, states, types, stations)

@@ -125,8 +125,8 @@ def link_ttl_asd(loops, noise: dict, f, coeffs: TTLCoefficients, theta, dt: floa
     """TTL ASD (6, n_source, n_f) [m/Hz^1/2] of the links (:data:`tqdyn.ttl.coupling.MOSAS` order) from each
     noise source (module docstring), and the source names.  ``loops``: the three spacecraft's
     :class:`ClosedLoop` (i = 1, 2, 3); ``noise`` {source: AsdModel}; ``f`` [Hz]; ``theta`` opening angle
-    [rad] (float or one per spacecraft); ``dt`` [s]: the zero-order-hold discretised loops (as the time
-    domain runs), else continuous."""
+    [rad] (float or one per spacecraft); ``dt`` [s]: the zero-order-hold discretised loops (a sampled loop on
+    held noise; the time series realise the continuous budget), else continuous."""
     _linear_only(coeffs)
     th = _check_loops(loops, theta)
     f = np.asarray(f, dtype=np.float64)

@@ -1,7 +1,6 @@
 """Orbit determination: the checks and parsers of the inputs of ``tqdyn od`` and of
 ``tqdyn.od_simulate | od_fit | od_covariance`` (tracking kinds, arcs, biases, a priori sigmas, SP3
-files, a measurement table's rows against a run), the parameters' units and the covariance's JSON
-record.
+files, a measurement table's rows against a run) and the covariance's JSON record.
 
 The jobs are :mod:`tqdyn.workflows.od_memory` (in memory: simulate, fit, covariance) and
 :mod:`tqdyn.workflows.od_files` (``tqdyn od simulate | fit | covariance``: a file read, the
@@ -22,17 +21,36 @@ from .._choices import allowed as allowed_names, did_you_mean, unknown
 from .closed_loop import file_sha256
 from .run import load_run_scenario
 
-__all__ = ["KIND_OF_TYPE", "covariance_record", "parameter_unit", "parse_arc", "parse_names", "parse_tracking"]
-
-#: measurement type -> the tracking kind that produces it
-KIND_OF_TYPE = {"gnss_pseudorange": "gnss", "slr_range": "slr", "isr_range": "isr", "dsn_range": "dsn",
-                "dsn_range_rate": "dsn"}
+__all__ = ["KIND_OF_TYPE", "covariance_record", "parameter_unit", "parse_arc", "parse_names",  # noqa: F822
+           "parse_tracking"]
 
 
 def _problem():
     from ..od import problem
 
     return problem
+
+
+def _registry():
+    from ..od import registry
+
+    return registry
+
+
+def _unit(name: str) -> str:
+    from ..od.tracking import parameter_unit
+
+    return parameter_unit(name)
+
+
+def __getattr__(name):
+    """The names this module had before the measurement registry (:mod:`tqdyn.od.registry`):
+    ``KIND_OF_TYPE`` {type: kind} and ``parameter_unit``, re-exported from it."""
+    if name == "KIND_OF_TYPE":
+        return {n: x.kind for n, x in _registry().TYPES.items()}
+    if name == "parameter_unit":
+        return _unit
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def parse_tracking(text, option: str = "--tracking") -> tuple[str, ...]:
@@ -83,22 +101,22 @@ def _number(text, option: str, key: str, positive: bool) -> float:
 
 
 def parse_biases(items, option: str = "--bias") -> dict:
-    """``TYPE=VALUE`` or ``TYPE/PEER=VALUE`` (repeated; or a mapping) -> {key: value [m, m/s for
-    dsn_range_rate]}, the measurement biases of ``tqdyn.od``'s ``problem.simulate``."""
+    """``TYPE=VALUE`` or ``TYPE/PEER=VALUE`` (repeated; or a mapping) -> {key: value [the type's
+    unit, m or m/s]}, the measurement biases of ``tqdyn.od``'s ``problem.simulate``."""
     allowed = _problem().BIAS_TYPES
     out = {}
     for key, value in _key_values(items, option, "TYPE=VALUE or TYPE/STATION=VALUE"):
         typ = key.removeprefix("bias/").split("/")[0]
         if typ not in allowed:
             raise ValueError(f"{option}: {key!r} is not allowed{did_you_mean(typ, allowed)}; allowed: "
-                             f"{', '.join(allowed)} (or TYPE/STATION, TYPE/EMITTER->RECEIVER)")
+                             f"{', '.join(allowed)}, or TYPE/PEER")
         out[key] = _number(value, option, key, positive=False)
     return out
 
 
 def parse_a_priori(items, option: str = "--a-priori") -> dict:
     """``GROUP=SIGMA`` (``state=SIGMA_R,SIGMA_V``, ``bias=SIGMA`` or ``bias/TYPE=SIGMA``; repeated, or a
-    mapping such as {"state": (100.0, 0.01), "bias": {"slr_range": 0.02}}) -> ``Tracking.a_priori_sigma``
+    mapping such as {"state": (100.0, 0.01), "bias": {TYPE: 0.02}}) -> ``Tracking.a_priori_sigma``
     {group: sigma} [m, m/s, m/s^2]."""
     groups = _problem().GROUPS
     pairs = []
@@ -129,9 +147,9 @@ def parse_a_priori(items, option: str = "--a-priori") -> dict:
 
 
 def _check_consider(con_names, a_priori: dict) -> None:
-    for g in con_names:
-        if g not in a_priori:
-            raise ValueError(f"--consider: {g!r} needs an a priori sigma; allowed: with --a-priori {g}=SIGMA")
+    from ..od.tracking import check_consider
+
+    check_consider(con_names, a_priori, "--consider", "--a-priori {g}=SIGMA")
 
 
 def parse_arc(value, option: str = "--arc") -> float:
@@ -147,22 +165,6 @@ def parse_arc(value, option: str = "--arc") -> float:
         raise ValueError(f"{option}: {value!r} is not a duration > 0; allowed: seconds, or with a unit (7d, 12h, "
                          "30min, 3600s)")
     return v
-
-
-def parameter_unit(name: str) -> str:
-    """The unit of an estimated parameter from its name ``"<sat>/<component>"``: the initial state's
-    x, y, z [m] and vx, vy, vz [m/s], the acceleration parameters and a coupled run's common
-    self-gravity [m/s^2], the measurement biases ``"bias/<type>/..."`` [m, m/s for range rates];
-    "" otherwise."""
-    from ..od.coupled import COMMON_NAMES
-    from ..od.parameters import PARAMETER_NAMES, STATE_NAMES
-
-    if name.startswith("bias/"):
-        return "m/s" if name.split("/")[1] == "dsn_range_rate" else "m"
-    last = name.rsplit("/", 1)[-1]
-    if last in STATE_NAMES:
-        return "m" if last in STATE_NAMES[:3] else "m/s"
-    return "m/s^2" if last in PARAMETER_NAMES or last in COMMON_NAMES else ""
 
 
 def _check_arc(scen, arc_s: float, source: str) -> None:
@@ -254,8 +256,9 @@ def _sp3_orbits(paths, scen, arc_s: float) -> dict:
     if not paths:
         return {}
     from ..od.gnss_sp3 import sp3_constellations
+    from ..od.measurement_type import scenario_eop
 
-    orbits = sp3_constellations(paths, scen.epoch)
+    orbits = sp3_constellations(paths, scen.epoch, **scenario_eop(scen))
     for o in orbits:
         lo, hi = o.span
         if lo > -1.0 or hi < arc_s:
@@ -320,7 +323,7 @@ def covariance_record(cov, scen, plan, sp3_paths=()) -> dict:
                          "estimate": list(_problem().estimated_groups(scen, plan)),
                          "consider": list(plan.consider), "a_priori_sigma": plan.a_priori_sigma or {},
                          **({"sp3": _sp3_record(sp3_paths)} if sp3_paths else {})},
-            "names": list(cov.names), "units": [parameter_unit(n) for n in cov.names], "values": arr(cov.values),
+            "names": list(cov.names), "units": [_unit(n) for n in cov.names], "values": arr(cov.values),
             "sigma": arr(cov.sigma), "covariance": arr(cov.covariance), "correlation": arr(cov.correlation),
             "consider_names": list(cov.consider_names), "consider_sigma": arr(cov.consider_sigma),
             "condition_number": float(cov.condition_number)}

@@ -374,7 +374,7 @@ def gather_campaign(spec: CampaignSpec, status=None, errors=None):
     data["ok"], data["error"] = (dims, ok), (dims, err.astype(str))
     coords = {"plan": [",".join(p) for p in spec.plans], "arc_s": ("arc", np.asarray(spec.arcs)),
               "epoch": list(spec.epochs), "parameter": names, "parameter_j": names,
-              "unit": ("parameter", [_od.parameter_unit(n) for n in names])}
+              "unit": ("parameter", [_od._unit(n) for n in names])}
     if recovery:
         coords["seed"] = list(spec.seeds)
         total = np.where(ok, arr["error_chi2"], 0.0).sum(axis=-1)

@@ -133,7 +133,7 @@ def fit_to_file(scenario, tdm, *, output=None, estimate=None, consider=None, a_p
     scen, notes, label = _scenario(scenario, overrides)
     say("reading")
     fields, info = read_measurements_tdm(tdm, epoch=scen.epoch, time_scale=scen.reference.time_scale,
-                                         with_lines=True)
+                                         with_lines=True, grid_s=float(scen.integrator.step_s))
     f = fit(label, fields, info, estimate=est_names, consider=con_names, a_priori=sig, edit_sigma=edit_sigma,
             sp3=sp3, options=options, name=str(tdm), progress=say, cli=True, scen=scen)
     attrs = {}

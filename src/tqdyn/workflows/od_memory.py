@@ -192,6 +192,9 @@ def measurements_dataset(meas, *, epoch: str, time_scale: str, satellite_names=N
               "peer": ("row", cols["peer"].astype(str))}
     data = {"value": ("row", cols["value"].astype(np.float64), {"units": "m or m/s (range rates)"}),
             "sigma": ("row", cols["sigma"].astype(np.float64), {"units": "m or m/s (range rates)"})}
+    tau = meas.get("tau_down") if isinstance(meas, dict) else getattr(meas, "tau_down", None)
+    if tau is not None:   # two-way rows: the downlink light time the TDM's tags are formed with
+        data["tau_down"] = ("row", np.asarray(tau, np.float64), {"units": "s"})
     attrs = {"epoch": epoch, "time_scale": time_scale,
              **({"satellite_names": ",".join(satellite_names)} if satellite_names else {}), **info}
     return xr.Dataset(data, coords=coords, attrs=attrs)
@@ -295,7 +298,7 @@ def fit(scenario, fields: dict, info: dict, tracking=None, *, estimate=None, con
             raise ValueError(f"{name}: {key} {info[key]}, the scenario's is {mine}; allowed: measurements of "
                              "this scenario")
     header = tuple(info["tracking"].split(",")) if info.get("tracking") else \
-        tuple(dict.fromkeys(_od.KIND_OF_TYPE[t] for t in fields["type"]))
+        tuple(dict.fromkeys(_od._registry().kind_of(t) for t in fields["type"]))
     _od.parse_tracking(header, f"{name}: header tqdyn tracking")
     if tracking is None:
         kinds = header
@@ -314,7 +317,7 @@ def fit(scenario, fields: dict, info: dict, tracking=None, *, estimate=None, con
     p = _problem()
     result = p.fit(scen, meas, plan, **opts)
     rows = p.residual_rows(meas)
-    units = [_od.parameter_unit(n) for n in result.names]
+    units = [_od._unit(n) for n in result.names]
     attrs = {"scenario": scen.to_toml(), "scenario_name": scen.name, "epoch": scen.epoch.iso,
              "time_scale": scen.reference.time_scale,
              "edit_sigma": math.nan if edit_sigma is None else float(edit_sigma),
