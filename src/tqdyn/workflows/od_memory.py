@@ -217,12 +217,20 @@ def measurements_fields(ds, name: str = "measurements") -> tuple[dict, dict]:
 def open_measurements(path, scenario=None):
     """The measurements Dataset of a measurement file (CCSDS TDM written by ``tqdyn od simulate`` or
     :func:`tqdyn.formats.od_tdm.write_measurements_tdm`), t from the file's epoch, or from
-    ``scenario``'s (a name, TOML, run file or Scenario; then checked to agree)."""
-    from ..formats.od_tdm import read_measurements_tdm
+    ``scenario``'s (a name, TOML, run file or Scenario; then checked to agree).  Two-way rows are
+    tagged at reception in the file; their bounce instants are moved back onto the grid of the
+    scenario's ``integrator.step`` (no scenario: the header's ``tqdyn interval_s``) as ``tqdyn od
+    fit`` reads them."""
+    from ..formats.od_tdm import tdm_to_measurements
+    from ..formats.tdm import read_tdm
 
     scen = None if scenario is None else _load(scenario, ())[0]
-    fields, info = read_measurements_tdm(path, epoch=None if scen is None else scen.epoch,
-                                         time_scale=None if scen is None else scen.reference.time_scale)
+    tdm = read_tdm(path)
+    kw = {"epoch": None if scen is None else scen.epoch,
+          "time_scale": None if scen is None else scen.reference.time_scale, "name": str(path)}
+    fields, info = tdm_to_measurements(tdm, **kw, grid_s=None if scen is None else float(scen.integrator.step_s))
+    if scen is None and "interval_s" in info:
+        fields, info = tdm_to_measurements(tdm, **kw, grid_s=_od._header_number(info, "interval_s", str(path)))
     epoch, time_scale = info.pop("epoch"), info.pop("time_scale")
     names = [s.name for s in scen.satellites] if scen is not None else None
     return measurements_dataset(fields, epoch=epoch, time_scale=time_scale, satellite_names=names, info=info)
