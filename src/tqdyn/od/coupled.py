@@ -30,13 +30,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import coupled_variational
 from .parameters import OrbitParameters, per_satellite_names, scenario_with
 from .tracking import fail
 from .variational import Partials, propagate_dd
 
-__all__ = ["COMMON_NAMES", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario",
+__all__ = ["COMMON_NAMES", "METHODS", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario",
            "nominal_common", "parameter_names", "propagate_with_partials"]
 
+#: Methods of the partials: the coupled variational equations (:mod:`.coupled_variational`) or
+#: central differences of dd runs.
+METHODS = ("variational", "differences")
 #: Names of the per-satellite common self-gravity parameters [m/s^2 in S].
 COMMON_NAMES = ("sgc_x", "sgc_y", "sgc_z")
 #: Central-difference steps: initial position [m], velocity [m/s], common self-gravity [m/s^2].
@@ -73,13 +77,21 @@ def _runs(scen, par: OrbitParameters, t, step: float):
 
 
 def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, step: float | None = None,
-                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON)) -> Partials:
-    """States at t_out [s since the epoch] (dd run with the run's step) and their partials by
-    central differences (module docstring) of runs with ``step`` [s] (None: the run's): a
-    :class:`~tqdyn.od.variational.Partials` whose ``sensitivities`` (n, n_sat, 6, 3) and
-    ``sensitivities_full`` (n, 6 n_sat, 3 n_sat) are with respect to the common self-gravity
-    [s^2, s], ``parameter_names`` :data:`COMMON_NAMES`.  steps: the difference steps (position
-    [m], velocity [m/s], common self-gravity [m/s^2])."""
+                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON), method: str = "variational",
+                            node_step: float | None = None) -> Partials:
+    """States at t_out [s since the epoch] (dd run with the run's step) and their partials,
+    integrated with ``step`` [s] (None: the run's): a :class:`~tqdyn.od.variational.Partials`
+    whose ``sensitivities`` (n, n_sat, 6, 3) and ``sensitivities_full`` (n, 6 n_sat, 3 n_sat)
+    are with respect to the common self-gravity [s^2, s], ``parameter_names`` :data:`COMMON_NAMES`.
+
+    method: ``"variational"`` (default): the coupled variational equations of
+    :mod:`.coupled_variational` (Jacobians at nodes every ``node_step`` [s]);
+    ``"differences"``: central differences of dd runs (module docstring), steps the difference
+    steps (position [m], velocity [m/s], common self-gravity [m/s^2])."""
+    if method not in METHODS:
+        fail(f"method: {method!r}; allowed: {', '.join(METHODS)}")
+    if method == "variational":
+        return coupled_variational.propagate_with_partials(scen, parameters, t_out, step, node_step)
     check_scenario(scen)
     par = parameters or OrbitParameters()
     t, y_dd = propagate_dd(scen, par, t_out)
