@@ -28,6 +28,9 @@ evaluation of the Jacobian, each the length of the arc).
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+
 import numpy as np
 
 from . import coupled_variational
@@ -35,12 +38,13 @@ from .parameters import OrbitParameters, per_satellite_names, scenario_with
 from .tracking import fail
 from .variational import Partials, propagate_dd
 
-__all__ = ["COMMON_NAMES", "METHODS", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario",
+__all__ = ["COMMON_NAMES", "METHODS", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario", "method",
            "nominal_common", "parameter_names", "propagate_with_partials"]
 
 #: Methods of the partials: the coupled variational equations (:mod:`.coupled_variational`) or
 #: central differences of dd runs.
 METHODS = ("variational", "differences")
+_METHOD = contextvars.ContextVar("coupled_partials_method", default="variational")
 #: Names of the per-satellite common self-gravity parameters [m/s^2 in S].
 COMMON_NAMES = ("sgc_x", "sgc_y", "sgc_z")
 #: Central-difference steps: initial position [m], velocity [m/s], common self-gravity [m/s^2].
@@ -76,18 +80,38 @@ def _runs(scen, par: OrbitParameters, t, step: float):
     return propagate_dd(scenario_with(scen, step_s=step), par, t)[1]
 
 
+@contextlib.contextmanager
+def method(name: str):
+    """Within the ``with`` block, the partials of coupled runs that name no method (those of
+    :mod:`tqdyn.od.problem`'s fits, covariances and computed measurements) are made by
+    ``name``, one of :data:`METHODS`::
+
+        with coupled.method("differences"):
+            est = problem.fit("tianqin", meas, tracking)
+    """
+    if name not in METHODS:
+        fail(f"method: {name!r}; allowed: {', '.join(METHODS)}")
+    token = _METHOD.set(name)
+    try:
+        yield
+    finally:
+        _METHOD.reset(token)
+
+
 def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, step: float | None = None,
-                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON), method: str = "variational",
+                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON), method: str | None = None,
                             node_step: float | None = None) -> Partials:
     """States at t_out [s since the epoch] (dd run with the run's step) and their partials,
     integrated with ``step`` [s] (None: the run's): a :class:`~tqdyn.od.variational.Partials`
     whose ``sensitivities`` (n, n_sat, 6, 3) and ``sensitivities_full`` (n, 6 n_sat, 3 n_sat)
     are with respect to the common self-gravity [s^2, s], ``parameter_names`` :data:`COMMON_NAMES`.
 
-    method: ``"variational"`` (default): the coupled variational equations of
-    :mod:`.coupled_variational` (Jacobians at nodes every ``node_step`` [s]);
-    ``"differences"``: central differences of dd runs (module docstring), steps the difference
-    steps (position [m], velocity [m/s], common self-gravity [m/s^2])."""
+    method: ``"variational"``: the coupled variational equations of :mod:`.coupled_variational`
+    (Jacobians at nodes every ``node_step`` [s]); ``"differences"``: central differences of dd
+    runs (module docstring), steps the difference steps (position [m], velocity [m/s], common
+    self-gravity [m/s^2]); None: that of the enclosing :func:`method` block, else
+    ``"variational"``."""
+    method = _METHOD.get() if method is None else method
     if method not in METHODS:
         fail(f"method: {method!r}; allowed: {', '.join(METHODS)}")
     if method == "variational":
