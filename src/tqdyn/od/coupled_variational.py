@@ -191,18 +191,17 @@ def default_node_step(h: float) -> float:
     return h * max(1, int(NODE_STEP_MAX // h))
 
 
-def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, step: float | None = None,
-                            node_step: float | None = None) -> Partials:
+def propagate_with_partials(scen, parameters: OrbitParameters, self_gravity_common, t_out, parameter_names,
+                            step: float | None = None, node_step: float | None = None) -> Partials:
     """States at t_out [s since the epoch] (the dd run at the run's step) and their partials by
-    the coupled variational equations (module docstring) integrated with ``step`` [s] (None: the
-    run's; a multiple of it dividing every t_out), Jacobians at nodes every ``node_step`` [s]
-    (None: :func:`default_node_step`; a multiple of step): a
-    :class:`~tqdyn.od.variational.Partials` as :func:`tqdyn.od.coupled.propagate_with_partials`
-    returns it."""
-    from .coupled import COMMON_NAMES, check_scenario, nominal_common   # coupled imports this module
-
-    check_scenario(scen)
-    par = parameters or OrbitParameters()
+    the coupled variational equations (module docstring) of the coupled scenario (checked by the
+    caller, :func:`tqdyn.od.coupled.propagate_with_partials`) with the parameter values
+    (``self_gravity_common``: their (3, 3) values [m/s^2 in S], resolved), integrated with
+    ``step`` [s] (None: the run's; a multiple of it dividing every t_out), Jacobians at nodes
+    every ``node_step`` [s] (None: :func:`default_node_step`; a multiple of step): a
+    :class:`~tqdyn.od.variational.Partials` with ``parameter_names`` the names of the
+    self-gravity components."""
+    par = parameters
     run_step = float(scen.integrator.step_s)
     h = run_step if step is None else float(step)
     if abs(h / run_step - round(h / run_step)) > 1e-12:
@@ -218,8 +217,7 @@ def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, ste
     t_all, inv = np.unique(np.concatenate([idx * h, t_nodes]), return_inverse=True)
     _, y_all = propagate_dd(scen, par, t_all)
     y_out, y_nodes = y_all[inv[:t_req.size]], y_all[inv[t_req.size:]]
-    sg = nominal_common(scen) if par.self_gravity_common is None else par.self_gravity_common
-    jac = jacobians(scen, t_nodes, y_nodes, sg)
+    jac = jacobians(scen, t_nodes, y_nodes, self_gravity_common)
     M, N = _affine_maps(jac, H, h, n_steps, scen.integrator.tableau)
     phi = np.empty((n_steps + 1, 18, 18))
     psi = np.empty((n_steps + 1, 18, 9))
@@ -228,4 +226,4 @@ def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, ste
         phi[k + 1] = M[k] @ phi[k]
         psi[k + 1] = M[k] @ psi[k] + N[k]
     return Partials.from_full(idx * h, y_out, phi[idx], psi[idx], [s.name for s in scen.satellites],
-                              COMMON_NAMES)
+                              parameter_names)
