@@ -26,7 +26,7 @@ states the run's own step.
 
 Cost: 2 runs per parameter (18 state + 9 self-gravity columns for three satellites: 54 runs per
 evaluation of the Jacobian, each the length of the arc); the variational equations take one run
-and 54 evaluations of the right-hand side per Jacobian node.  The two agree to ~1e-9 of each
+and 46 evaluations of the right-hand side per Jacobian node.  The two agree to ~1e-9 of each
 column's largest value over 10 days (tests/test_od_coupled.py).
 """
 
