@@ -134,19 +134,19 @@ def _variational_vs_differences(v, d) -> dict:
 
 
 def test_variational_equations_match_differences_half_day(coupled_partials, record_number):
-    """The coupled variational partials (Jacobians of the dd coupled right-hand side every 5400 s,
-    DP87 at 600 s) against the central differences of dd runs over 12 h every 3 h: largest
+    """The coupled variational partials (Jacobians of the dd coupled right-hand side every 3600 s,
+    the default node spacing over 12 h, so that 12 nodes interpolate; DP87 at 600 s) against the central differences of dd runs over 12 h every 3 h: largest
     difference per parameter class relative to each column's largest value, measured 2.2e-11
     (states) and 6e-12 (common self-gravity), bounded at 1e-10; the blocks that couple the
     satellites (one satellite's state against another's parameters, ~1e-4 m/m and ~4 s^2 after
-    12 h) relative to their own size measured 2.3e-8, bounded at 1e-7."""
+    12 h) relative to their own size measured 5.2e-8, bounded at 2e-7."""
     t, d = coupled_partials
     v = coupled.propagate_with_partials(load_scenario(SCEN), None, t, step=600.0)
     assert np.array_equal(v.states_dd, d.states_dd)
     rel = _variational_vs_differences(v, d)
     record_number("od.coupled_variational_rel_12h", rel)
     assert max(rel["position"], rel["velocity"], rel["self_gravity_common"]) < 1e-10, rel
-    assert rel["cross"] < 1e-7, rel
+    assert rel["cross"] < 2e-7, rel
 
 
 @pytest.mark.slow  # 54 ten-day coupled runs for the differences: ~1 min

@@ -186,10 +186,10 @@ def _affine_maps(jac, node_step: float, h: float, n_steps: int, tableau: str):
     return M, N
 
 
-def default_node_step(h: float) -> float:
-    """The largest multiple of the partials' step h [s] at most :data:`NODE_STEP_MAX` (h itself
-    when h is larger)."""
-    return h * max(1, int(NODE_STEP_MAX // h))
+def default_node_step(h: float, span: float = np.inf) -> float:
+    """The largest multiple of the partials' step h [s] at most :data:`NODE_STEP_MAX` and, over a
+    short span [s], at most span / 11, so that 12 nodes interpolate (h itself when h is larger)."""
+    return h * max(1, int(min(NODE_STEP_MAX, span / (_ORDER - 1)) // h))
 
 
 def propagate_with_partials(scen, parameters: OrbitParameters, self_gravity_common, t_out, parameter_names,
@@ -207,12 +207,12 @@ def propagate_with_partials(scen, parameters: OrbitParameters, self_gravity_comm
     h = run_step if step is None else float(step)
     if abs(h / run_step - round(h / run_step)) > 1e-12:
         raise ValueError(f"step: {step} s is not a multiple of integrator.step = {run_step} s")
-    H = default_node_step(h) if node_step is None else float(node_step)
-    if abs(H / h - round(H / h)) > 1e-12:
-        raise ValueError(f"node_step: {node_step} s is not a multiple of the partials' step {h} s")
     t_req = np.atleast_1d(np.asarray(t_out, np.float64))
     idx = _grid(t_req, h, "step")
     n_steps = max(int(idx.max()), 1)
+    H = default_node_step(h, n_steps * h) if node_step is None else float(node_step)
+    if abs(H / h - round(H / h)) > 1e-12:
+        raise ValueError(f"node_step: {node_step} s is not a multiple of the partials' step {h} s")
     n_nodes = max(int(np.ceil(n_steps * h / H - 1e-9)) + 1, 2)
     t_nodes = np.arange(n_nodes) * H
     t_all, inv = np.unique(np.concatenate([idx * h, t_nodes]), return_inverse=True)
