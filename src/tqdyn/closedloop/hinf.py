@@ -107,15 +107,17 @@ def design_plant(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = 
     return control.ss(G.A[np.ix_(keep, keep)], G.B[keep], G.C[:, keep], G.D, inputs=ins, outputs=outs)
 
 
-def weights(channels) -> tuple[control.StateSpace, control.StateSpace, np.ndarray]:
-    """(W1, W2, w (n,) [rad/s]) of the ``channels`` ``<loop>[k]`` (module docstring)."""
+def weights(channels, peak_sensitivity: float = PEAK_SENSITIVITY, authority_ratio: float = AUTHORITY_RATIO) \
+        -> tuple[control.StateSpace, control.StateSpace, np.ndarray]:
+    """(W1, W2, w (n,) [rad/s]) of the ``channels`` ``<loop>[k]`` (module docstring; M_s = ``peak_sensitivity``,
+    r = ``authority_ratio``)."""
     from .missions import CROSSOVER_HZ
 
     w = np.array([2 * math.pi * CROSSOVER_HZ[c.split("[")[0]] for c in channels])
-    W1 = control.append(*[control.ss(control.tf([1.0 / PEAK_SENSITIVITY, wk], [1.0, wk * SENSITIVITY_FLOOR]))
+    W1 = control.append(*[control.ss(control.tf([1.0 / peak_sensitivity, wk], [1.0, wk * SENSITIVITY_FLOOR]))
                           for wk in w])
     W2 = control.ss(np.zeros((0, 0)), np.zeros((0, len(w))), np.zeros((len(w), 0)),
-                    np.diag(1.0 / (AUTHORITY_RATIO * w) ** 2))
+                    np.diag(1.0 / (authority_ratio * w) ** 2))
     return W1, W2, w
 
 
@@ -130,12 +132,14 @@ def _sb10ad(P: control.StateSpace, n_meas: int, n_con: int):
 
 
 def synthesise(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = "dws",
-               scheme: str = "constellation", where: str = "") -> HinfController:
+               scheme: str = "constellation", where: str = "", peak_sensitivity: float = PEAK_SENSITIVITY,
+               authority_ratio: float = AUTHORITY_RATIO) -> HinfController:
     """The H-infinity mixed-sensitivity controller (module docstring) of a spacecraft with parameters ``p`` at
-    working point ``wp``.  DesignError (one line naming ``closed_loop.design``) for a scheme other than
+    working point ``wp``, weights of peak sensitivity ``peak_sensitivity`` (``closed_loop.hinf_peak_sensitivity``)
+    and authority ratio ``authority_ratio`` (``closed_loop.hinf_authority_ratio``).  DesignError (one line naming ``closed_loop.design``) for a scheme other than
     "constellation", a synthesis that fails (no stabilising controller for the weights) or a gamma > 1 (the
     weights cannot be met); ``where`` names the spacecraft in that line."""
-    at = f" ({where})" if where else ""
+    at = f" for {where}" if where else ""
     if scheme != "constellation":
         raise DesignError(DESIGN_KEY, f"'hinf' is not available for the {scheme!r} scheme{at}; allowed: 'hinf' "
                                       "with the 'constellation' scheme (tianqin, lisa, taiji), 'per_loop' otherwise")
@@ -143,7 +147,7 @@ def synthesise(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = "d
     chans = channel_names(scheme)
     G = design_plant(p, wp, attitude_z_sensor, scheme)
     Gs = control.ss(G.A + SHIFT_RAD_S * np.eye(G.nstates), G.B, G.C, G.D)
-    W1, W2, w = weights(chans)
+    W1, W2, w = weights(chans, peak_sensitivity, authority_ratio)
     P = control.augw(Gs, W1, W2, None)
     n = len(chans)
     try:
@@ -153,8 +157,9 @@ def synthesise(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = "d
         raise DesignError(DESIGN_KEY, f"'hinf': the synthesis failed{at} ({why}); allowed: 'per_loop', or "
                                       "weights a stabilising controller can meet") from None
     if not gamma <= 1.0:
-        raise DesignError(DESIGN_KEY, f"'hinf': the weights cannot be met{at} (gamma = {gamma:.3g} > 1); "
-                                      "allowed: 'per_loop', or weights with gamma <= 1 (docs/closed-loop.md)")
+        raise DesignError(DESIGN_KEY, f"'hinf': the weights cannot be met{at} (gamma = {gamma:.3g} > 1 with "
+                                      f"hinf_peak_sensitivity = {peak_sensitivity:g}, hinf_authority_ratio = "
+                                      f"{authority_ratio:g}); allowed: larger ones (gamma <= 1), or 'per_loop'")
     # augw closes u = K (w - G u); the loop closes c = C e with e = G c (the actuators apply -c): C = -K
     K = control.ss(Ks.A - SHIFT_RAD_S * np.eye(Ks.nstates), Ks.B, -Ks.C, -Ks.D,
                    inputs=[f"e_{c}" for c in chans], outputs=[f"c_{c}" for c in chans], name="C_hinf")

@@ -145,20 +145,22 @@ def _assemble(parts, controllers: dict, attitude_z_sensor: str, scheme: str, val
     return cls, st
 
 
-def _hinf_loops(parts, attitude_z_sensor: str, scheme: str, validate: bool, names=()) -> tuple[list, tuple]:
+def _hinf_loops(parts, settings: dict, validate: bool, names=()) -> tuple[list, tuple]:
     """(closed loops, controllers) of the (PlantParameters, WorkingPoint) ``parts`` (a list per satellite of
     one per segment) under the "hinf" design: one synthesis per satellite (its first segment), every segment's
     loop built with it (checked stable with ``validate``)."""
     from .hinf import synthesise
 
-    ks = tuple(synthesise(*per_sat[0], attitude_z_sensor, scheme, names[i] if i < len(names) else f"Sat{i + 1}")
+    attitude_z_sensor, scheme = settings["attitude_z_sensor"], settings["scheme"]
+    ks = tuple(synthesise(*per_sat[0], attitude_z_sensor, scheme, names[i] if i < len(names) else f"Sat{i + 1}",
+                          settings["hinf_peak_sensitivity"], settings["hinf_authority_ratio"])
                for i, per_sat in enumerate(parts))
     cls = [_build(p, wp, k, attitude_z_sensor, scheme, validate) for k, per_sat in zip(ks, parts) for p, wp in per_sat]
     return cls, ks
 
 
 def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_sensor: str, validate: bool,
-           scheme: str = "constellation", design: str = "per_loop", names=()):
+           scheme: str = "constellation", settings: dict | None = None, names=()):
     """(loops, parts, stack) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments
     ``rows`` (:func:`_assemble`)."""
     n_sat, n_seg = len(wps[0]), len(rows)
@@ -168,8 +170,8 @@ def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_senso
             wp = wps[k][i]
             parts[i].append((plant_parameters(plant, craft, wp.theta), wp))
     ks = ()
-    if design == "hinf":
-        (cls, ks), st = _hinf_loops(parts, attitude_z_sensor, scheme, validate, names), None
+    if settings is not None and settings["design"] == "hinf":
+        (cls, ks), st = _hinf_loops(parts, settings, validate, names), None
     else:
         cls, st = _assemble([pw for per_sat in parts for pw in per_sat], controllers, attitude_z_sensor, scheme,
                             validate)
@@ -212,7 +214,7 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
     names = tuple(getattr(traj, "satellite_names", ()))
     loops, parts, stack, ks = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl,
                                      settings["attitude_z_sensor"], validate, cfg.scheme(traj.spacecraft.architecture),
-                                     settings["design"], names)
+                                     settings, names)
     names = names or tuple(f"Sat{i + 1}" for i in range(len(loops)))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,
                            satellite_names=names, t_span=(float(t[0]), float(t[-1])), parts=parts,
@@ -247,8 +249,7 @@ def static_closed_loop_model(config=None, validate: bool = True) -> ClosedLoopMo
     wp = representative_working_point(mission)
     ks = ()
     if settings["design"] == "hinf":
-        ((cl,), ks), stack = _hinf_loops([[(p, wp)]], settings["attitude_z_sensor"], settings["scheme"], validate,
-                                         (mission,)), None
+        ((cl,), ks), stack = _hinf_loops([[(p, wp)]], settings, validate, (mission,)), None
     else:
         (cl,), stack = _assemble([(p, wp)], ctl, settings["attitude_z_sensor"], settings["scheme"], validate)
     span = float(settings["duration"] or settings["segment"])

@@ -12,6 +12,7 @@ Dataset (dims design, sample) written as netCDF-4 (nothing at the output path on
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import time
@@ -67,8 +68,9 @@ def check_monte_carlo(mission, n, overrides=(), workers=None) -> None:
                              "(the Monte Carlo runs both designs)")
 
 
-def _designs(mission, overrides) -> dict:
-    """{design: (model, controllers)} of the mission's static working point."""
+@functools.lru_cache(maxsize=4)
+def _designs(mission, overrides: tuple) -> dict:
+    """{design: (model, controllers)} of the mission's static working point (kept: a synthesis is the slow part)."""
     from ..closedloop.model import static_closed_loop_model
     from ..scenario.closed_loop import DESIGNS
     from ..scenario.loader import closed_loop_config
@@ -95,7 +97,7 @@ def monte_carlo(mission: str, n: int, seed: int = 0, overrides=(), scheduler=Non
 
     check_monte_carlo(mission, n, overrides, workers)
     t0 = time.perf_counter()
-    designs = _designs(mission, overrides)
+    designs = _designs(mission, tuple(overrides))
     t_build = time.perf_counter() - t0
     z = draw(np.random.default_rng(seed), n)
     req = requirement(mission)
