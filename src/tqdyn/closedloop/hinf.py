@@ -12,7 +12,7 @@ Weights (diagonal, one per channel k, :func:`weights`):
 
 * W1_k(s) = (s / M_s + w_k) / (s + w_k A) on the sensitivity S = (I + G K)^-1: |S| below |1/W1|, i.e. rising
   as f / f_k below the loop's bandwidth f_k = w_k / 2 pi (:data:`tqdyn.closedloop.missions.CROSSOVER_HZ`,
-  the bandwidths the requirement sets: docs/closed-loop.md#controllers-and-margins), a peak M_s = 2 (a
+  the per-loop design's crossovers: docs/closed-loop.md#controllers-and-margins), a peak M_s = 2 (a
   sensitivity peak of 2 bounds every loop-at-a-time gain margin beyond [2/3, 2] and phase margin beyond
   29 deg) and a low-frequency floor A = 1e-4;
 * W2_k = 1 / (r w_k)^2 on K S (the command per unit error, s^-2): the actuator authority, a command
