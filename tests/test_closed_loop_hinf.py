@@ -191,3 +191,23 @@ def test_weights_that_cannot_be_met(tianqin):
     msg = str(exc.value)
     assert msg.startswith("closed_loop.design: ") and "gamma" in msg and "hinf_authority_ratio = 3" in msg
     assert "\n" not in msg and len(msg) <= 200
+
+
+def test_monte_carlo_command_on_a_local_cluster(tianqin, tmp_path, capsys):
+    """``tqdyn closed-loop --mission tianqin --monte-carlo 1 --workers 1``: the draws run as Dask tasks on a
+    one-worker local cluster; the netCDF file holds both designs' results and the draw, the same numbers as
+    the in-process evaluation of the same seed (the reference: workers=0)."""
+    import xarray as xr
+
+    from tqdyn.workflows.closed_loop_mc import monte_carlo
+
+    out = tmp_path / "mc.nc"
+    status, stdout, err = run_cli(["closed-loop", "--mission", "tianqin", "--monte-carlo", "1", "--workers", "1",
+                                   "--seed", "3", "-q", "-o", str(out)], capsys)
+    assert status == 0, err
+    assert "hinf: stable 100%" in stdout and out.exists()
+    ds = xr.open_dataset(out)
+    ref = monte_carlo("tianqin", 1, seed=3, workers=0)
+    assert np.allclose(ds.requirement_ratio.values, ref.requirement_ratio.values, rtol=1e-12)
+    assert ds.attrs["scheduler"] == "local" and ds.crosstalk.shape == (1,)
+    ds.close()
