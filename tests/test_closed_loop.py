@@ -95,7 +95,7 @@ def test_default_designs_are_stable_with_margins_and_name_their_dominant_sources
     assert np.all(np.isfinite(b)) and np.all(b >= 0)
     i = output_names().index("tm1_acceleration")
     low = f < 3e-4
-    # below the loops' bandwidths the residual acceleration is the TM force noise (the requirement curve)
+    # below the loops' bandwidths the residual acceleration is the TM force noise input
     assert sources[int(np.argmax(np.mean(b[i][:, low] ** 2, axis=1)))] == "tm_force"
 
 

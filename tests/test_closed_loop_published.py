@@ -9,7 +9,8 @@ Published numbers (abstract level):
   noise ~0.17 uN/Hz^1/2.
 
 The other references are analytic: the sensitivity S = 1/(1 + C P) of the default suspension
-controller on P = 1/(s^2 + k), evaluated directly from C(s).
+controller on P = 1/(s^2 + k), evaluated directly from C(s).  The mission defaults here are the "v0.3" preset of
+``closed_loop.defaults`` (docs/closed-loop-validation.md, sections 1-3 evaluate it; section 7 the published one).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ LPF_STIFFNESS = (-1.3e-6, -2.0e-6)   # s^-2, k1, k2 (x'' = -k x; the order of LP
 def _lpf(df_hz=CROSSOVER_HZ["dragfree"], sus_hz=CROSSOVER_HZ["suspension"], sc_mass=LPF_SC_MASS,
          stiffness=LPF_STIFFNESS):
     return two_tm_axis_loop(lead_lag_pid(df_hz, name="dragfree"), lead_lag_pid(sus_hz, name="suspension"),
-                            sc_mass, default_plant("lisa")["tm_mass"], stiffness)
+                            sc_mass, default_plant("lisa", "v0.3")["tm_mass"], stiffness)
 
 
 _INPUTS = ["thruster_force[0]", "tm_force[0]", "tm_force[3]", "interferometer[0]", "interferometer[1]"]
@@ -120,7 +121,7 @@ def lisa_dc_limit():
     A = np.array([[0.0, 1e-10, 0.0], [0.0, -1e-10, 0.0]])
     wp = dataclasses.replace(wp, a_suspension=A, self_gravity=np.zeros((2, 3)), a_dragfree=np.zeros(3))
     p = representative_plant("lisa")
-    cl = build_closed_loop(p, wp, default_controllers("lisa"))
+    cl = build_closed_loop(p, wp, default_controllers("lisa", "v0.3"))
     check_stable(cl)
     return p, cl
 
@@ -132,7 +133,7 @@ def test_dc_suspension_limit_reaches_the_suspended_axis_through_the_suspension_s
     /Hz^1/2 the actuation noise, A_dc = 1e-10 m/s^2): the closed loop agrees within 10 % at 1-100 mHz
     (measured <= 2.5 %, the spacecraft's share below the crossover)."""
     p, cl = lisa_dc_limit
-    eps = default_noise("lisa")["actuation_force"].level
+    eps = default_noise("lisa", "v0.3")["actuation_force"].level
     G = closed_loop_response(cl, F_DC, ["tm1_es_force_y", "tm1_displacement_y"], ["actuation_force[1]"])
     a_p = np.abs(G[0, 0] / p.tm_mass - p.stiffness[0, 1] * G[1, 0]) * eps
     s = 2j * math.pi * F_DC
@@ -149,7 +150,7 @@ def test_dc_suspension_limit_in_the_science_budget_is_crosstalk_times_sensitivit
     ASD = crosstalk eps A_dc |S_sus|; the model's budget (source actuation_force, output
     tm1_acceleration) agrees within 5e-4 (measured 9e-5)."""
     p, cl = lisa_dc_limit
-    noise = default_noise("lisa")
+    noise = default_noise("lisa", "v0.3")
     b, sources = noise_budget(cl, {"actuation_force": noise["actuation_force"]}, F_DC, ["tm1_acceleration"])
     s = 2j * math.pi * F_DC
     S = 1.0 / (1.0 + lead_lag_pid(CROSSOVER_HZ["suspension"]).tf()(s) / (s ** 2 + p.stiffness[0, 1]))
@@ -167,9 +168,9 @@ def test_mosa_actuator_path_to_the_science_axis_is_crosstalk_of_the_suspension_f
     (measured 0.05 % at 1-20 mHz) at LISA's representative working point."""
     wp = representative_working_point("lisa")
     p = representative_plant("lisa")
-    cl = build_closed_loop(p, wp, default_controllers("lisa"))
+    cl = build_closed_loop(p, wp, default_controllers("lisa", "v0.3"))
     f = np.array([1e-3, 5e-3, 1e-2, 2e-2])
-    noise = default_noise("lisa")
+    noise = default_noise("lisa", "v0.3")
     b, _ = noise_budget(cl, {"mosa_actuator": noise["mosa_actuator"]}, f, ["tm1_acceleration"])
     s = 2j * math.pi * f
     Sm = 1.0 / (1.0 + lead_lag_pid(CROSSOVER_HZ["mosa"]).tf()(s) / s ** 2)

@@ -11,7 +11,7 @@ them for the working points of coupled runs; docs/closed-loop.md renders them).
 per mission, the loop-at-a-time margins of the default design at a representative working point, and
 the residual TM acceleration along the sensitive axis at 1 and 10 mHz split into
 
-* ``tm_force``: the TM force noise (the requirement curve by default);
+* ``tm_force``: the TM force noise (LISA Pathfinder's per-TM level by default, the requirement curve in the "v0.3" preset);
 * ``actuation_force``: force-proportional electrostatic actuation noise (level x the DC suspension m |A|),
   reaching the sensitive axis only through cross-talk (the scheme applies no force along it);
 * ``crosstalk_commands``: the AC suspension commands leaking into the sensitive axis through cross-talk

@@ -3,7 +3,10 @@
 
 Every number has its source in src/tqdyn/data/SOURCES.md (section "Closed-loop defaults"); the ones
 marked *assumption* are tqdyn's choices where no public document gives a value, stated with the
-reason.  Units: SI; ASDs one-sided (:mod:`tqdyn.closedloop.noise`).
+reason.  Two presets (``closed_loop.defaults``, :data:`tqdyn.scenario.closed_loop.DEFAULTS`): ``"published"``
+(the default) replaces v0.3's values where a published design or flight paper gives one
+(:mod:`tqdyn.closedloop.published`); ``"v0.3"`` keeps version 0.3's lead-lag design and assumed values as
+they were.  Units: SI; ASDs one-sided (:mod:`tqdyn.closedloop.noise`).
 """
 
 from __future__ import annotations
@@ -14,13 +17,14 @@ import numpy as np
 
 from .._choices import unknown
 
-from ..scenario.closed_loop import (CONSTELLATION_MISSIONS, MISSIONS, PLANT_KEYS, SCHEME_LOOPS,
+from ..scenario.closed_loop import (CONSTELLATION_MISSIONS, DEFAULTS, MISSIONS, PLANT_KEYS, SCHEME_LOOPS,
                                     SINGLE_SPACECRAFT_MISSIONS)
 from .controllers import Controller, lead_lag_pid
 from .flown import (flown_controllers, flown_noise, flown_plant, flown_plant_parameters, flown_requirement,
                     flown_working_point)
 from .noise import AsdModel
 from .plant import PlantParameters, WorkingPoint, plant_parameters
+from .published import published_noise_levels
 
 __all__ = ["CONSTELLATION_MISSIONS", "MISSIONS", "SINGLE_SPACECRAFT_MISSIONS", "controller_from_keys",
            "default_controllers", "default_noise", "default_plant", "representative_plant",
@@ -46,16 +50,20 @@ CROSSOVER_HZ = {"dragfree": 0.05, "suspension": 0.005, "attitude": 0.02, "attitu
                 "tm_rotation": 0.005}
 
 
-def _check(mission: str) -> None:
+def _check(mission: str, defaults: str = DEFAULTS[0]) -> None:
     if mission not in MISSIONS:
         raise ValueError(unknown("closed_loop.mission", mission, MISSIONS, problem="is not a mission"))
+    if defaults not in DEFAULTS:
+        raise ValueError(unknown("closed_loop.defaults", defaults, DEFAULTS, problem="is not a defaults preset"))
 
 
-def default_plant(mission: str) -> dict:
+def default_plant(mission: str, defaults: str = DEFAULTS[0]) -> dict:
     """The [closed_loop.plant] defaults of ``mission`` (keys of :class:`tqdyn.closedloop.plant.PlantParameters`
     that are not geometry): masses [kg], inertias [kg m^2], tm_side [m], stiffness [s^-2], crosstalk [1]; the
-    single-spacecraft missions also tm2_stiffness [s^-2] and tm_separation [m] (their geometry)."""
-    _check(mission)
+    single-spacecraft missions also tm2_stiffness [s^-2] and tm_separation [m] (their geometry).  ``defaults``:
+    a preset of :data:`~tqdyn.scenario.closed_loop.DEFAULTS` (the two agree on the plant: no published value of
+    the stiffness, cross-talk or spacecraft inertia was found, SOURCES.md)."""
+    _check(mission, defaults)
     if mission in SINGLE_SPACECRAFT_MISSIONS:
         return flown_plant(mission)
     return {**_COMMON_PLANT, **_PLANT[mission]}
@@ -74,11 +82,26 @@ def requirement(mission: str) -> AsdModel:
     return AsdModel(3e-15, ((4e-4, -1.0), (8e-3, 2.0)), "m/s^2", "requirement")
 
 
-def default_noise(mission: str) -> dict:
-    """{source: AsdModel} defaults of ``mission`` (one-sided ASDs; units of :data:`tqdyn.closedloop.loop.SOURCES`)."""
-    _check(mission)
+def default_noise(mission: str, defaults: str = DEFAULTS[0]) -> dict:
+    """{source: AsdModel} defaults of ``mission`` (one-sided ASDs; units of :data:`tqdyn.closedloop.loop.SOURCES`).
+    ``defaults="published"``: the TM force noise, thrust and thruster-torque noise of
+    :func:`tqdyn.closedloop.published.published_noise_levels` over v0.3's; ``"v0.3"``: version 0.3's values
+    (the TM force noise equal to the requirement)."""
+    _check(mission, defaults)
     if mission in SINGLE_SPACECRAFT_MISSIONS:
         return flown_noise(mission)
+    out = _v03_noise(mission)
+    if defaults == "published":
+        a = _PLANT[mission]["tm_side"]
+        for src, (level, knees) in published_noise_levels(mission).items():
+            out[src] = AsdModel(level, knees, out[src].unit, out[src].name)
+        tm = out["tm_force"]
+        out["tm_torque"] = AsdModel(3.0 * tm.level / a, tm.knees, "rad/s^2", out["tm_torque"].name)
+    return out
+
+
+def _v03_noise(mission: str) -> dict:
+    """Version 0.3's noise defaults of a constellation mission (SOURCES.md)."""
     req = requirement(mission)
     a = _PLANT[mission]["tm_side"]
 
@@ -105,12 +128,13 @@ def default_noise(mission: str) -> dict:
     }
 
 
-def default_controllers(mission: str) -> dict:
+def default_controllers(mission: str, defaults: str = DEFAULTS[0]) -> dict:
     """{loop: Controller}: :func:`tqdyn.closedloop.controllers.lead_lag_pid` at :data:`CROSSOVER_HZ`
     (the same crossovers for the three constellation missions; the plants differ in masses and inertias only
     by the actuator conversion, which the controllers' acceleration commands absorb); the single-spacecraft
-    missions' loops: :func:`tqdyn.closedloop.flown.flown_controllers`."""
-    _check(mission)
+    missions' loops: :func:`tqdyn.closedloop.flown.flown_controllers`.  Both presets of ``defaults`` use
+    these crossovers: no published bandwidth of a TianQin, LISA or Taiji loop was readable (SOURCES.md)."""
+    _check(mission, defaults)
     if mission in SINGLE_SPACECRAFT_MISSIONS:
         return flown_controllers(mission)
     return {loop: lead_lag_pid(f, name=loop) for loop, f in CROSSOVER_HZ.items()}
@@ -127,13 +151,14 @@ def controller_from_keys(loop: str, zeros, poles, gain) -> Controller:
 def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
     """(mission, plant dict, {loop: Controller}, {source: AsdModel}) of a
     :class:`tqdyn.scenario.closed_loop.ClosedLoopConfig` over the mission's defaults (the mission:
-    ``closed_loop.mission`` or the spacecraft ``architecture``); a given noise ``level`` or ``knees``
+    ``closed_loop.mission`` or the spacecraft ``architecture``; the preset ``closed_loop.defaults``); a given noise ``level`` or ``knees``
     replaces that part of the default.  A ``closed_loop.scheme`` other than the mission's takes the
     project's lead-lag design for its loops (:data:`CROSSOVER_HZ`; 20 mHz for a loop it does not name).
     ValueError (one line) for ``tm_separation`` on a constellation mission."""
     mission = config.mission(architecture)
     raw = config.raw or {}
-    plant = default_plant(mission)
+    defaults = str(raw.get("defaults", DEFAULTS[0]))
+    plant = default_plant(mission, defaults)
     for k, v in raw.get("plant", {}).items():
         if k == "tm_separation" and mission not in SINGLE_SPACECRAFT_MISSIONS:
             raise ValueError(f"closed_loop.plant.tm_separation: {v!r} is not allowed for {mission!r}; allowed: "
@@ -141,13 +166,13 @@ def resolve(config, architecture: str) -> tuple[str, dict, dict, dict]:
                              "run's geometry comes from its spacecraft)")
         plant[k] = float(v) if PLANT_KEYS[k] == 1 else tuple(float(x) for x in v)
     scheme = config.scheme(architecture)
-    ctl = default_controllers(mission)
+    ctl = default_controllers(mission, defaults)
     if set(ctl) != set(SCHEME_LOOPS[scheme]):       # another scheme than the mission's: its loops' defaults
         ctl = {loop: lead_lag_pid(CROSSOVER_HZ.get(loop, CROSSOVER_HZ["attitude"]), name=loop)
                for loop in SCHEME_LOOPS[scheme]}
     for loop, spec in raw.get("controllers", {}).items():
         ctl[loop] = controller_from_keys(loop, spec["zeros"], spec["poles"], float(spec["gain"]))
-    noise = default_noise(mission)
+    noise = default_noise(mission, defaults)
     for src, spec in raw.get("noise", {}).items():
         base = noise[src]
         noise[src] = AsdModel(float(spec.get("level", base.level)),

@@ -7,6 +7,8 @@ run's ``spacecraft.architecture``, and the settings' defaults of :data:`CLOSED_L
 
     [closed_loop]
     mission                       # one of MISSIONS: "tianqin" | "lisa" | "taiji" | "lpf" | "tianqin-1"
+    defaults                      # one of DEFAULTS: "published" (default) | "v0.3" (the constellation missions'
+                                  # preset of default values: tqdyn.closedloop.missions)
     scheme                        # one of SCHEMES (default: the mission's, MISSION_SCHEME)
     fs                            # Hz, time-domain sample rate
     duration                      # time-domain length ("3d" or s; default: the first day, or the run's span)
@@ -44,8 +46,8 @@ from ..numerics.finite import finite_number
 from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _require, _require_choice, _unknown_key
 
-__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "COLLINEAR_LOOPS", "CONSTELLATION_MISSIONS", "DEFAULT_SERIES_S",
-           "DESIGNS",
+__all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "COLLINEAR_LOOPS", "CONSTELLATION_MISSIONS", "DEFAULTS",
+           "DEFAULT_SERIES_S", "DESIGNS",
            "LOOPS", "MISSIONS", "MISSION_SCHEME", "PLANT_KEYS", "SCHEMES", "SCHEME_LOOPS", "SINGLE_SPACECRAFT_MISSIONS",
            "SINGLE_TM_LOOPS", "SOURCES", "ClosedLoopConfig", "check_asd", "check_controller"]
 
@@ -124,18 +126,24 @@ ATTITUDE_Z_SENSORS = ("dws", "star_tracker")
 #: "hinf" (an H-infinity mixed-sensitivity controller over each spacecraft's whole plant, tqdyn.closedloop.hinf;
 #: the "constellation" scheme).
 DESIGNS = ("per_loop", "hinf")
+#: Presets of the constellation missions' default values (``closed_loop.defaults``): "published" replaces version
+#: 0.3's values where a published design or flight paper gives one (tqdyn.closedloop.published, cited in
+#: SOURCES.md), "v0.3" keeps version 0.3's lead-lag design and assumed values.  The first is the default.
+DEFAULTS = ("published", "v0.3")
 
 #: Length [s] of the time series when ``duration`` is not given: the run's first day (its span if shorter).
 DEFAULT_SERIES_S = 86400.0
 #: Top-level keys of [closed_loop]: name -> (kind, default).  Defaults: ``mission`` None = the spacecraft
 #: architecture; ``scheme`` None = the mission's (:data:`MISSION_SCHEME`); ``fs`` [Hz]; ``duration`` [s] None =
 #: :data:`DEFAULT_SERIES_S` or the run's span if shorter; ``segment`` [s]; ``f_min``, ``f_max``
-#: [Hz] and ``n_freq`` the budget's log grid; ``attitude_z_sensor`` one of :data:`ATTITUDE_Z_SENSORS`.
+#: [Hz] and ``n_freq`` the budget's log grid; ``attitude_z_sensor`` one of :data:`ATTITUDE_Z_SENSORS`;
+#: ``defaults`` one of :data:`DEFAULTS`.
 CLOSED_LOOP_KEYS = {"mission": ("string", None), "scheme": ("string", None), "fs": ("number", 4.0),
                     "duration": ("duration", None), "seed": ("integer", 0), "segment": ("duration", 86400.0),
                     "f_min": ("number", 1e-5), "f_max": ("number", 1.0), "n_freq": ("integer", 300),
-                    "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0]), "design": ("string", DESIGNS[0]),
-                    "hinf_peak_sensitivity": ("number", 2.0), "hinf_authority_ratio": ("number", 30.0)}
+                    "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0]), "defaults": ("string", DEFAULTS[0]),
+                    "design": ("string", DESIGNS[0]), "hinf_peak_sensitivity": ("number", 2.0),
+                    "hinf_authority_ratio": ("number", 30.0)}
 #: Keys of [closed_loop.plant]: name -> number of values (1: a number).
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1, "tm2_stiffness": 3,
@@ -175,6 +183,8 @@ class ClosedLoopConfig:
                 _require(_num(v) and float(v) > 1, name, v, "is not allowed", "a peak sensitivity > 1")
             elif key == "hinf_authority_ratio":
                 _require(_num(v) and float(v) > 0, name, v, "is not allowed", "a bandwidth ratio > 0")
+            elif key == "defaults":
+                _require_choice(v, name, DEFAULTS, problem="is not a defaults preset")
             elif key in ("fs", "f_min", "f_max"):
                 _require(_num(v) and float(v) > 0, name, v, "is not a positive number", "a frequency > 0 Hz")
             elif key in ("seed", "n_freq"):
@@ -261,7 +271,7 @@ class ClosedLoopConfig:
     def settings(self) -> dict:
         """The top-level settings but ``mission`` with the defaults of :data:`CLOSED_LOOP_KEYS` filled in:
         fs [Hz], duration [s] (None: the run's span), seed, segment [s], f_min, f_max [Hz], n_freq,
-        attitude_z_sensor; numbers as float, integers as int."""
+        attitude_z_sensor, defaults; numbers as float, integers as int."""
         cast = {"number": float, "integer": int, "duration": float, "string": str}
         out = {}
         for key, (kind, default) in CLOSED_LOOP_KEYS.items():
