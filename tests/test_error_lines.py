@@ -124,6 +124,7 @@ OVERRIDES = [
     ("scenario.central_body=eart", "scenario.central_body", "earth"),
     ("closed_loop.mission=lisaa", "closed_loop.mission", "lisa"),
     ("closed_loop.attitude_z_sensor=dw", "closed_loop.attitude_z_sensor", "dws"),
+    ("closed_loop.design=hnf", "closed_loop.design", "hinf"),
     ("closed_loop.defaults=publishd", "closed_loop.defaults", "published"),
 ]
 

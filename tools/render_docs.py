@@ -9,13 +9,14 @@ The records (docs/numbers.md): ``docs/data/bench.json`` (``tqdyn bench
 (the ``summary.json`` of ``tqdyn report --studies [--mission lisa]``),
 ``docs/data/closed-loop.json`` (the ``summary.json`` of ``tqdyn report --closed-loop``),
 ``docs/data/od-study.json`` (``python tools/od_study.py``),
-``docs/data/od-residuals.json`` (``python tools/od_residuals.py``) and
+``docs/data/od-residuals.json`` (``python tools/od_residuals.py``),
+``docs/data/closed-loop-hinf.json`` (``python tools/closed_loop_hinf.py``) and
 ``docs/data/tests.json`` (``pytest --record-numbers``).
 
 Markers in the markdown (HTML comments: GitHub shows the value, not the marker):
 
 * a value: ``<!--n:SOURCE:PATH|FORMAT-->1.54<!--/n-->``.  SOURCE is ``bench``,
-  ``tianqin``, ``lisa``, ``closedloop``, ``odstudy``, ``odresiduals`` or ``tests``; PATH is a ``/``-separated path into the
+  ``tianqin``, ``lisa``, ``closedloop``, ``odstudy``, ``odresiduals``, ``hinf`` or ``tests``; PATH is a ``/``-separated path into the
   record (``bench``: MODEL/... looked up in the model's ``result``, then in the
   entry itself: ``kepler/runs/tqdyn dd/wall_s``, ``kepler/date``; ``tests``:
   the key, its ``value``; the studies: from the record's top:
@@ -55,7 +56,7 @@ ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data"
 SOURCES = {"bench": "bench.json", "tianqin": "studies-tianqin.json", "lisa": "studies-lisa.json",
            "tests": "tests.json", "closedloop": "closed-loop.json", "odstudy": "od-study.json",
-           "odresiduals": "od-residuals.json"}
+           "odresiduals": "od-residuals.json", "hinf": "closed-loop-hinf.json"}
 
 INLINE = re.compile(r"<!--n:(?P<src>[a-z]+):(?P<path>[^|>]*?)(?:\|(?P<fmt>[^>]*?))?-->(?P<text>.*?)<!--/n-->",
                     re.S)

@@ -22,7 +22,8 @@ __all__ = ["bench", "MODELS", "ALL_MODELS"]
 
 #: Every model, in the order they run.
 MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels", "default-run", "startup", "tianqin-5y",
-          "tianqin-5y-multistep", "lisa-10y", "closed-loop", "closed-loop-budget-90d", "closed-loop-budget-lisa-1y")
+          "tianqin-5y-multistep", "lisa-10y", "closed-loop", "closed-loop-budget-90d", "closed-loop-budget-lisa-1y",
+          "od-coupled-30d")
 #: What ``--model all`` runs (the mission-length commands are asked for by name).
 ALL_MODELS = ("kepler", "full", "coupled", "lisa", "lisa-coupled", "kernels")
 
@@ -51,7 +52,7 @@ def _check_json_path(path) -> Path:
               help="Propagated span [default: 90d; lisa: 3652.5d = 10 years; lisa-coupled: 365d; rounded up to "
                    "whole 6 h steps; default-run: the scenario's 10 d; tianqin-5y(-multistep): 1826d; lisa-10y: 3653d; "
                    "closed-loop: the time series, 3d; closed-loop-budget-90d: 90d; closed-loop-budget-lisa-1y: "
-                   "365d].")
+                   "365d; od-coupled-30d: 30d].")
 @click.option("--step", default="50", show_default=True, help="Step / output grid [s] of the kepler model.")
 @click.option("--no-heyoka", is_flag=True, help="Skip the heyoka real128 peer even if installed.")
 @click.option("--model", "which", type=Choice(MODELS + ("all",), doc="docs/commands.md#tqdyn-bench"), multiple=True,
@@ -67,7 +68,9 @@ def _check_json_path(path) -> Path:
                    "lisa` for ten years; closed-loop: the closed-loop time series of 3 TianQin spacecraft, "
                    "3 days at 4 Hz, streamed to a file; closed-loop-budget-90d / closed-loop-budget-lisa-1y: "
                    "tqdyn closed-loop's model, budget and file of a 90-day TianQin / one-year LISA run (made "
-                   "first, not timed), time and peak memory; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
+                   "first, not timed), time and peak memory; od-coupled-30d: a 30-day coupled TianQin recovery (GNSS + SLR + "
+                   "ISR) fitted with the variational equations and with central differences, against the 30-day "
+                   "run; all: " + ", ".join(ALL_MODELS) + " [default]. Repeatable.")
 @click.option("--json", "json_path", metavar="PATH",
               help="Also write the results to this JSON record: the entries of the models run are replaced, "
                    "the others kept (docs/numbers.md).")
@@ -84,6 +87,7 @@ def bench(duration, step, no_heyoka, which, json_path):
     from ..workflows import bench_closed_loop as _closed_loop
     from ..workflows import bench_kernels as _kernels
     from ..workflows import bench_mission as _mission
+    from ..workflows import bench_od as _od
     from ..workflows import numbers as _numbers
 
     chosen = set()
@@ -123,6 +127,7 @@ def bench(duration, step, no_heyoka, which, json_path):
     for name in _closed_loop.BUDGET_RUNS:
         runners[name] = lambda name=name: (_closed_loop.closed_loop_budget_benchmark(name, duration),
                                            _closed_loop.format_budget_report)
+    runners["od-coupled-30d"] = lambda: (_od.od_coupled_benchmark(duration), _od.format_od_coupled_report)
     runners["startup"] = lambda: (_mission.startup_benchmark(duration), _mission.format_startup_report)
     for name in _mission.MISSION_RUNS:
         runners[name] = lambda name=name: (_mission.mission_benchmark(name, duration), _mission.format_mission_report)

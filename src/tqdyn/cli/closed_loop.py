@@ -58,8 +58,16 @@ class _Bars:
                    "--set closed_loop.noise.thruster_force.level=1e-7 (repeatable; docs/scenarios.md).")
 @click.option("--per-source", is_flag=True, help="Also write the ASD of every output from every noise source "
                                                 "(/budget/asd; the totals and dominant sources are always written).")
+@click.option("--monte-carlo", "monte_carlo", type=int, metavar="N",
+              help="With --mission: instead of the budget and series, N draws of the plant's uncertain parameters "
+                   "evaluated with both designs (per_loop, hinf); writes a netCDF dataset (docs/closed-loop.md).")
+@click.option("--scheduler", metavar="ADDRESS", help="With --monte-carlo: a Dask scheduler to run the draws on "
+                                                     "[default: a local cluster].")
+@click.option("--workers", type=int, help="With --monte-carlo: the local cluster's workers [default: the usable "
+                                          "cores]; 0: in this process.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bars.")
-def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source, quiet):
+def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source, quiet, monte_carlo=None,
+                scheduler=None, workers=None):
     """The closed loop of the coupled run RUN.h5 (any mission), or of a mission's static working point
     (--mission, e.g. lpf or tianqin-1): the drag-free, suspension, attitude and MOSA loops linearised
     around the working point (docs/closed-loop.md), their noise budget, margins and dominant sources,
@@ -70,6 +78,9 @@ def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source,
     from ..formats import trajectory as io
     from ..workflows import closed_loop as wf
 
+    if monte_carlo is not None or scheduler is not None or workers is not None:
+        _monte_carlo(run_file, mission, output, monte_carlo, seed, sets, scheduler, workers, quiet)
+        return
     with guarded(bad_input=(ValueError, FileNotFoundError, io.OutputError)):
         job = wf.check_closed_loop_inputs(run_file, output, duration=duration, fs=fs, seed=seed, overrides=sets,
                                           per_source=per_source, mission=mission)
@@ -88,3 +99,35 @@ def closed_loop(run_file, mission, output, duration, fs, seed, sets, per_source,
     click.echo(f"budget: {summary.budget_s:.2f} s; time series: {summary.n_samples} samples x {summary.n_sat} "
                f"spacecraft in {summary.timeseries_s:.2f} s")
     click.echo(f"output: {summary.path} ({summary.size_bytes / 1e6:.1f} MB)")
+
+
+def _monte_carlo(run_file, mission, output, n, seed, sets, scheduler, workers, quiet) -> None:
+    """``--monte-carlo N``: the robustness Monte Carlo (:mod:`tqdyn.workflows.closed_loop_mc`) to a netCDF file."""
+    from tqdm import tqdm
+
+    from ..formats import trajectory as io
+    from ..formats.atomic import check_output
+    from ..formats.netcdf import write_netcdf
+    from ..workflows import closed_loop_mc as mc
+
+    with guarded(bad_input=(ValueError, io.OutputError)):
+        if n is None:
+            raise ValueError("--scheduler/--workers: only with --monte-carlo N; allowed: tqdyn closed-loop --mission "
+                             "NAME --monte-carlo N [--scheduler ADDRESS | --workers N] --output MC.nc")
+        if run_file is not None:
+            raise ValueError("RUN.h5: not with --monte-carlo; allowed: --mission NAME (the static working point)")
+        mc.check_monte_carlo(mission, n, sets, workers)
+        out = check_output(output, "--output", {})
+    click.echo(f"tqdyn closed-loop: Monte Carlo of {mission}, {n} draws x 2 designs (per_loop, hinf), seed "
+               f"{seed or 0}, on {scheduler or ('this process' if workers == 0 else 'a local cluster')}", err=True)
+    bar = tqdm(total=2 * n, disable=True if quiet else None, unit="draw", file=sys.stderr, dynamic_ncols=True,
+               desc="monte carlo")
+    with guarded(bad_input=(ValueError, io.OutputError), cleanup=bar.close):
+        ds = mc.monte_carlo(mission, n, seed or 0, sets, scheduler, workers, progress=bar.update)
+        bar.close()
+        path = write_netcdf(ds, out)
+    for d, row in mc.summarise(ds).items():
+        r = row["requirement_ratio"]
+        ratio = "no stable draw" if r is None else f"{r['median']:.3g} [{r['p05']:.3g}, {r['p95']:.3g}]"
+        click.echo(f"{d}: stable {row['stable_fraction']:.0%}, requirement ratio median [5 %, 95 %] {ratio}")
+    click.echo(f"output: {path}")

@@ -12,8 +12,10 @@ margins), :mod:`~tqdyn.closedloop.simulate` (time domain), :mod:`~tqdyn.closedlo
 the time series realise the budget), :mod:`~tqdyn.closedloop.one_dof` (the
 one-axis reference loop), :mod:`~tqdyn.closedloop.schemes` (the single-spacecraft control schemes),
 :mod:`~tqdyn.closedloop.flown` (LISA Pathfinder and TianQin-1 as configurations, their static working
-points) and :mod:`~tqdyn.closedloop.flight_observables` (Delta g, the six-DOF stability, the measured
-residual acceleration).  The loop and noise-source tables are the scenario's
+points), :mod:`~tqdyn.closedloop.flight_observables` (Delta g, the six-DOF stability, the measured
+residual acceleration), :mod:`~tqdyn.closedloop.hinf` (the H-infinity design over a spacecraft's whole
+plant, ``closed_loop.design = "hinf"``) and :mod:`~tqdyn.closedloop.robust` (a design's robustness over the
+plant's uncertain parameters).  The loop and noise-source tables are the scenario's
 (:data:`tqdyn.scenario.closed_loop.LOOPS`, :data:`tqdyn.scenario.closed_loop.SOURCES`).
 
 The public names below are imported from their modules on first use (python-control is slow to
@@ -39,6 +41,7 @@ _HOME = {
     "representative_plant": "missions", "representative_working_point": "missions", "requirement": "missions",
     "working_points": "working_point",
     "series_psd": "synthesis",
+    "HinfController": "hinf", "synthesise": "hinf", "UNCERTAINTY": "robust",
 }
 
 __all__ = sorted(_HOME)

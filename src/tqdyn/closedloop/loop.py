@@ -339,25 +339,36 @@ def loop_blocks(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = A
 
 
 def build_closed_loop(p: PlantParameters, wp: WorkingPoint, controllers: dict,
-                      attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0], scheme: str = "constellation") -> ClosedLoop:
+                      attitude_z_sensor: str = ATTITUDE_Z_SENSORS[0], scheme: str = "constellation",
+                      actuator_gain: dict | None = None) -> ClosedLoop:
     """The closed loop (module docstring) of a spacecraft with parameters ``p`` at working point ``wp``
-    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of the ``scheme``
+    with one :class:`~tqdyn.closedloop.controllers.Controller` per loop of the ``scheme`` (or ``controllers`` a
+    multivariable controller with a ``system`` e_* -> c_*, :class:`tqdyn.closedloop.hinf.HinfController`)
     (:data:`tqdyn.scenario.closed_loop.SCHEME_LOOPS`: "constellation" (default, :data:`LOOPS`), "collinear",
     "single_tm"; :mod:`tqdyn.closedloop.schemes`).  ``attitude_z_sensor`` ("constellation" only): "dws" (the
     mean DWS yaw minus the mean MOSA encoder angle, default) or "star_tracker".  The blocks
     (:func:`loop_blocks`) are joined by signal name with python-control's check of unused signals on (a
     misnamed signal would leave one unconnected).  ValueError (one line naming the key) for a geometry the
     scheme cannot control.  :func:`tqdyn.closedloop.frequency.closed_loops` builds the same loops for many
-    working points at once."""
+    working points at once.  ``actuator_gain`` {plant input (``F[i]``, ``T[i]``, ``f1[i]``, ``t2[i]``, ``tm[l]``):
+    factor}: the actuators' true gains (1: as the controllers assume; a Monte Carlo's draws) on the commands."""
     b = loop_blocks(p, wp, attitude_z_sensor, scheme)
+    if actuator_gain:
+        Da, ain, aout = b["actuators"]
+        cols = [k for k, s in enumerate(ain) if s.startswith(("c_", "d_"))]
+        Da = Da.copy()
+        for name, g in actuator_gain.items():
+            Da[aout.index(name), cols] *= g
+        b["actuators"] = (Da, ain, aout)
     A, B, C, D, pin, pout, pst = b["plant"]
     P = control.ss(A, B, C, D, inputs=pin, outputs=pout, states=pst, name="plant")
     chans = b["channels"]
     noise = [s for src in SOURCES for s in source_inputs(src)]
     inplist = noise + [f"d_{c}" for c in chans]
     outlist = output_names() + [f"c_{c}" for c in chans] + [f"e_{c}" for c in chans]
-    syslist = ([P, _static(*b["sensors"], "sensors"), _static(*b["actuators"], "actuators"),
-                _static(*b["observables"], "observables")] + _controllers_ss(controllers, _scheme_loops(scheme)))
+    ctl = [controllers.system] if hasattr(controllers, "system") else _controllers_ss(controllers, _scheme_loops(scheme))
+    syslist = [P, _static(*b["sensors"], "sensors"), _static(*b["actuators"], "actuators"),
+               _static(*b["observables"], "observables")] + ctl
     cl = control.interconnect(syslist, inplist=inplist, outlist=outlist, inputs=inplist, outputs=outlist,
                               name="closed_loop", warn_duplicate=False)
     return ClosedLoop(system=cl, channel_names=tuple(chans), dc_force=b["dc_force"])

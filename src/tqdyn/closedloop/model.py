@@ -50,7 +50,9 @@ class ClosedLoopModel:
     WorkingPoint) the loops were built from; controllers : {loop: Controller} (to rebuild a loop with
     changed parameters, e.g. without cross-talk); stack : the loops' blocks
     (:class:`tqdyn.closedloop.frequency.LoopStack`, satellite-major: loop ``loops[i][k]`` is entry
-    i n_segment + k) for the frequency domain, or None.
+    i n_segment + k) for the frequency domain, or None.  hinf : with ``closed_loop.design = "hinf"``, one
+    :class:`tqdyn.closedloop.hinf.HinfController` per satellite (synthesised at its first segment's working
+    point, used in all its segments; ``controllers`` then holds the per-loop design it replaces), else ().
     """
 
     loops: list
@@ -62,6 +64,7 @@ class ClosedLoopModel:
     parts: list = field(default_factory=list)
     controllers: dict = field(default_factory=dict)
     stack: object = None
+    hinf: tuple = ()
 
 
 def _where(traj) -> str:
@@ -142,8 +145,22 @@ def _assemble(parts, controllers: dict, attitude_z_sensor: str, scheme: str, val
     return cls, st
 
 
+def _hinf_loops(parts, settings: dict, validate: bool, names=()) -> tuple[list, tuple]:
+    """(closed loops, controllers) of the (PlantParameters, WorkingPoint) ``parts`` (a list per satellite of
+    one per segment) under the "hinf" design: one synthesis per satellite (its first segment), every segment's
+    loop built with it (checked stable with ``validate``)."""
+    from .hinf import synthesise
+
+    attitude_z_sensor, scheme = settings["attitude_z_sensor"], settings["scheme"]
+    ks = tuple(synthesise(*per_sat[0], attitude_z_sensor, scheme, names[i] if i < len(names) else f"Sat{i + 1}",
+                          settings["hinf_peak_sensitivity"], settings["hinf_authority_ratio"])
+               for i, per_sat in enumerate(parts))
+    cls = [_build(p, wp, k, attitude_z_sensor, scheme, validate) for k, per_sat in zip(ks, parts) for p, wp in per_sat]
+    return cls, ks
+
+
 def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_sensor: str, validate: bool,
-           scheme: str = "constellation"):
+           scheme: str = "constellation", settings: dict | None = None, names=()):
     """(loops, parts, stack) of :class:`ClosedLoopModel` from the working points ``wps`` of the segments
     ``rows`` (:func:`_assemble`)."""
     n_sat, n_seg = len(wps[0]), len(rows)
@@ -152,10 +169,14 @@ def _loops(t, rows, wps, plant: dict, craft, controllers: dict, attitude_z_senso
         for i in range(n_sat):
             wp = wps[k][i]
             parts[i].append((plant_parameters(plant, craft, wp.theta), wp))
-    cls, st = _assemble([pw for per_sat in parts for pw in per_sat], controllers, attitude_z_sensor, scheme,
-                        validate)
+    ks = ()
+    if settings is not None and settings["design"] == "hinf":
+        (cls, ks), st = _hinf_loops(parts, settings, validate, names), None
+    else:
+        cls, st = _assemble([pw for per_sat in parts for pw in per_sat], controllers, attitude_z_sensor, scheme,
+                            validate)
     loops = [[(float(t[rows[k][0]]), cls[i * n_seg + k]) for k in range(n_seg)] for i in range(n_sat)]
-    return loops, parts, st
+    return loops, parts, st, ks
 
 
 def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopModel:
@@ -190,12 +211,14 @@ def closed_loop_model(traj, config=None, validate: bool = True) -> ClosedLoopMod
     wps = working_points(t[mids], traj["sat/r"][mids], traj["sat/T_S_I"][mids], traj["sat/omega"][mids],
                          traj["sat/omega_dot"][mids], traj["mosa/angle"][mids], traj["tm/a_suspension"][mids],
                          traj["tm/alpha_suspension"][mids], traj["sat/a_dragfree"][mids], sg, central_gm, pos, gms)
-    loops, parts, stack = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl, settings["attitude_z_sensor"],
-                                 validate, cfg.scheme(traj.spacecraft.architecture))
-    names = tuple(getattr(traj, "satellite_names", ())) or tuple(f"Sat{i + 1}" for i in range(len(loops)))
+    names = tuple(getattr(traj, "satellite_names", ()))
+    loops, parts, stack, ks = _loops(t, rows, wps, plant, _craft(traj.spacecraft), ctl,
+                                     settings["attitude_z_sensor"], validate, cfg.scheme(traj.spacecraft.architecture),
+                                     settings, names)
+    names = names or tuple(f"Sat{i + 1}" for i in range(len(loops)))
     return ClosedLoopModel(loops=loops, noise=noise, mission=mission, settings=settings,
                            satellite_names=names, t_span=(float(t[0]), float(t[-1])), parts=parts,
-                           controllers=dict(ctl), stack=stack)
+                           controllers=dict(ctl), stack=stack, hinf=ks)
 
 
 def static_closed_loop_model(config=None, validate: bool = True) -> ClosedLoopModel:
@@ -224,8 +247,12 @@ def static_closed_loop_model(config=None, validate: bool = True) -> ClosedLoopMo
         raise ClosedLoopError(str(exc)) from None
     p = representative_plant(mission, **plant)
     wp = representative_working_point(mission)
-    (cl,), stack = _assemble([(p, wp)], ctl, settings["attitude_z_sensor"], settings["scheme"], validate)
+    ks = ()
+    if settings["design"] == "hinf":
+        ((cl,), ks), stack = _hinf_loops([[(p, wp)]], settings, validate, (mission,)), None
+    else:
+        (cl,), stack = _assemble([(p, wp)], ctl, settings["attitude_z_sensor"], settings["scheme"], validate)
     span = float(settings["duration"] or settings["segment"])
     return ClosedLoopModel(loops=[[(0.0, cl)]], noise=noise, mission=mission, settings=settings,
                            satellite_names=(mission,), t_span=(0.0, span), parts=[[(p, wp)]], controllers=dict(ctl),
-                           stack=stack)
+                           stack=stack, hinf=ks)

@@ -1,5 +1,6 @@
 """Partials of coupled runs (attitude, test masses, drag-free and suspension control) for orbit
-determination, by central differences of double-double propagations.
+determination: by the coupled variational equations (:mod:`.coupled_variational`, the default) or
+by central differences of double-double propagations (the reference, below).
 
 Parameters of a coupled run, per satellite (:func:`parameter_names`, column order of
 ``sensitivities_full``): the initial state x, y, z [m], vx, vy, vz [m/s] at the epoch (the run's
@@ -7,8 +8,9 @@ frame) and ``sgc_x``, ``sgc_y``, ``sgc_z`` [m/s^2 in the satellite frame S]: the
 ``spacecraft.self_gravity_common``, the DC acceleration common to both test masses of the
 satellite, which the drag-free control hands on to the orbit.
 
-Model.  The partials are those of the full coupled dynamics of :func:`tqdyn.dynamics.propagate`
-(the scenario's force model, attitude, test masses and control, nothing linearised):
+Central differences.  The partials are those of the full coupled dynamics of
+:func:`tqdyn.dynamics.propagate` (the scenario's force model, attitude, test masses and control,
+nothing linearised):
 
     d y(t) / d p_j = (y(t; p + h_j e_j) - y(t; p - h_j e_j)) / (2 h_j),
 
@@ -23,20 +25,30 @@ largest multiple of the run's step dividing the time tags, at most 600 s geocent
 states the run's own step.
 
 Cost: 2 runs per parameter (18 state + 9 self-gravity columns for three satellites: 54 runs per
-evaluation of the Jacobian, each the length of the arc).
+evaluation of the Jacobian, each the length of the arc); the variational equations take one run
+and 46 evaluations of the right-hand side per Jacobian node.  The two agree to ~1e-9 of each
+column's largest value over 10 days (tests/test_od_coupled.py).
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+
 import numpy as np
 
+from . import coupled_variational
 from .parameters import OrbitParameters, per_satellite_names, scenario_with
 from .tracking import fail
 from .variational import Partials, propagate_dd
 
-__all__ = ["COMMON_NAMES", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario",
+__all__ = ["COMMON_NAMES", "METHODS", "STEP_COMMON", "STEP_POSITION", "STEP_VELOCITY", "check_scenario", "method",
            "nominal_common", "parameter_names", "propagate_with_partials"]
 
+#: Methods of the partials: the coupled variational equations (:mod:`.coupled_variational`) or
+#: central differences of dd runs.
+METHODS = ("variational", "differences")
+_METHOD = contextvars.ContextVar("coupled_partials_method", default="variational")
 #: Names of the per-satellite common self-gravity parameters [m/s^2 in S].
 COMMON_NAMES = ("sgc_x", "sgc_y", "sgc_z")
 #: Central-difference steps: initial position [m], velocity [m/s], common self-gravity [m/s^2].
@@ -72,16 +84,45 @@ def _runs(scen, par: OrbitParameters, t, step: float):
     return propagate_dd(scenario_with(scen, step_s=step), par, t)[1]
 
 
+@contextlib.contextmanager
+def method(name: str):
+    """Within the ``with`` block, the partials of coupled runs that name no method (those of
+    :mod:`tqdyn.od.problem`'s fits, covariances and computed measurements) are made by
+    ``name``, one of :data:`METHODS`::
+
+        with coupled.method("differences"):
+            est = problem.fit("tianqin", meas, tracking)
+    """
+    if name not in METHODS:
+        fail(f"method: {name!r}; allowed: {', '.join(METHODS)}")
+    token = _METHOD.set(name)
+    try:
+        yield
+    finally:
+        _METHOD.reset(token)
+
+
 def propagate_with_partials(scen, parameters: OrbitParameters | None, t_out, step: float | None = None,
-                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON)) -> Partials:
-    """States at t_out [s since the epoch] (dd run with the run's step) and their partials by
-    central differences (module docstring) of runs with ``step`` [s] (None: the run's): a
-    :class:`~tqdyn.od.variational.Partials` whose ``sensitivities`` (n, n_sat, 6, 3) and
-    ``sensitivities_full`` (n, 6 n_sat, 3 n_sat) are with respect to the common self-gravity
-    [s^2, s], ``parameter_names`` :data:`COMMON_NAMES`.  steps: the difference steps (position
-    [m], velocity [m/s], common self-gravity [m/s^2])."""
+                            steps=(STEP_POSITION, STEP_VELOCITY, STEP_COMMON), method: str | None = None,
+                            node_step: float | None = None) -> Partials:
+    """States at t_out [s since the epoch] (dd run with the run's step) and their partials,
+    integrated with ``step`` [s] (None: the run's): a :class:`~tqdyn.od.variational.Partials`
+    whose ``sensitivities`` (n, n_sat, 6, 3) and ``sensitivities_full`` (n, 6 n_sat, 3 n_sat)
+    are with respect to the common self-gravity [s^2, s], ``parameter_names`` :data:`COMMON_NAMES`.
+
+    method: ``"variational"``: the coupled variational equations of :mod:`.coupled_variational`
+    (Jacobians at nodes every ``node_step`` [s]); ``"differences"``: central differences of dd
+    runs (module docstring), steps the difference steps (position [m], velocity [m/s], common
+    self-gravity [m/s^2]); None: that of the enclosing :func:`method` block, else
+    ``"variational"``."""
+    method = _METHOD.get() if method is None else method
+    if method not in METHODS:
+        fail(f"method: {method!r}; allowed: {', '.join(METHODS)}")
     check_scenario(scen)
     par = parameters or OrbitParameters()
+    if method == "variational":
+        sg = nominal_common(scen) if par.self_gravity_common is None else par.self_gravity_common
+        return coupled_variational.propagate_with_partials(scen, par, sg, t_out, COMMON_NAMES, step, node_step)
     t, y_dd = propagate_dd(scen, par, t_out)
     n_sat = y_dd.shape[1]
     h = float(scen.integrator.step_s) if step is None else float(step)

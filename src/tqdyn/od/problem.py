@@ -42,7 +42,8 @@ are those of the projected measurements.
 Coupled runs (``constellation.pointing`` set: attitude, test masses, drag-free and suspension
 control): the parameters are the initial states and the common self-gravity of each satellite's
 test masses (group ``"self_gravity_common"``, ``spacecraft.self_gravity_common`` [m/s^2 in S]),
-with partials by central differences of dd runs of the full coupled dynamics (:mod:`.coupled`);
+with partials by the variational equations of the full coupled dynamics (:mod:`.coupled`,
+:mod:`.coupled_variational`; central differences of dd runs inside ``with coupled.method("differences")``);
 the point-mass acceleration groups are refused there, and ``"self_gravity_common"`` on
 point-mass runs.
 
@@ -276,8 +277,8 @@ def _compute(scen, tracking, parameters, meas):
 
 
 def _partials(scen, parameters, t) -> Partials:
-    """States and partials at t [s]: the variational equations (point-mass runs) or central
-    differences of dd runs (coupled runs, :mod:`.coupled`)."""
+    """States and partials at t [s]: the variational equations of point-mass runs or of coupled
+    runs (:mod:`.coupled`: or central differences of dd runs, :func:`.coupled.method`)."""
     prop = coupled.propagate_with_partials if _coupled(scen) else propagate_with_partials
     return prop(scen, parameters, t, step=_partials_step(scen, t))
 

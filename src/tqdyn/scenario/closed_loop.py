@@ -16,6 +16,9 @@ run's ``spacecraft.architecture``, and the settings' defaults of :data:`CLOSED_L
     segment                       # frozen-coefficient segment length ("1d" or s)
     f_min, f_max, n_freq          # the budget's log frequency grid [Hz]
     attitude_z_sensor             # one of ATTITUDE_Z_SENSORS
+    design                        # one of DESIGNS: "per_loop" (default) | "hinf"
+    hinf_peak_sensitivity         # "hinf": the weights' peak sensitivity M_s (> 1; default 2)
+    hinf_authority_ratio          # "hinf": the actuators' bandwidth ratio r (> 0; default 30)
     [closed_loop.plant]           # sc_mass [kg], sc_inertia [kg m^2] (3), tm_mass [kg], tm_side [m],
                                   # mosa_inertia [kg m^2], mosa_stiffness [N m/rad], stiffness [s^-2] (3),
                                   # rotational_stiffness [s^-2] (3), crosstalk [1], tm2_stiffness,
@@ -44,7 +47,7 @@ from .toml_text import toml_str, toml_value
 from .values import ScenarioError, _require, _require_choice, _unknown_key
 
 __all__ = ["ATTITUDE_Z_SENSORS", "CLOSED_LOOP_KEYS", "COLLINEAR_LOOPS", "CONSTELLATION_MISSIONS", "DEFAULTS",
-           "DEFAULT_SERIES_S",
+           "DEFAULT_SERIES_S", "DESIGNS",
            "LOOPS", "MISSIONS", "MISSION_SCHEME", "PLANT_KEYS", "SCHEMES", "SCHEME_LOOPS", "SINGLE_SPACECRAFT_MISSIONS",
            "SINGLE_TM_LOOPS", "SOURCES", "ClosedLoopConfig", "check_asd", "check_controller"]
 
@@ -119,6 +122,10 @@ SOURCES = {
 #: the star tracker (as LISA Pathfinder, which had no DWS).
 ATTITUDE_Z_SENSORS = ("dws", "star_tracker")
 
+#: Controller designs: "per_loop" (one controller per channel: the mission's or [closed_loop.controllers]) and
+#: "hinf" (an H-infinity mixed-sensitivity controller over each spacecraft's whole plant, tqdyn.closedloop.hinf;
+#: the "constellation" scheme).
+DESIGNS = ("per_loop", "hinf")
 #: Presets of the constellation missions' default values (``closed_loop.defaults``): "published" replaces version
 #: 0.3's values where a published design or flight paper gives one (tqdyn.closedloop.published, cited in
 #: SOURCES.md), "v0.3" keeps version 0.3's lead-lag design and assumed values.  The first is the default.
@@ -134,7 +141,9 @@ DEFAULT_SERIES_S = 86400.0
 CLOSED_LOOP_KEYS = {"mission": ("string", None), "scheme": ("string", None), "fs": ("number", 4.0),
                     "duration": ("duration", None), "seed": ("integer", 0), "segment": ("duration", 86400.0),
                     "f_min": ("number", 1e-5), "f_max": ("number", 1.0), "n_freq": ("integer", 300),
-                    "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0]), "defaults": ("string", DEFAULTS[0])}
+                    "attitude_z_sensor": ("string", ATTITUDE_Z_SENSORS[0]), "defaults": ("string", DEFAULTS[0]),
+                    "design": ("string", DESIGNS[0]), "hinf_peak_sensitivity": ("number", 2.0),
+                    "hinf_authority_ratio": ("number", 30.0)}
 #: Keys of [closed_loop.plant]: name -> number of values (1: a number).
 PLANT_KEYS = {"sc_mass": 1, "sc_inertia": 3, "tm_mass": 1, "tm_side": 1, "mosa_inertia": 1, "mosa_stiffness": 1,
               "stiffness": 3, "rotational_stiffness": 3, "crosstalk": 1, "tm2_stiffness": 3,
@@ -168,6 +177,12 @@ class ClosedLoopConfig:
                 _require_choice(v, name, SCHEMES, problem="is not a control scheme")
             elif key == "attitude_z_sensor":
                 _require_choice(v, name, ATTITUDE_Z_SENSORS, problem="is not a sensor")
+            elif key == "design":
+                _require_choice(v, name, DESIGNS, problem="is not a controller design")
+            elif key == "hinf_peak_sensitivity":
+                _require(_num(v) and float(v) > 1, name, v, "is not allowed", "a peak sensitivity > 1")
+            elif key == "hinf_authority_ratio":
+                _require(_num(v) and float(v) > 0, name, v, "is not allowed", "a bandwidth ratio > 0")
             elif key == "defaults":
                 _require_choice(v, name, DEFAULTS, problem="is not a defaults preset")
             elif key in ("fs", "f_min", "f_max"):
