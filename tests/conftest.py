@@ -209,7 +209,8 @@ def pytest_sessionfinish(session, exitstatus):
                           "test": f"{name} in the default suite", "machine": where}
     if not store:
         return
-    entries = {k: {**v, "date": prov["date"], "tqdyn_version": prov["tqdyn_version"]} for k, v in store.items()}
+    entries = {k: {**v, "date": prov["date"], "tqdyn_version": prov["tqdyn_version"],
+                   "tqdyn_commit": prov["tqdyn_commit"]} for k, v in store.items()}
     merge_section(path, "numbers", entries, {**prov, "description": "numbers measured by the tests (record_number "
                                                                    "in tests/), one entry per key with its test"})
 

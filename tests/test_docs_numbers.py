@@ -38,8 +38,9 @@ def test_page_numbers_match_their_records(page, records):
     assert rendered == text, f"{page}: differs from its rendering (python tools/render_docs.py)"
 
 
-def test_records_have_provenance(records):
+def test_records_have_provenance():
     """Each record says what wrote it, and each speed number carries the machine and the date."""
+    records = rd.load_records(check=False)
     for name in ("bench", "tianqin", "lisa", "tests"):
         assert records[name], f"docs/data/{rd.SOURCES[name]} is missing (tools/refresh_numbers.sh)"
         assert records[name].get("written_by"), name
@@ -114,3 +115,23 @@ def test_the_guard_sees_typed_numbers():
     found = _typed_speed_numbers("x.md", text)
     assert [f.split(": ", 1)[1] for f in found] == ["'300 MB'", "'0.4 us per evaluation'",
                                                      "'40-53 s in double-double'", "'takes 8 s'"]
+
+
+def test_a_record_of_another_version_fails_the_check():
+    """docs/numbers.md: a page renders only records measured on the package's own version.  The same
+    record files render with the package's version and fail, naming the record and both versions, when the
+    package is another version (a bench model, a test number and a whole record each)."""
+    version = rd.package_version()
+    records = {"bench": {"models": {"m": {"tqdyn_version": version, "command": "tqdyn bench --model m",
+                                          "result": {"wall_s": 1.5}}}},
+               "tests": {"numbers": {"k": {"tqdyn_version": version, "test": "tests/test_x.py::t", "value": 2.0}}},
+               "closedloop": {"tqdyn_version": version, "command": "tqdyn report --closed-loop", "x": 3.0}}
+    text = "<!--n:bench:m/wall_s-->?<!--/n--> <!--n:tests:k-->?<!--/n--> <!--n:closedloop:x-->?<!--/n-->"
+    assert rd.render(text, rd.check_versions(records, version)) == text.replace("?", "1.5", 1).replace(
+        "?", "2.0", 1).replace("?", "3.0", 1)
+    for marker in text.split(" "):
+        with pytest.raises(rd.StaleRecordError, match=r"measured on tqdyn .*, the package is 9\.9"):
+            rd.render(marker, rd.check_versions(records, "9.9"), "x.md")
+    with pytest.raises(rd.StaleRecordError, match="README.md"):
+        readme = (ROOT / "README.md").read_text(encoding="utf-8")
+        rd.render(readme, rd.load_records(version="0.0.0"), "README.md")

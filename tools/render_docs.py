@@ -67,16 +67,69 @@ class RenderError(ValueError):
     """A marker that cannot be rendered (names the page and the marker)."""
 
 
+class StaleRecordError(RenderError):
+    """A marker reads a record measured on another tqdyn version than the package's."""
+
+
 # =========================================================================== records
 
 
-def load_records(data_dir: Path = DATA) -> dict:
-    """Every record by source name ({} for a missing file)."""
+def package_version(root: Path = ROOT) -> str:
+    """The version of the package in this tree (``src/tqdyn/_version.py``, read without importing it)."""
+    text = (Path(root) / "src" / "tqdyn" / "_version.py").read_text(encoding="utf-8")
+    return re.search(r'__version__\s*=\s*"([^"]+)"', text).group(1)
+
+
+class Stale(dict):
+    """A record, bench model or test number measured on another tqdyn version than the package's:
+    any use of it raises :class:`StaleRecordError` naming what, both versions and the command to re-run."""
+
+    def __init__(self, what: str, measured, package: str, command):
+        super().__init__()
+        self.message = (f"{what} was measured on tqdyn {measured or '(no version)'}, the package is {package}"
+                        + (f"; re-run: {command}" if command else ""))
+
+    def _fail(self, *args, **kwargs):
+        raise StaleRecordError(self.message)
+
+    __getitem__ = get = __contains__ = __iter__ = keys = items = values = _fail
+
+
+def check_versions(records: dict, version: str) -> dict:
+    """``records`` with every part measured on another version than ``version`` replaced by a
+    :class:`Stale` (bench: each model; tests: each number; the other records as a whole)."""
+    out = {}
+    for name, rec in records.items():
+        if not rec:
+            out[name] = rec
+        elif name == "bench":
+            models = {m: e if e.get("tqdyn_version") == version else
+                      Stale(f"bench model {m!r}", e.get("tqdyn_version"), version, e.get("command"))
+                      for m, e in rec.get("models", {}).items()}
+            out[name] = {**rec, "models": models}
+        elif name == "tests":
+            numbers = {k: e if e.get("tqdyn_version") == version else
+                       Stale(f"test number {k!r} ({e.get('test')})", e.get("tqdyn_version"), version,
+                             "pytest --record-numbers docs/data/tests.json " + str(e.get("test", "")).split("::")[0])
+                       for k, e in rec.get("numbers", {}).items()}
+            out[name] = {**rec, "numbers": numbers}
+        elif rec.get("tqdyn_version") == version:
+            out[name] = rec
+        else:
+            out[name] = Stale(f"docs/data/{SOURCES[name]}", rec.get("tqdyn_version"), version, rec.get("command"))
+    return out
+
+
+def load_records(data_dir: Path = DATA, version: str | None = None, check: bool = True) -> dict:
+    """Every record by source name ({} for a missing file), the parts measured on another tqdyn version
+    than ``version`` (default: the package's, :func:`package_version`) made :class:`Stale` unless
+    ``check`` is False: a page that renders one of them fails (records match the code they describe,
+    docs/numbers.md)."""
     out = {}
     for name, fname in SOURCES.items():
         p = Path(data_dir) / fname
         out[name] = json.loads(p.read_text(encoding="utf-8")) if p.exists() else {}
-    return out
+    return check_versions(out, package_version() if version is None else version) if check else out
 
 
 def _step(node, seg: str):
@@ -143,6 +196,8 @@ def lookup(records: dict, src: str, path: str):
                     break
         try:
             node = _step(node, seg)
+        except StaleRecordError:
+            raise
         except (KeyError, IndexError, ValueError, TypeError):
             raise KeyError(f"{src}:{path}: no {seg!r}") from None
         i += used
@@ -494,6 +549,8 @@ def render(text: str, records: dict, page: str = "page") -> str:
                               f"{', '.join(GENERATORS)}")
         try:
             body = GENERATORS[name](records, arg or None)
+        except StaleRecordError as exc:
+            raise StaleRecordError(f"{page}: <!--gen:{m.group('name')}-->: {exc}") from None
         except (KeyError, IndexError, TypeError, ValueError) as exc:
             raise RenderError(f"{page}: <!--gen:{m.group('name')}-->: {exc!r}") from None
         return m.group("open") + body + "\n" + m.group("close")
@@ -502,6 +559,8 @@ def render(text: str, records: dict, page: str = "page") -> str:
         try:
             value = lookup(records, m.group("src"), m.group("path"))
             out = fmt_value(value, m.group("fmt"))
+        except StaleRecordError as exc:
+            raise StaleRecordError(f"{page}: {marker_of(m)}: {exc}") from None
         except (KeyError, IndexError, TypeError, ValueError) as exc:
             raise RenderError(f"{page}: {marker_of(m)}: {exc}") from None
         return m.group(0)[: m.start("text") - m.start(0)] + out + "<!--/n-->"

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from ..formats.atomic import replacing
 
-__all__ = ["FORMAT_VERSION", "LIBRARIES", "machine", "libraries", "provenance", "to_json", "read_record",
+__all__ = ["FORMAT_VERSION", "LIBRARIES", "commit", "machine", "libraries", "provenance", "to_json", "read_record",
            "write_record", "merge_section"]
 
 #: Layout version of the records (a top-level ``format_version``).
@@ -88,17 +88,37 @@ def libraries() -> dict:
     return out
 
 
+def commit() -> str | None:
+    """The git commit of the source tree tqdyn is imported from (40 hex digits, with ``+dirty`` when
+    files tracked by git differ from it), or None when the package is not a git checkout (an installed
+    wheel) or git is not available."""
+    import subprocess
+
+    where = Path(__file__).resolve().parent
+    try:
+        head = subprocess.run(["git", "-C", str(where), "rev-parse", "HEAD"], capture_output=True, text=True,
+                              timeout=10)
+        if head.returncode != 0:
+            return None
+        dirty = subprocess.run(["git", "-C", str(where), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head.stdout.strip() + ("+dirty" if dirty.returncode == 0 and dirty.stdout.strip() else "")
+
+
 def provenance(written_by: str, command: str | None = None) -> dict:
     """Who, where and when: ``written_by``, ``command`` (default: this
     process's command line), ``date`` (UTC, ISO 8601, seconds),
-    ``tqdyn_version``, ``machine`` (:func:`machine`), ``libraries``."""
+    ``tqdyn_version``, ``tqdyn_commit`` (:func:`commit`), ``machine``
+    (:func:`machine`), ``libraries``."""
     from .._version import __version__
 
     if command is None:
         command = " ".join([Path(sys.argv[0]).name] + sys.argv[1:]) if sys.argv and sys.argv[0] else "python"
     now = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0)
     return {"written_by": written_by, "command": command, "date": now.isoformat().replace("+00:00", "Z"),
-            "tqdyn_version": __version__, "machine": machine(), "libraries": libraries()}
+            "tqdyn_version": __version__, "tqdyn_commit": commit(), "machine": machine(), "libraries": libraries()}
 
 
 def to_json(value):
