@@ -1,5 +1,5 @@
 """The residuals' figure of an orbit-determination fit (tqdyn.analysis.figures_od, ``tqdyn od fit --figure``,
-``tqdyn.plot_od_residuals``; docs/orbit-determination.md, "The residuals' figure").
+``tqdyn.plot_od_residuals``; docs/od-files.md, "The residuals' figure").
 
 The problem is the linear stand-in tests/od_fake_problem.py (as in tests/test_od_cli.py), whose design
 matrix numpy can use directly.  References: the normalised residual of a row is r_i / sqrt(v_i) with

@@ -1,5 +1,5 @@
 """The orbit-determination files: measurements as CCSDS TDM (tqdyn.formats.od_tdm) and the estimate
-file EST.h5 (tqdyn.formats.od_estimate); docs/orbit-determination.md, "Files".
+file EST.h5 (tqdyn.formats.od_estimate); docs/od-files.md.
 
 References: exact decimal arithmetic (Python's decimal module) for the m -> km conversion of the
 values; the IERS offsets TAI - UTC = 32 s (1999-2006, IERS Bulletin C) and TT - TAI = 32.184 s for
@@ -252,7 +252,7 @@ def _text(v) -> str:
 def test_tdm_read_by_ccsds_ndm(tmp_path):
     """A measurement file of tqdyn parsed by ccsds-ndm 3.1 (its KVN reader): one segment per
     (type, satellite, peer, sigma); TIME_SYSTEM, the participants, PATH, MODE, RANGE_UNITS (of the
-    ranges) and TIMETAG_REF as the table of docs/orbit-determination.md says; every epoch as written and every
+    ranges) and TIMETAG_REF as the table of docs/od-files.md says; every epoch as written and every
     value (km, km/s) equal to the table's m, m/s / 1000 to the float64 rounding of ccsds-ndm's parse
     of the decimal (1 ulp), every epoch the TT of the UTC epoch + t (TT - UTC = 64.184 s in 2004)."""
     meas = _table()

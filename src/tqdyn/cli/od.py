@@ -92,7 +92,7 @@ def od():
 @click.argument("run_file", metavar="RUN.h5")
 @click.option("--tracking", required=True,
               help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
-                   "docs/orbit-determination.md#measurement-types).")
+                   "docs/od-measurements.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
@@ -168,7 +168,7 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
 @click.argument("scenario", metavar="SCENARIO")
 @click.option("--tracking", required=True,
               help="Tracking kinds, comma-separated, e.g. gnss,slr,isr (every kind: "
-                   "docs/orbit-determination.md#measurement-types).")
+                   "docs/od-measurements.md#measurement-types).")
 @click.option("--arc", required=True, help="Arc from the epoch: seconds, or with a unit: 7d, 12h, 30min.")
 @click.option("--interval", help="Measurement interval: seconds or with a unit [default: 600 s].")
 @click.option("--estimate", help="Parameter groups to estimate, comma-separated [default: state,s_frame; "

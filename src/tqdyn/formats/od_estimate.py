@@ -1,5 +1,5 @@
 """The orbit-determination estimate file: the ``tqdyn-od-estimate`` HDF5 format (I/O only;
-docs/orbit-determination.md, "Files").
+docs/od-files.md).
 
 One file holds one batch least-squares fit (``tqdyn od fit SCENARIO MEAS.tdm --output EST.h5``):
 

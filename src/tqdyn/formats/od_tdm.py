@@ -1,5 +1,5 @@
 """Orbit-determination measurements as CCSDS Tracking Data Messages (KVN, 503.0-B-2): the measurement
-file of ``tqdyn od simulate`` and ``tqdyn od fit`` (I/O only; docs/orbit-determination.md, "Files").
+file of ``tqdyn od simulate`` and ``tqdyn od fit`` (I/O only; docs/od-files.md).
 
 A measurement table has one row per scalar measurement: ``t`` (m,) [s since the scenario epoch, the
 run's time scale], ``type`` (m,) str (:data:`TYPES`), ``sat`` (m,) int (the satellite's index in the

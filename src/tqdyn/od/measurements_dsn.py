@@ -80,7 +80,7 @@ def station_itrs(stations=None) -> tuple[list[str], np.ndarray]:
     bad = [s for s in names if s not in DEEP_SPACE_STATIONS]
     if bad:
         raise ValueError(unknown("deep-space station", bad[0], DEEP_SPACE_STATIONS,
-                                 "docs/orbit-determination.md#measurement-models", noun="stations"))
+                                 "docs/od-measurements.md#measurement-models", noun="stations"))
     return names, np.array([DEEP_SPACE_STATIONS[s] for s in names])
 
 

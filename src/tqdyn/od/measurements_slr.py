@@ -35,7 +35,7 @@ __all__ = ["ILRS_STATIONS", "SLR_SIGMA_M", "slr_range", "slr_station_positions"]
 
 #: A handful of ILRS stations: name -> (ILRS 4-digit code, SINEX point code).
 #: Where the stations are listed.
-_DOC = "docs/orbit-determination.md#measurement-models"
+_DOC = "docs/od-measurements.md#measurement-models"
 ILRS_STATIONS = {
     "Yarragadee": ("7090", "A"),
     "Monument Peak": ("7110", "A"),

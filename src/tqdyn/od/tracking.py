@@ -35,7 +35,7 @@ GROUPS = {"state": STATE_NAMES, "s_frame": PARAMETER_NAMES[0:3], "rtn": PARAMETE
 #: The groups of a coupled run (the others but "bias" are those of point-mass runs).
 COUPLED_GROUPS = ("state", "self_gravity_common", "bias")
 #: Where the stations are listed.
-STATIONS_DOC = "docs/orbit-determination.md#measurement-models"
+STATIONS_DOC = "docs/od-measurements.md#measurement-models"
 #: Measurement types with a constant bias parameter (group "bias", :func:`bias_design`):
 #: :data:`tqdyn.od.registry.BIAS_TYPES` (one per ground station and type, one per one-way link).
 #: The groups estimated when a plan names none: point-mass runs, coupled runs.
