@@ -217,3 +217,20 @@ def test_tqdyn_reads_ccsds_ndm_and_old_files(tdm_file, tmp_path):
     fields, _ = read_measurements_tdm(old, epoch=scen.epoch, time_scale="TT")
     assert fields["t"][0] == 0.0 and set(fields["type"]) == {"slr_range", "dsn_range_rate"}
     assert fields["value"].tolist()[:2] == [101234567.891, 0.125]
+
+
+def test_ttc_stations_option_of_the_commands(tmp_path, capsys):
+    """``--ttc-stations FILE`` (tqdyn od simulate | fit | covariance): a file with an unknown measurement type
+    is refused in one line naming the station, the field and what is allowed (exit 2, nothing written), and
+    the choice ends with the command (the shipped stations again afterwards)."""
+    from cli_support import run_cli
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[station]]\nname = "X"\ntypes = ["ttc_phase"]\nitrf = [1.0, 2.0, 3.0]\n')
+    out_json = tmp_path / "cov.json"
+    status, out, err = run_cli(["od", "covariance", "tianqin-kepler", "--tracking", "ttc", "--arc", "12h",
+                                "--ttc-stations", str(bad), "--json", str(out_json)], capsys)
+    assert status == 2 and not out_json.exists()
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "'ttc_phase' is not allowed" in lines[0] and "ttc_range" in lines[0], err
+    assert "Kashi" in ttc_stations()

@@ -61,6 +61,39 @@ def _run(job, stages: _Stages):
     return out
 
 
+def _ttc_option(f):
+    """``--ttc-stations FILE``: the TT&C stations file of the command (docs/od-measurements.md)."""
+    return click.option("--ttc-stations", "ttc_stations", metavar="FILE",
+                        help="TT&C ground stations from this TOML file instead of the shipped one "
+                             "(docs/od-measurements.md; also $TQDYN_TTC_STATIONS).")(f)
+
+
+def _with_ttc(path, job):
+    """``job`` run with the TT&C stations file ``path`` (None: the default), checked first (one line)
+    and handed on to Dask workers started later through ``$TQDYN_TTC_STATIONS``."""
+    if path is None:
+        return job
+
+    def run():
+        import os
+
+        from ..od.measurements_ttc import use_ttc_stations
+
+        before = os.environ.get("TQDYN_TTC_STATIONS")
+        try:
+            use_ttc_stations(path)
+            os.environ["TQDYN_TTC_STATIONS"] = os.fspath(path)
+            return job()
+        finally:  # the command's choice ends with it (commands may run in one process, as in the tests)
+            if before is None:
+                os.environ.pop("TQDYN_TTC_STATIONS", None)
+            else:
+                os.environ["TQDYN_TTC_STATIONS"] = before
+            use_ttc_stations(None)
+
+    return run
+
+
 def _notes(notes) -> None:
     for note in notes:
         if note:
@@ -108,15 +141,16 @@ def od():
 @click.option("--output", "-o", required=True, help="Output measurement file (CCSDS TDM, KVN).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, output, sets, quiet):
+@_ttc_option
+def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, output, sets, quiet, ttc_stations):
     """Simulate the measurements of a tracking plan on the run RUN.h5: its recorded scenario, with its
     [accelerations] and initial states as the truth, seeded white noise; written as a CCSDS TDM."""
     from ..workflows import od_files as wf
 
     stages = _Stages(("scheduling", "simulating", "writing"), quiet, "od simulate")
-    s = _run(lambda: wf.simulate_to_tdm(run_file, tracking, arc, output=output, seed=seed, interval=interval,
-                                        stations=stations, bias=biases, sp3=sp3, overrides=sets,
-                                        progress=stages), stages)
+    s = _run(_with_ttc(ttc_stations, lambda: wf.simulate_to_tdm(
+        run_file, tracking, arc, output=output, seed=seed, interval=interval, stations=stations, bias=biases,
+        sp3=sp3, overrides=sets, progress=stages)), stages)
     _notes(s.notes)
     counts = ", ".join(f"{n} {t}" for t, n in s.counts.items())
     click.echo(f"measurements: {sum(s.counts.values())} ({counts}) over {s.tracking.arc_s:g} s, seed {seed}")
@@ -141,16 +175,16 @@ def simulate(run_file, tracking, arc, seed, interval, stations, biases, sp3, out
 @click.option("--figure", help="Also draw the normalised post-fit residuals and their histogram (.png or .pdf).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
-def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, figure, sets, quiet):
+@_ttc_option
+def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, figure, sets, quiet, ttc_stations):
     """Fit SCENARIO (a built-in name, a TOML file or a run file) to the measurements MEAS.tdm by batch
     least squares; print each estimated parameter with its 1-sigma, and chi^2/dof."""
     from ..workflows import od as od_inputs, od_files as wf
 
     stages = _Stages(("reading", "fitting", "writing") + (("plotting",) if figure else ()), quiet, "od fit")
-    est, _, notes = _run(lambda: wf.fit_to_file(scenario, tdm, output=output, estimate=estimate, consider=consider,
-                                                a_priori=a_priori, edit_sigma=edit_sigma, sp3=sp3, overrides=sets,
-                                                figure=figure,
-                                                progress=stages), stages)
+    est, _, notes = _run(_with_ttc(ttc_stations, lambda: wf.fit_to_file(
+        scenario, tdm, output=output, estimate=estimate, consider=consider, a_priori=a_priori,
+        edit_sigma=edit_sigma, sp3=sp3, overrides=sets, figure=figure, progress=stages)), stages)
     _notes(notes)
     units = [od_inputs.parameter_unit(n) for n in est.names]
     click.echo("\n".join(summary_lines(est.names, est.values, est.sigma, units,
@@ -186,16 +220,17 @@ def fit(scenario, tdm, output, estimate, consider, a_priori, edit_sigma, sp3, fi
 @click.option("--json", "json_out", help="Also write the covariance as JSON to this file.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
+@_ttc_option
 def covariance(scenario, tracking, arc, interval, estimate, consider, a_priori, stations, sp3, json_out, sets,
-               quiet):
+               quiet, ttc_stations):
     """Predict, without measurements, how well a tracking plan determines SCENARIO's parameters: the
     1-sigma of each (and with --consider the consider sigma)."""
     from ..workflows import od as od_inputs, od_files as wf
 
     stages = _Stages(("covariance", "writing") if json_out else ("covariance",), quiet, "od covariance")
-    cov, _, notes = _run(lambda: wf.covariance_of(scenario, tracking, arc, interval=interval, estimate=estimate,
-                                                  consider=consider, a_priori=a_priori, stations=stations,
-                                                  sp3=sp3, overrides=sets, json_out=json_out, progress=stages), stages)
+    cov, _, notes = _run(_with_ttc(ttc_stations, lambda: wf.covariance_of(
+        scenario, tracking, arc, interval=interval, estimate=estimate, consider=consider, a_priori=a_priori,
+        stations=stations, sp3=sp3, overrides=sets, json_out=json_out, progress=stages)), stages)
     _notes(notes)
     units = [od_inputs.parameter_unit(n) for n in cov.names]
     click.echo("\n".join(summary_lines(cov.names, None, cov.sigma, units,
