@@ -138,15 +138,15 @@ def test_link_ttl_of_a_closed_loop_time_series_agrees_with_the_budget_within_wel
 
 
 def test_single_link_budget_dataset_and_its_tm_term():
-    """single_link_budget on LISA's loop: the TM term of a link at 1 mHz is the two TMs' stray acceleration
-    (LISA's requirement shape, 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4) each, drag-free
+    """single_link_budget on LISA's loop with version 0.3's noise (``defaults="v0.3"``): the TM term of a link at
+    1 mHz is the two TMs' stray acceleration (LISA's requirement shape, 3e-15 sqrt(1 + (0.4 mHz/f)^2) sqrt(1 + (f/8 mHz)^4) each, drag-free
     suppresses the rest) in quadrature over (2 pi f)^2 (within 10 %); the requirement is LISA's 15 pm
     sqrt(1 + (2 mHz/f)^4); total = power sum of TTL, TM and readout (round-off)."""
     from tqdyn.closedloop.model import ClosedLoopModel
     from tqdyn.analysis.ttl_budget import single_link_budget
 
     cl = _lisa_loop()
-    model = ClosedLoopModel(loops=[[(0.0, cl)]] * 3, noise=default_noise("lisa"), mission="lisa",
+    model = ClosedLoopModel(loops=[[(0.0, cl)]] * 3, noise=default_noise("lisa", "v0.3"), mission="lisa",
                             settings={"f_min": 1e-4, "f_max": 1.0, "n_freq": 41}, satellite_names=("1", "2", "3"),
                             t_span=(0.0, 1.0), parts=[[(None, cl_wp)] for cl_wp in [_WP] * 3])
     ds = single_link_budget(model)
