@@ -98,6 +98,9 @@ def _parse(stdout: str) -> dict:
     m = re.search(r"output: .* \((\d+) rows, ([0-9.]+) MB\)", stdout)
     if m:
         out["rows"] = int(m.group(1))
+    m = re.search(r"max first correction \|r_C - r_P\| \(component\): ([0-9.eE+-]+) m", stdout)
+    if m:  # multistep runs: the largest corrector-minus-predictor position difference [m]
+        out["first_correction_r_m"] = float(m.group(1))
     return out
 
 
