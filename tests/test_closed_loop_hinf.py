@@ -211,3 +211,22 @@ def test_monte_carlo_command_on_a_local_cluster(tianqin, tmp_path, capsys):
     assert np.allclose(ds.requirement_ratio.values, ref.requirement_ratio.values, rtol=1e-12)
     assert ds.attrs["scheduler"] == "local" and ds.crosstalk.shape == (1,)
     ds.close()
+
+
+def test_file_configuration_records_the_synthesised_controllers(tianqin):
+    """The closed-loop file's configuration (tqdyn.workflows.closed_loop.resolved_configuration) of an
+    H-infinity model names what ran: per satellite the controller's order and gamma as the synthesis returned
+    them (HinfController, the reference) and its bandwidths; without controllers there is no ``hinf`` key."""
+    import json
+
+    from tqdyn.scenario.loader import closed_loop_config
+    from tqdyn.workflows.closed_loop import resolved_configuration
+
+    model, _ = _hinf(tianqin)
+    cfg = closed_loop_config({"mission": "tianqin", "design": "hinf"}, ())
+    conf = json.loads(json.dumps(resolved_configuration(cfg, "tianqin", dict(model.settings), model.hinf)))
+    assert len(conf["hinf"]) == len(model.hinf) > 0
+    for rec, k in zip(conf["hinf"], model.hinf):
+        assert rec["order"] == k.system.nstates and rec["gamma"] == k.gamma < 1
+        assert len(rec["bandwidth_hz"]) == len(k.channels)
+    assert "hinf" not in resolved_configuration(cfg, "tianqin", dict(model.settings))

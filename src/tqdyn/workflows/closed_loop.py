@@ -63,13 +63,18 @@ def _positive(name: str, text, parse) -> float:
     return v
 
 
-def resolved_configuration(config, architecture: str, settings: dict) -> dict:
+def resolved_configuration(config, architecture: str, settings: dict, hinf=()) -> dict:
     """The resolved closed-loop configuration as plain JSON types: settings, plant, controllers
-    (zeros, poles [rad/s] as [re, im], gain) and noise (level [unit/Hz^1/2], knees [[Hz, slope]], unit)."""
+    (zeros, poles [rad/s] as [re, im], gain) and noise (level [unit/Hz^1/2], knees [[Hz, slope]], unit); with
+    ``closed_loop.design = "hinf"`` (``hinf``: the model's synthesised controllers, one per satellite) also
+    ``hinf``, per satellite the controller's ``order``, ``gamma``, ``bandwidth_hz`` and ``shift`` [rad/s]
+    (``controllers`` then holds the per-loop design it replaces)."""
     from ..closedloop.missions import resolve
 
     mission, plant, ctl, noise = resolve(config, architecture)
-    return {"mission": mission, "settings": dict(settings),
+    extra = {"hinf": [{"order": k.order, "gamma": float(k.gamma), "bandwidth_hz": [float(f) for f in k.bandwidth_hz],
+                       "shift": float(k.shift)} for k in hinf]} if hinf else {}
+    return {"mission": mission, "settings": dict(settings), **extra,
             "plant": {k: (list(v) if isinstance(v, (tuple, list)) else float(v)) for k, v in plant.items()},
             "controllers": {k: {"zeros": [[complex(z).real, complex(z).imag] for z in c.zeros],
                                 "poles": [[complex(p).real, complex(p).imag] for p in c.poles], "gain": float(c.gain)}
@@ -115,7 +120,8 @@ def _static_job(mission, out, dur, rate, seed, overrides, per_source: bool) -> C
     s = model.settings
     dur, rate, seed, n = _series(model, dur, rate, seed)
     _check_size(model, n, out)
-    conf = resolved_configuration(cfg, mission, {**s, "fs": rate, "duration": float(dur), "seed": int(seed)})
+    conf = resolved_configuration(cfg, mission, {**s, "fs": rate, "duration": float(dur), "seed": int(seed)},
+                                  model.hinf)
     conf["working_point"] = "static"
     attrs = {"mission": model.mission, "source_file": "", "source_path": "", "source_sha256": "",
              "source_scenario_sha256": "", "source_format_version": 0, "source_tqdyn_version": "",
@@ -170,7 +176,7 @@ def check_closed_loop_inputs(run_file, output, duration=None, fs=None, seed=None
     dur, rate, seed, n = _series(model, dur, rate, seed)
     _check_size(model, n, out)
     settings = {**s, "fs": rate, "duration": float(dur), "seed": int(seed)}
-    conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings)
+    conf = resolved_configuration(scen.closed_loop, traj.spacecraft.architecture, settings, model.hinf)
     ta = traj.attrs
     attrs = {"mission": model.mission, "source_file": os.path.basename(src), "source_path": src,
              "source_sha256": file_sha256(src),
