@@ -49,6 +49,8 @@ NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
 STACKED_SCHEMES = ("constellation", "collinear")
 #: Complex numbers held at once per evaluation chunk (bounds the memory: 16 bytes each).
 _CHUNK_ELEMENTS = 1_500_000
+#: Multiply-adds of one real matrix product below which OpenBLAS uses one thread (its SMP threshold, 65536 x 4).
+_BLAS_SINGLE = 200_000
 
 
 @dataclass(frozen=True)
@@ -244,26 +246,38 @@ def _chunks(n_loops: int, per_loop: int):
 
 
 def _lmul(L, X) -> np.ndarray:
-    """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m).  The blocks' matrices are sparse (a
-    few entries per row): the product runs over the nonzero pattern shared by the k loops."""
-    r, c = np.nonzero(np.any(L != 0, axis=0))                     # row-major: sorted by row
-    out = np.zeros(X.shape[:2] + (L.shape[1], X.shape[3]), dtype=complex)
-    if len(r):
-        starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-        out[:, :, r[starts], :] = np.add.reduceat(X[:, :, c, :] * L[:, r, c][:, None, :, None], starts, axis=2)
+    """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m), one real matrix product per loop and
+    frequency on the real view of X (real and imaginary parts as adjacent columns: BLAS dgemm)."""
+    X = np.ascontiguousarray(X, dtype=complex)
+    out = np.matmul(np.asarray(L, dtype=np.float64)[:, None], X.view(np.float64))
+    return out.view(complex)
+
+
+def _columns_product(A, B) -> np.ndarray:
+    """A B for A (k, r, c) and B (c, n), in blocks of B's columns small enough (<= :data:`_BLAS_SINGLE` multiply-adds)
+    that BLAS runs each on one thread: on a machine shared with other jobs a threaded product of these sizes waits
+    for its threads far longer than it computes."""
+    k, r, c = A.shape
+    n = max(1, _BLAS_SINGLE // max(1, r * c))
+    out = np.empty((k, r, B.shape[1]))
+    for a in range(0, B.shape[1], n):
+        out[:, :, a:a + n] = np.matmul(A, B[:, a:a + n])
     return out
 
 
-def _kmul(P, S, Ks) -> np.ndarray:
-    """P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks`` (17, F): (k, F, a, b), over the
-    nonzero entries of the products P_ic S_cj shared by the k loops."""
+def _kmul(P, S, Ks, out) -> np.ndarray:
+    """``out`` (k, F, a, b) complex plus P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks``
+    (17, F), in place and returned: the real products P_ic S_cj (one matrix per loop), then over their nonzero
+    entries shared by the k loops one real matrix product with K(s)'s real view, over all frequencies."""
     k, a, nc = P.shape
     b = S.shape[2]
     PS = (P[:, :, None, :] * np.moveaxis(S, 1, 2)[:, None, :, :]).reshape(k, a * b, nc)
     rows = np.flatnonzero(np.any(PS != 0, axis=(0, 2)))
-    out = np.zeros((k, Ks.shape[1], a * b), dtype=complex)
-    out[:, :, rows] = np.moveaxis(np.matmul(PS[:, rows, :], Ks), 1, 2)
-    return out.reshape(k, Ks.shape[1], a, b)
+    if len(rows):
+        y = _columns_product(PS[:, rows], np.ascontiguousarray(Ks, dtype=complex).view(np.float64)).view(complex)
+        flat = out.reshape(k, Ks.shape[1], a * b)
+        flat[:, :, rows] += np.moveaxis(y, 2, 1)
+    return out
 
 
 def _polys(terms, s, X) -> np.ndarray:
@@ -294,12 +308,13 @@ def _solve(st: LoopStack, idx, s, Ks, breaks: bool):
     M = sF ** 2 * np.eye(nq) - sF * Gq[:, None] - Kq[:, None]
     for L, power in sens:
         if np.any(L):
-            M = M - _kmul(Pbar, L, Ks * s[None, :] ** power)
+            _kmul(-Pbar, L, Ks * s[None, :] ** power, M)
+    shape = M.shape[:2] + (nq, st.Ad.shape[2] if breaks else st.Sw.shape[2])
     if breaks:
-        rhs = np.broadcast_to(np.matmul(Bq, st.Ad[idx])[:, None], M.shape[:2] + (nq, st.Ad.shape[2]))
+        rhs = np.broadcast_to(np.matmul(Bq, st.Ad[idx])[:, None], shape).astype(complex)
     else:
-        rhs = _kmul(Pbar, st.Sw[idx], Ks) + np.matmul(Bq, st.Aw[idx])[:, None]
-    return np.linalg.solve(M, rhs.astype(complex)), sens, pieces
+        rhs = _kmul(Pbar, st.Sw[idx], Ks, np.broadcast_to(np.matmul(Bq, st.Aw[idx])[:, None], shape).astype(complex))
+    return np.linalg.solve(M, rhs), sens, pieces
 
 
 def noise_response(st: LoopStack, idx, f) -> np.ndarray:
