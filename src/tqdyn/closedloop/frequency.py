@@ -20,7 +20,9 @@ static observables z = Oy y + Ou u (w the noise inputs, d the loop breaks, z the
   solved by LAPACK (``numpy.linalg.solve``, partial pivoting) batched over loops and frequencies, in the
   plant's own coordinates.  The plant outputs that are second derivatives of a coordinate (the TMs'
   relative accelerations x_l'', rows of the plant's C, D equal to rows of its A, B) are taken as s^2 q:
-  no cancellation of large terms at low frequencies.
+  no cancellation of large terms at low frequencies.  The controllers' terms P diag(K(s)) S are one real
+  product over all frequencies on K(s)'s real view (real and imaginary parts side by side), in blocks small
+  enough that BLAS keeps them on one thread.
 
 Units SI; frequencies in Hz, s in rad/s; ASDs one-sided in (output unit)/Hz^1/2.
 """
@@ -246,11 +248,16 @@ def _chunks(n_loops: int, per_loop: int):
 
 
 def _lmul(L, X) -> np.ndarray:
-    """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m), one real matrix product per loop and
-    frequency on the real view of X (real and imaginary parts as adjacent columns: BLAS dgemm)."""
-    X = np.ascontiguousarray(X, dtype=complex)
-    out = np.matmul(np.asarray(L, dtype=np.float64)[:, None], X.view(np.float64))
-    return out.view(complex)
+    """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m).  The blocks' matrices are sparse (a
+    few entries per row): the product runs over the nonzero pattern shared by the k loops, each row summed in
+    the order of its columns (a BLAS product sums in another order: at low frequencies, where some outputs are
+    differences of large terms, that moves them by up to 1e-8 relative)."""
+    r, c = np.nonzero(np.any(L != 0, axis=0))                     # row-major: sorted by row
+    out = np.zeros(X.shape[:2] + (L.shape[1], X.shape[3]), dtype=complex)
+    if len(r):
+        starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
+        out[:, :, r[starts], :] = np.add.reduceat(X[:, :, c, :] * L[:, r, c][:, None, :, None], starts, axis=2)
+    return out
 
 
 def _columns_product(A, B) -> np.ndarray:
@@ -317,9 +324,8 @@ def _solve(st: LoopStack, idx, s, Ks, breaks: bool):
     return np.linalg.solve(M, rhs), sens, pieces
 
 
-def noise_response(st: LoopStack, idx, f) -> np.ndarray:
-    """The closed-loop transfer functions G (k, 46, 58, F) from the noise inputs (:data:`NOISE_INPUTS`) to the
-    outputs (:func:`~tqdyn.closedloop.loop.output_names`) of the loops ``idx`` at ``f`` (F,) [Hz]."""
+def _response(st: LoopStack, idx, f) -> np.ndarray:
+    """:func:`noise_response` with the frequency second: (k, F, 46, 58)."""
     idx = np.atleast_1d(np.asarray(idx))
     s = 2j * math.pi * np.asarray(f, dtype=np.float64)
     Ks = controller_response(st, s)
@@ -327,9 +333,14 @@ def noise_response(st: LoopStack, idx, f) -> np.ndarray:
     c = Ks.T[None, :, :, None] * (_polys(sens, s, q) + st.Sw[idx][:, None])          # (k, F, 17, 58)
     u = _lmul(st.Ac[idx], c) + st.Aw[idx][:, None]                                   # (k, F, 32, 58)
     Oy = st.Oy[idx]
-    z = _polys([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, q) \
-        + _lmul(np.matmul(Oy, Dp) + st.Ou[idx], u)                                  # (k, F, 46, 58)
-    return np.moveaxis(z, 1, 3)
+    return _polys([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, q) \
+        + _lmul(np.matmul(Oy, Dp) + st.Ou[idx], u)
+
+
+def noise_response(st: LoopStack, idx, f) -> np.ndarray:
+    """The closed-loop transfer functions G (k, 46, 58, F) from the noise inputs (:data:`NOISE_INPUTS`) to the
+    outputs (:func:`~tqdyn.closedloop.loop.output_names`) of the loops ``idx`` at ``f`` (F,) [Hz]."""
+    return np.moveaxis(_response(st, idx, f), 1, 3)
 
 
 def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
@@ -340,14 +351,15 @@ def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
     idx = np.atleast_1d(np.asarray(idx))
     out = np.empty((len(idx), len(output_names()), len(sources), len(f)))
     for part in _chunks(len(idx), len(f) * len(NOISE_INPUTS) * 52):
-        G = noise_response(st, idx[list(part)], f)
+        z = _response(st, idx[list(part)], f)                                       # (k, F, 46, 58)
+        p2 = z.real ** 2 + z.imag ** 2
         k = 0
         for src in SOURCES:
             n = SOURCES[src][0]
             if src in noise:
-                g = G[:, :, k:k + n, :]
-                p2 = np.sum(g.real ** 2 + g.imag ** 2, axis=2)
-                out[part.start:part.stop, :, sources.index(src), :] = np.sqrt(p2) * noise[src].asd(f)[None, None]
+                ps = np.sum(p2[:, :, :, k:k + n], axis=3)                                # (k, F, 46)
+                out[part.start:part.stop, :, sources.index(src), :] = np.moveaxis(np.sqrt(ps), 1, 2) \
+                    * noise[src].asd(f)[None, None]
             k += n
     return out, sources
 
