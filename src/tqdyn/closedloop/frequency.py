@@ -20,9 +20,8 @@ static observables z = Oy y + Ou u (w the noise inputs, d the loop breaks, z the
   solved by LAPACK (``numpy.linalg.solve``, partial pivoting) batched over loops and frequencies, in the
   plant's own coordinates.  The plant outputs that are second derivatives of a coordinate (the TMs'
   relative accelerations x_l'', rows of the plant's C, D equal to rows of its A, B) are taken as s^2 q:
-  no cancellation of large terms at low frequencies.  The controllers' terms P diag(K(s)) S are one real
-  product over all frequencies on K(s)'s real view (real and imaginary parts side by side), in blocks small
-  enough that BLAS keeps them on one thread.
+  no cancellation of large terms at low frequencies.  The controllers' terms P diag(K(s)) S are one matrix
+  product over all frequencies, in blocks small enough that BLAS keeps them on one thread.
 
 Units SI; frequencies in Hz, s in rad/s; ASDs one-sided in (output unit)/Hz^1/2.
 """
@@ -51,8 +50,9 @@ NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
 STACKED_SCHEMES = ("constellation", "collinear")
 #: Complex numbers held at once per evaluation chunk (bounds the memory: 16 bytes each).
 _CHUNK_ELEMENTS = 1_500_000
-#: Multiply-adds of one real matrix product below which OpenBLAS uses one thread (its SMP threshold, 65536 x 4).
-_BLAS_SINGLE = 200_000
+#: Complex multiply-adds of one matrix product that OpenBLAS runs on one thread (measured: its zgemm threads at
+#: 5e4 multiply-adds, not at 2e4).
+_BLAS_SINGLE = 20_000
 
 
 @dataclass(frozen=True)
@@ -266,7 +266,7 @@ def _columns_product(A, B) -> np.ndarray:
     for its threads far longer than it computes."""
     k, r, c = A.shape
     n = max(1, _BLAS_SINGLE // max(1, r * c))
-    out = np.empty((k, r, B.shape[1]))
+    out = np.empty((k, r, B.shape[1]), dtype=np.result_type(A, B))
     for a in range(0, B.shape[1], n):
         out[:, :, a:a + n] = np.matmul(A, B[:, a:a + n])
     return out
@@ -275,13 +275,13 @@ def _columns_product(A, B) -> np.ndarray:
 def _kmul(P, S, Ks, out) -> np.ndarray:
     """``out`` (k, F, a, b) complex plus P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks``
     (17, F), in place and returned: the real products P_ic S_cj (one matrix per loop), then over their nonzero
-    entries shared by the k loops one real matrix product with K(s)'s real view, over all frequencies."""
+    entries shared by the k loops one matrix product with K(s) over all frequencies (:func:`_columns_product`)."""
     k, a, nc = P.shape
     b = S.shape[2]
     PS = (P[:, :, None, :] * np.moveaxis(S, 1, 2)[:, None, :, :]).reshape(k, a * b, nc)
     rows = np.flatnonzero(np.any(PS != 0, axis=(0, 2)))
     if len(rows):
-        y = _columns_product(PS[:, rows], np.ascontiguousarray(Ks, dtype=complex).view(np.float64)).view(complex)
+        y = _columns_product(PS[:, rows].astype(complex), np.asarray(Ks, dtype=complex))
         flat = out.reshape(k, Ks.shape[1], a * b)
         flat[:, :, rows] += np.moveaxis(y, 2, 1)
     return out
