@@ -8,8 +8,9 @@ point; the three spacecraft's closed loops are then simulated in the time domain
 The mission-length budget benchmarks (``tqdyn bench --model closed-loop-budget-90d`` and
 ``closed-loop-budget-lisa-1y``, :func:`closed_loop_budget_benchmark`): a coupled run of the span (made first
 by ``tqdyn run`` in a child process, not timed), then ``tqdyn closed-loop``'s work in this process: the model
-(every spacecraft and day), the budget and its file with a 60 s series, timed apart, with the file's size
-and the process's peak resident memory; then the same file with the per-source spectra (``--per-source``).  Measured: the wall time of the streamed
+(every spacecraft and day), the budget and its file with a 60 s series, timed apart (wall; the process's CPU
+time over the three), with the file's size and the process's peak resident memory; then the same file with the
+per-source spectra (``--per-source``).  Measured: the wall time of the streamed
 time series (noise generation, the discretised loops, the HDF5 writes; the frequency-domain budget,
 computed before on a 20-point grid, is reported apart and not included), the samples per second, the
 file's size and the process's peak resident memory.
