@@ -20,7 +20,8 @@ static observables z = Oy y + Ou u (w the noise inputs, d the loop breaks, z the
   solved by LAPACK (``numpy.linalg.solve``, partial pivoting) batched over loops and frequencies, in the
   plant's own coordinates.  The plant outputs that are second derivatives of a coordinate (the TMs'
   relative accelerations x_l'', rows of the plant's C, D equal to rows of its A, B) are taken as s^2 q:
-  no cancellation of large terms at low frequencies.
+  no cancellation of large terms at low frequencies.  The controllers' terms P diag(K(s)) S are one matrix
+  product over all frequencies, in blocks small enough that BLAS keeps them on one thread.
 
 Units SI; frequencies in Hz, s in rad/s; ASDs one-sided in (output unit)/Hz^1/2.
 """
@@ -49,6 +50,9 @@ NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
 STACKED_SCHEMES = ("constellation", "collinear")
 #: Complex numbers held at once per evaluation chunk (bounds the memory: 16 bytes each).
 _CHUNK_ELEMENTS = 1_500_000
+#: Complex multiply-adds of one matrix product that OpenBLAS runs on one thread (measured: its zgemm threads at
+#: 5e4 multiply-adds, not at 2e4).
+_BLAS_SINGLE = 20_000
 
 
 @dataclass(frozen=True)
@@ -245,7 +249,9 @@ def _chunks(n_loops: int, per_loop: int):
 
 def _lmul(L, X) -> np.ndarray:
     """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m).  The blocks' matrices are sparse (a
-    few entries per row): the product runs over the nonzero pattern shared by the k loops."""
+    few entries per row): the product runs over the nonzero pattern shared by the k loops, each row summed in
+    the order of its columns (a BLAS product sums in another order: at low frequencies, where some outputs are
+    differences of large terms, that moves them by up to 1e-8 relative)."""
     r, c = np.nonzero(np.any(L != 0, axis=0))                     # row-major: sorted by row
     out = np.zeros(X.shape[:2] + (L.shape[1], X.shape[3]), dtype=complex)
     if len(r):
@@ -254,16 +260,31 @@ def _lmul(L, X) -> np.ndarray:
     return out
 
 
-def _kmul(P, S, Ks) -> np.ndarray:
-    """P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks`` (17, F): (k, F, a, b), over the
-    nonzero entries of the products P_ic S_cj shared by the k loops."""
+def _columns_product(A, B) -> np.ndarray:
+    """A B for A (k, r, c) and B (c, n), in blocks of B's columns small enough (<= :data:`_BLAS_SINGLE` multiply-adds)
+    that BLAS runs each on one thread: on a machine shared with other jobs a threaded product of these sizes waits
+    for its threads far longer than it computes."""
+    k, r, c = A.shape
+    n = max(1, _BLAS_SINGLE // max(1, r * c))
+    out = np.empty((k, r, B.shape[1]), dtype=np.result_type(A, B))
+    for a in range(0, B.shape[1], n):
+        out[:, :, a:a + n] = np.matmul(A, B[:, a:a + n])
+    return out
+
+
+def _kmul(P, S, Ks, out) -> np.ndarray:
+    """``out`` (k, F, a, b) complex plus P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks``
+    (17, F), in place and returned: the real products P_ic S_cj (one matrix per loop), then over their nonzero
+    entries shared by the k loops one matrix product with K(s) over all frequencies (:func:`_columns_product`)."""
     k, a, nc = P.shape
     b = S.shape[2]
     PS = (P[:, :, None, :] * np.moveaxis(S, 1, 2)[:, None, :, :]).reshape(k, a * b, nc)
     rows = np.flatnonzero(np.any(PS != 0, axis=(0, 2)))
-    out = np.zeros((k, Ks.shape[1], a * b), dtype=complex)
-    out[:, :, rows] = np.moveaxis(np.matmul(PS[:, rows, :], Ks), 1, 2)
-    return out.reshape(k, Ks.shape[1], a, b)
+    if len(rows):
+        y = _columns_product(PS[:, rows].astype(complex), np.asarray(Ks, dtype=complex))
+        flat = out.reshape(k, Ks.shape[1], a * b)
+        flat[:, :, rows] += np.moveaxis(y, 2, 1)
+    return out
 
 
 def _polys(terms, s, X) -> np.ndarray:
@@ -294,17 +315,17 @@ def _solve(st: LoopStack, idx, s, Ks, breaks: bool):
     M = sF ** 2 * np.eye(nq) - sF * Gq[:, None] - Kq[:, None]
     for L, power in sens:
         if np.any(L):
-            M = M - _kmul(Pbar, L, Ks * s[None, :] ** power)
+            _kmul(-Pbar, L, Ks * s[None, :] ** power, M)
+    shape = M.shape[:2] + (nq, st.Ad.shape[2] if breaks else st.Sw.shape[2])
     if breaks:
-        rhs = np.broadcast_to(np.matmul(Bq, st.Ad[idx])[:, None], M.shape[:2] + (nq, st.Ad.shape[2]))
+        rhs = np.broadcast_to(np.matmul(Bq, st.Ad[idx])[:, None], shape).astype(complex)
     else:
-        rhs = _kmul(Pbar, st.Sw[idx], Ks) + np.matmul(Bq, st.Aw[idx])[:, None]
-    return np.linalg.solve(M, rhs.astype(complex)), sens, pieces
+        rhs = _kmul(Pbar, st.Sw[idx], Ks, np.broadcast_to(np.matmul(Bq, st.Aw[idx])[:, None], shape).astype(complex))
+    return np.linalg.solve(M, rhs), sens, pieces
 
 
-def noise_response(st: LoopStack, idx, f) -> np.ndarray:
-    """The closed-loop transfer functions G (k, 46, 58, F) from the noise inputs (:data:`NOISE_INPUTS`) to the
-    outputs (:func:`~tqdyn.closedloop.loop.output_names`) of the loops ``idx`` at ``f`` (F,) [Hz]."""
+def _response(st: LoopStack, idx, f) -> np.ndarray:
+    """:func:`noise_response` with the frequency second: (k, F, 46, 58)."""
     idx = np.atleast_1d(np.asarray(idx))
     s = 2j * math.pi * np.asarray(f, dtype=np.float64)
     Ks = controller_response(st, s)
@@ -312,9 +333,14 @@ def noise_response(st: LoopStack, idx, f) -> np.ndarray:
     c = Ks.T[None, :, :, None] * (_polys(sens, s, q) + st.Sw[idx][:, None])          # (k, F, 17, 58)
     u = _lmul(st.Ac[idx], c) + st.Aw[idx][:, None]                                   # (k, F, 32, 58)
     Oy = st.Oy[idx]
-    z = _polys([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, q) \
-        + _lmul(np.matmul(Oy, Dp) + st.Ou[idx], u)                                  # (k, F, 46, 58)
-    return np.moveaxis(z, 1, 3)
+    return _polys([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, q) \
+        + _lmul(np.matmul(Oy, Dp) + st.Ou[idx], u)
+
+
+def noise_response(st: LoopStack, idx, f) -> np.ndarray:
+    """The closed-loop transfer functions G (k, 46, 58, F) from the noise inputs (:data:`NOISE_INPUTS`) to the
+    outputs (:func:`~tqdyn.closedloop.loop.output_names`) of the loops ``idx`` at ``f`` (F,) [Hz]."""
+    return np.moveaxis(_response(st, idx, f), 1, 3)
 
 
 def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
@@ -325,14 +351,15 @@ def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
     idx = np.atleast_1d(np.asarray(idx))
     out = np.empty((len(idx), len(output_names()), len(sources), len(f)))
     for part in _chunks(len(idx), len(f) * len(NOISE_INPUTS) * 52):
-        G = noise_response(st, idx[list(part)], f)
+        z = _response(st, idx[list(part)], f)                                       # (k, F, 46, 58)
+        p2 = z.real ** 2 + z.imag ** 2
         k = 0
         for src in SOURCES:
             n = SOURCES[src][0]
             if src in noise:
-                g = G[:, :, k:k + n, :]
-                p2 = np.sum(g.real ** 2 + g.imag ** 2, axis=2)
-                out[part.start:part.stop, :, sources.index(src), :] = np.sqrt(p2) * noise[src].asd(f)[None, None]
+                ps = np.sum(p2[:, :, :, k:k + n], axis=3)                                # (k, F, 46)
+                out[part.start:part.stop, :, sources.index(src), :] = np.moveaxis(np.sqrt(ps), 1, 2) \
+                    * noise[src].asd(f)[None, None]
             k += n
     return out, sources
 
