@@ -38,7 +38,7 @@ def _loop(mission):
                              default_controllers(mission), scheme=MISSION_SCHEME[mission])
 
 
-@pytest.mark.parametrize("fs", [FS, 1.0])
+@pytest.mark.parametrize("fs", [FS, pytest.param(1.0, marks=pytest.mark.slow)])  # 1 Hz: slow, 4 Hz its counterpart
 def test_the_series_spectrum_is_the_budget_for_every_output_of_every_mission(fs, record_number):
     """The exact one-sided PSD of what simulate realises (series_psd: the low band's discrete transfer
     functions, the high band's FIR filters) over the continuous budget, every time-domain output of the
