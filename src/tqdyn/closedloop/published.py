@@ -5,7 +5,7 @@ Every entry of :data:`PUBLISHED` is (value, source); the sources were read at th
 the abstract: the papers' bodies, tables and figures were not available), and src/tqdyn/data/SOURCES.md
 ("Closed-loop defaults") lists the same table.  What no source read here gives stays at the v0.3 value
 (:mod:`tqdyn.closedloop.missions`, marked *assumption* there); no value is chosen to make a budget pass.
-docs/closed-loop-validation.md (section 6) evaluates both presets against the requirements.
+docs/closed-loop-validation.md (section 7) evaluates both presets against the requirements.
 
 Units: SI; ASDs one-sided, ``(level [unit/Hz^1/2], knees ((f [Hz], slope), ...))`` as
 :class:`tqdyn.closedloop.noise.AsdModel`.
