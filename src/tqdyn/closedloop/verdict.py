@@ -15,7 +15,7 @@ the mission's requirement (:func:`tqdyn.closedloop.missions.requirement`) over a
   total to meet the requirement, ``max_f sqrt(P_loop / (P_req - P_tm_force))`` (P the power ASD^2), over
   the frequencies where the floor leaves room (P_tm_force < P_req).
 
-docs/closed-loop-validation.md (section 6) quotes these numbers for both presets of ``closed_loop.defaults``.
+docs/closed-loop-validation.md (section 7) quotes these numbers for both presets of ``closed_loop.defaults``.
 """
 
 from __future__ import annotations
