@@ -113,6 +113,22 @@ def _load(source, overrides):
     return _od._scenario(source, over)
 
 
+def _groups(estimate, consider, a_priori, groups, cli: bool) -> tuple:
+    """(estimated groups, considered groups, {group: a priori sigma}) of the arguments, each falling back to
+    ``groups`` (a Tracking's ``(estimate, consider, a_priori_sigma)``, or None) when not given; ValueError
+    (one line) for a considered group without an a priori sigma."""
+    from ..od.tracking import check_consider
+
+    est_names = _od.parse_names(estimate, _opt("estimate", cli))
+    con_names = _od.parse_names(consider, _opt("consider", cli))
+    sig = _od.parse_a_priori(a_priori, _opt("a_priori", cli))
+    if groups is not None:
+        est_names, con_names = est_names or tuple(groups[0] or ()), con_names or tuple(groups[1])
+        sig = sig or dict(groups[2] or {})
+    check_consider(con_names, sig, _opt("consider", cli), _opt("a_priori", cli) + " {g}=SIGMA")
+    return est_names, con_names, sig
+
+
 def _plan(tracking, arc, interval, stations, cli: bool):
     """(kinds, arc_s, interval_s, stations, groups) of ``tracking``: kinds (``"gnss,slr"`` or a
     sequence) with ``arc`` [s or "7d"], or a ``tqdyn.od.problem.Tracking`` (then without arc,
@@ -283,16 +299,7 @@ def fit(scenario, fields: dict, info: dict, tracking=None, *, estimate=None, con
             kinds = tuple(tracking.kinds)
         else:
             kinds = _od.parse_tracking(tracking, _opt("tracking", cli))
-    est_names = _od.parse_names(estimate, _opt("estimate", cli))
-    con_names = _od.parse_names(consider, _opt("consider", cli))
-    sig = _od.parse_a_priori(a_priori, _opt("a_priori", cli))
-    if groups is not None:
-        est_names, con_names = est_names or tuple(groups[0] or ()), con_names or tuple(groups[1])
-        sig = sig or dict(groups[2] or {})
-    for g in con_names:
-        if g not in sig:
-            raise ValueError(f"{_opt('consider', cli)}: {g!r} needs an a priori sigma; allowed: with "
-                             f"{_opt('a_priori', cli)} {g}=SIGMA")
+    est_names, con_names, sig = _groups(estimate, consider, a_priori, groups, cli)
     if edit_sigma is not None and (isinstance(edit_sigma, bool) or not isinstance(edit_sigma, (int, float))
                                    or not edit_sigma > 0):
         raise ValueError(f"{_opt('edit_sigma', cli)}: {edit_sigma!r} is not allowed; allowed: a number > 0")
@@ -391,16 +398,7 @@ def covariance(scenario, tracking, arc=None, *, interval=None, estimate=None, co
     say = progress or (lambda stage: None)
     kinds, arc_s, interval_s, station_names, groups = _plan(tracking, arc, interval, stations, cli)
     sp3_paths = _od._sp3_paths(sp3, kinds)
-    est_names = _od.parse_names(estimate, _opt("estimate", cli))
-    con_names = _od.parse_names(consider, _opt("consider", cli))
-    sig = _od.parse_a_priori(a_priori, _opt("a_priori", cli))
-    if groups is not None:
-        est_names, con_names = est_names or tuple(groups[0] or ()), con_names or tuple(groups[1])
-        sig = sig or dict(groups[2] or {})
-    for g in con_names:
-        if g not in sig:
-            raise ValueError(f"{_opt('consider', cli)}: {g!r} needs an a priori sigma; allowed: with "
-                             f"{_opt('a_priori', cli)} {g}=SIGMA")
+    est_names, con_names, sig = _groups(estimate, consider, a_priori, groups, cli)
     if ready is not None:
         ready()
     scen, notes, label = _load(scenario, overrides)
