@@ -13,15 +13,13 @@ exit status 2, nothing written, for a campaign with no seeds).
 from __future__ import annotations
 
 import json
-import os
-import signal
-import time
 
 import numpy as np
 import pytest
 from scipy import stats
 
 from cli_support import run_cli
+from dask_support import kill_a_busy_worker
 from tqdyn.workflows import od_campaign as oc
 from tqdyn.workflows.sweep import read_sweep_netcdf
 
@@ -80,17 +78,7 @@ def test_recovery_chi_square_over_20_seeds(twenty, record_number):
 def _killer(client, state):
     """progress: at the first finished member, SIGKILL a worker process that is running a member."""
     def progress(member, res):
-        if state.get("killed"):
-            return
-        t0 = time.time()
-        while time.time() - t0 < 10:
-            busy = [w for w, keys in client.processing().items() if keys]
-            if busy:
-                pids = client.run(os.getpid, workers=[busy[0]])
-                os.kill(pids[busy[0]], signal.SIGKILL)
-                state["killed"] = busy[0]
-                return
-            time.sleep(0.05)
+        kill_a_busy_worker(client, state)
     return progress
 
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 import socket
 import subprocess
 import time
@@ -26,6 +25,7 @@ import pytest
 import xarray as xr
 
 from cli_support import run_cli
+from dask_support import kill_a_busy_worker
 from test_sweep import SIX_DIRECTIONS, _CHEAP, _toml_list
 from tqdyn.workflows import sweep as sw
 
@@ -231,17 +231,7 @@ def test_sweep_on_a_tls_cluster(tmp_path, capsys):
 def _killer(client, state):
     """progress callback: at the first finished member, SIGKILL a worker process that is running a member."""
     def progress(outcome):
-        if state.get("killed"):
-            return
-        t0 = time.time()
-        while time.time() - t0 < 10:
-            busy = [w for w, keys in client.processing().items() if keys]
-            if busy:
-                pids = client.run(os.getpid, workers=[busy[0]])
-                os.kill(pids[busy[0]], signal.SIGKILL)
-                state["killed"] = busy[0]
-                return
-            time.sleep(0.05)
+        kill_a_busy_worker(client, state)
     return progress
 
 
