@@ -56,8 +56,10 @@ def test_vectorised_budget_equals_the_per_segment_evaluation(loops):
     """noise_asd (20 x 20 solves in the plant's coordinates, all loops at once) against noise_budget (an LU
     solve of each loop's 74-state space at each frequency): every output and source agrees to 2e-8 of the
     output's total at that frequency (measured 8e-9 at TianQin's low frequencies, 6e-12 at the median), but
-    the outputs the LU evaluation computes by cancellation (_CANCELLING: measured up to 1.5e-7), which agree
-    to 1e-6."""
+    the outputs the LU evaluation computes by cancellation (_CANCELLING), which agree to 1e-5: the MOSA torques'
+    LU error is ~1e-22 N m/Hz^1/2 absolute at 10 uHz (cancellation), against a total there of 3e-17 (LISA) to
+    6e-17 (TianQin) N m/Hz^1/2 with the published preset's flat DWS noise (measured 3.4e-6 / 1.5e-6; v0.3's DWS
+    noise, rising as (2 mHz/f)^2, made the total 3e-13 and the ratio 5e-10)."""
     mission, st, cl = loops
     noise = default_noise(mission)
     new, src = frequency.noise_asd(st, [0], noise, F)
@@ -67,7 +69,7 @@ def test_vectorised_budget_equals_the_per_segment_evaluation(loops):
     err = np.max(np.abs(new[0] - old) / total, axis=(1, 2))
     names = output_names()
     for o, e in zip(names, err):
-        assert e <= (1e-6 if o in _CANCELLING else 2e-8), (o, e)
+        assert e <= (1e-5 if o in _CANCELLING else 2e-8), (o, e)
 
 
 def test_relative_acceleration_is_s2_times_the_displacement(loops):

@@ -71,11 +71,19 @@ def test_closed_loop_poles_from_the_matrices(tianqin):
     assert np.max(ev2.real) < -k.shift
     # the same spectrum: the poles beyond 1e-2 rad/s one by one (to 1e-6); the clusters near -eps, -2 eps and the
     # TMs' 1e-3 rad/s (nearly repeated poles, each sensitive as the m-th root of a rounding error) by their
-    # number and their mean (the trace of the invariant subspace: well conditioned)
+    # number and their mean (the trace of the invariant subspace: its first-order sensitivity to a perturbation
+    # dA is ||dA|| ||P|| / n, P the cluster's spectral projector; the two constructions and the eigenvalue solver
+    # differ by a few tens of eps ||A||: bound 30 eps ||A|| ||P|| / n, ~1e-8 here; measured 2.3e-9 with the
+    # published 1.1e-3 cross-talk, 1.7e-10 with 1e-3)
     e1, e2 = np.sort_complex(ev), np.sort_complex(ev2)
     far1, far2 = np.abs(e1) > 1e-2, np.abs(e2) > 1e-2
     assert np.array_equal(far1, far2) and np.allclose(e2[far2], e1[far1], rtol=1e-6)
-    assert abs(np.mean(e1[~far1]) - np.mean(e2[~far2])) < 1e-9
+    A2 = sys.A[np.ix_(kp, kp)]
+    w, V = np.linalg.eig(A2)
+    near = np.abs(w) <= 1e-2
+    proj = np.linalg.norm(V[:, near] @ np.linalg.inv(V)[near, :], 2)
+    tol = 30 * np.finfo(float).eps * np.linalg.norm(A2, 2) * proj / np.count_nonzero(near)
+    assert abs(np.mean(e1[~far1]) - np.mean(e2[~far2])) < tol
 
 
 def test_gamma_is_the_norm_of_the_weighted_closed_loop(tianqin):

@@ -43,9 +43,11 @@ _YEAR = 365.25 * 86400.0                                    # s
 
 #: Plant values (scenario keys of [closed_loop.plant]; SOURCES.md).
 _PLANT = {
-    "lpf": dict(sc_mass=422.7, sc_inertia=(151.7, 151.7, 233.0), tm_mass=1.928, tm_side=0.046, mosa_inertia=1.0,
+    # inertia about X_S (the TM line), Y_S, Z_S (the Sun line) and the actuation cross-talk (worst case): the LPF
+    # DFACS External ICD (S2-ASD-ICD-2011 Iss14) as typed in the LTPDA toolbox's ltp_parameters.m
+    "lpf": dict(sc_mass=422.7, sc_inertia=(202.5, 209.7, 191.7), tm_mass=1.928, tm_side=0.046, mosa_inertia=1.0,
                 mosa_stiffness=0.0, stiffness=(-1.3e-6, -1.3e-6, -1.3e-6), tm2_stiffness=(-2.0e-6, -2.0e-6, -2.0e-6),
-                rotational_stiffness=(-1e-6, -1e-6, -1e-6), crosstalk=1e-3, tm_separation=0.376),
+                rotational_stiffness=(-1e-6, -1e-6, -1e-6), crosstalk=1.1e-3, tm_separation=0.376),
     "tianqin-1": dict(sc_mass=35.0, sc_inertia=(1.266, 1.240, 1.427), tm_mass=0.1, tm_side=0.03, mosa_inertia=1.0,
                       mosa_stiffness=0.0, stiffness=(-1e-6, -1e-6, -1e-6), rotational_stiffness=(-1e-6, -1e-6, -1e-6),
                       crosstalk=1e-3, tm_separation=0.0),

@@ -24,7 +24,7 @@ from .flown import (flown_controllers, flown_noise, flown_plant, flown_plant_par
                     flown_working_point)
 from .noise import AsdModel
 from .plant import PlantParameters, WorkingPoint, plant_parameters
-from .published import published_noise_levels
+from .published import published_noise_levels, published_plant_values
 
 __all__ = ["CONSTELLATION_MISSIONS", "MISSIONS", "SINGLE_SPACECRAFT_MISSIONS", "controller_from_keys",
            "default_controllers", "default_noise", "default_plant", "representative_plant",
@@ -61,12 +61,16 @@ def default_plant(mission: str, defaults: str = DEFAULTS[0]) -> dict:
     """The [closed_loop.plant] defaults of ``mission`` (keys of :class:`tqdyn.closedloop.plant.PlantParameters`
     that are not geometry): masses [kg], inertias [kg m^2], tm_side [m], stiffness [s^-2], crosstalk [1]; the
     single-spacecraft missions also tm2_stiffness [s^-2] and tm_separation [m] (their geometry).  ``defaults``:
-    a preset of :data:`~tqdyn.scenario.closed_loop.DEFAULTS` (the two agree on the plant: no published value of
-    the stiffness, cross-talk or spacecraft inertia was found, SOURCES.md)."""
+    a preset of :data:`~tqdyn.scenario.closed_loop.DEFAULTS`; ``"published"`` differs from ``"v0.3"`` only in the
+    actuation cross-talk (LISA Pathfinder's design value, :func:`tqdyn.closedloop.published.published_plant_values`;
+    no published stiffness or spacecraft inertia of these missions was found, SOURCES.md)."""
     _check(mission, defaults)
     if mission in SINGLE_SPACECRAFT_MISSIONS:
         return flown_plant(mission)
-    return {**_COMMON_PLANT, **_PLANT[mission]}
+    out = {**_COMMON_PLANT, **_PLANT[mission]}
+    if defaults == "published":
+        out.update(published_plant_values(mission))
+    return out
 
 
 def requirement(mission: str) -> AsdModel:
@@ -84,7 +88,7 @@ def requirement(mission: str) -> AsdModel:
 
 def default_noise(mission: str, defaults: str = DEFAULTS[0]) -> dict:
     """{source: AsdModel} defaults of ``mission`` (one-sided ASDs; units of :data:`tqdyn.closedloop.loop.SOURCES`).
-    ``defaults="published"``: the TM force noise, thrust and thruster-torque noise of
+    ``defaults="published"``: the TM force noise, thrust, thruster-torque and DWS noise of
     :func:`tqdyn.closedloop.published.published_noise_levels` over v0.3's; ``"v0.3"``: version 0.3's values
     (the TM force noise equal to the requirement)."""
     _check(mission, defaults)
