@@ -53,6 +53,7 @@ from numba import njit
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.doodson import delaunay_multipliers, doodson_multipliers
 from .constants import J2000_JD
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "DAYS_PER_JULIAN_CENTURY",
@@ -148,7 +149,7 @@ def tidal_phase(beta, multipliers) -> np.ndarray:
     return beta @ mult.T
 
 
-@njit(cache=True)
+@inner_kernel
 def _exp_powers(beta_row, pmax, pr, pi_):
     """pr[k, pmax + p] + i pi_[k, pmax + p] = exp(i p beta_row[k]) for
     p = -pmax..pmax (by repeated multiplication; negative p by conjugation)."""
@@ -165,7 +166,7 @@ def _exp_powers(beta_row, pmax, pr, pi_):
             pi_[k, pmax - p] = -pi_[k, pmax + p]
 
 
-@njit(cache=True)
+@inner_kernel
 def _phase(pr, pi_, pmax, mult, f):
     """(cos, sin) of theta_f = sum_k mult[f, k] beta_k from the powers of
     exp(i beta_k) tabulated by :func:`_exp_powers`."""

@@ -25,6 +25,7 @@ from numba import njit
 from ..forces.model import ForceModel
 from ..numerics import dp87
 from ..numerics.dd import add, copy_columns, ld, mul, st
+from ..numerics.jit import kernel
 from . import layout as _lay
 from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
@@ -82,7 +83,7 @@ def _steps(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, p
 # picks the run's).
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                  cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
     """n_steps fixed DP87 steps of the coupled constellation.  Before step n
@@ -93,7 +94,7 @@ def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, 
            cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _fixed_chunk_points(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                         cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
     """:func:`_fixed_chunk` for independent point masses (fw None)."""

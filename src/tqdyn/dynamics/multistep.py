@@ -37,6 +37,7 @@ from numba import njit
 from ..numerics import dp87
 from ..numerics import multistep as _ms
 from ..numerics.dd import copy_columns
+from ..numerics.jit import kernel
 from . import layout as _lay
 from .fixed import (CheckpointClock, _as_precision, _grid_times, _workspace, chunk_kernel, chunk_plan, deliver_rows,
                     input_pipeline, warm_up_systems)
@@ -88,7 +89,7 @@ def _steps(rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_
     head[0] = h
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
                      layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
     """n_steps steps P(EC)^n_corr [E] of the coupled constellation: predict,
@@ -104,7 +105,7 @@ def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stat
            params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _multistep_chunk_points(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
                             params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
     """:func:`_multistep_chunk` for independent point masses (fw None)."""

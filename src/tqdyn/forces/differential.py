@@ -70,6 +70,7 @@ from .earth import PARAM_HEADER as _EF_HEADER
 from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
 from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, float64_terms
 from .third_body import pm_difference
+from ..numerics.jit import inner_kernel
 
 __all__ = ["pm_difference", "quadrupole_jacobian_product", "direct_terms", "differential_gravity",
            "MOON_DEGREE_DG"]
@@ -110,7 +111,7 @@ def quadrupole_jacobian_product(k, mxx, myy, mzz, mxy, mxz, myz, x, y, z, dx, dy
             s1 * md_z - s2 * mz - s3 * z - s4 * dz + s5 * z)
 
 
-@njit(cache=True)
+@inner_kernel
 def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     """Sum [m/s^2] of the terms whose differences :func:`differential_gravity`
     takes directly in float64, apart from the Earth field: the list of
@@ -121,7 +122,7 @@ def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     return float64_terms(0.0, 0.0, 0.0, rx, ry, rz, vx, vy, vz, tdat, params, layout, dynamic(MOON_DEGREE_DG))
 
 
-@njit(cache=True)
+@inner_kernel
 def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey, ez, sx, sy, sz,
                          tdat, params, layout):
     """a(r + d, v + u) - a(r, v) [m/s^2] of the force model (see the module

@@ -46,6 +46,7 @@ from .moon import MoonField, moon_field_accel, moon_field_direct
 from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
+from ..numerics.jit import inner_kernel
 
 __all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity", "gravity_split", "SLOTS"]
 
@@ -270,7 +271,7 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     return ax, ay, az
 
 
-@njit(cache=True)
+@inner_kernel
 def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
     and velocity (vx, vy, vz) [m/s] relative to the central body, in the
@@ -328,7 +329,7 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
 
 
-@njit(cache=True)
+@inner_kernel
 def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon_degree):
     """(px, py, pz) plus the force terms evaluated in float64 at the point itself [m/s^2], in this
     order: the Moon's field, the Sun's J2, relativity (IERS 2010 eq. 10.12), the central body's J2,
