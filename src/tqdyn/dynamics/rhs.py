@@ -445,5 +445,5 @@ def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: n
     k = np.zeros_like(y)
     cpar = make_cpar(MODE_POINT_MASS) if cpar is None else cpar
     gw, fw, aux = workspace(y, cpar)
-    system_rhs(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
+    system_rhs(y, tdat_row, model.params, model.kernel_layout, cpar, k, aux, gw, fw)
     return (k, aux) if with_aux else k

@@ -28,12 +28,13 @@ differential gravity differences too).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
-from ..numerics.jit import dynamic
+from ..numerics.jit import OVERLOAD_OPTIONS, dynamic, inner_kernel
 from .body_gms import body_gms
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
@@ -46,9 +47,9 @@ from .moon import MoonField, moon_field_accel, moon_field_direct
 from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
-from ..numerics.jit import inner_kernel
 
-__all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity", "gravity_split", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "call_term", "describe_terms", "float64_terms", "gravity",
+           "gravity_split", "slot_table", "SLOTS"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -84,6 +85,10 @@ class ForceModel:
     params: (n_params,) float64, the terms' parameters concatenated.
     layout: (n_slots, 3) int64; row s = (enabled, parameter offset, tdat
         column offset) of slot s.
+    kernel_layout: the ``layout`` the propagation passes to the compiled
+        functions: (layout, on), on[s] True for an enabled slot s and None
+        for one that is off, so that only the enabled terms are compiled
+        (:func:`call_term`); the table alone compiles every term.
     n_tdat: total number of time-only input columns.
     eop: the :class:`~tqdyn.astro.eop.EOP` table the Earth's orientation
         uses (None: no EOP); eop_source: its name ("auto", "c04-14", ...,
@@ -109,6 +114,7 @@ class ForceModel:
             t_off += term.n_tdat
         self.params = np.concatenate(params) if params else np.zeros(0)
         self.n_tdat = t_off
+        self.kernel_layout = (self.layout, tuple(True if row[0] else None for row in self.layout))
 
     @property
     def time_dependent(self) -> bool:
@@ -260,6 +266,34 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     return ForceModel(terms, reference)
 
 
+def slot_table(layout):
+    """The (n_slots, 3) int64 table of ``layout``: :attr:`ForceModel.layout`
+    itself or the table of :attr:`ForceModel.kernel_layout` (compiled code only)."""
+
+
+@overload(slot_table, jit_options=OVERLOAD_OPTIONS)
+def _ov_slot_table(layout):
+    if isinstance(layout, types.Array):
+        return lambda layout: layout
+    return lambda layout: layout[0]
+
+
+def call_term(layout, slot, fn, *args):
+    """``fn(*args)``: the float64 acceleration (ax, ay, az) [m/s^2] of the
+    term in slot ``slot`` (a constant) -- compiled only if the term can be
+    on: with the :attr:`ForceModel.kernel_layout` of a model without it,
+    ``fn`` is not compiled and the call gives (0.0, 0.0, 0.0) (the caller
+    checks the table at run time, as for ``layout`` alone).  Compiled code only."""
+
+
+@overload(call_term, jit_options=OVERLOAD_OPTIONS, prefer_literal=True)
+def _ov_call_term(layout, slot, fn, *args):
+    if (isinstance(layout, types.BaseTuple) and isinstance(slot, types.IntegerLiteral)
+            and isinstance(layout.types[1].types[slot.literal_value], types.NoneType)):
+        return lambda layout, slot, fn, *args: (0.0, 0.0, 0.0)
+    return lambda layout, slot, fn, *args: fn(*args)
+
+
 @njit(cache=True, inline="always")
 def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
@@ -284,14 +318,15 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     field's float64 kernel (zero without that term), which the differential
     gravity of the test masses reuses (:mod:`tqdyn.forces.differential`).
     """
+    tab = slot_table(layout)
     zero = mul(x, 0.0)
     ax, ay, az = zero, zero, zero
-    if layout[SLOT_EARTH_MONOPOLE, 0]:
-        o = layout[SLOT_EARTH_MONOPOLE, 1]
+    if tab[SLOT_EARTH_MONOPOLE, 0]:
+        o = tab[SLOT_EARTH_MONOPOLE, 1]
         gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
         ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    if layout[SLOT_THIRD_BODY, 0]:
-        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+    if tab[SLOT_THIRD_BODY, 0]:
+        o, c = tab[SLOT_THIRD_BODY, 1], tab[SLOT_THIRD_BODY, 2]
         n = int(params[o])
         for k in range(n):
             if params[o + 1 + n + k] != 0.0:  # this body in extended precision
@@ -299,8 +334,8 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
                                                   tdat[c + 3 * k + 2], params[o + 1 + k], tdat[c + 3 * (n + k)],
                                                   tdat[c + 3 * (n + k) + 1], tdat[c + 3 * (n + k) + 2])
                 ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    if layout[SLOT_EARTH_FIELD, 0]:
-        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
+    if tab[SLOT_EARTH_FIELD, 0]:
+        o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
         ld = int(params[o + 2]) + 1
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 in extended precision
             gx, gy, gz = degree2_accel_ext(x, y, z, tdat[c:], params[o:])
@@ -313,17 +348,19 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     ux, uy, uz = to_f64(vx), to_f64(vy), to_f64(vz)
     px, py, pz = 0.0, 0.0, 0.0
     ex, ey, ez = 0.0, 0.0, 0.0
-    if layout[SLOT_THIRD_BODY, 0]:
-        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+    if tab[SLOT_THIRD_BODY, 0]:
+        o, c = tab[SLOT_THIRD_BODY, 1], tab[SLOT_THIRD_BODY, 2]
         gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EARTH_FIELD, 0]:
-        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
-        ex, ey, ez = earth_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+    if tab[SLOT_EARTH_FIELD, 0]:
+        o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
+        ex, ey, ez = call_term(layout, SLOT_EARTH_FIELD, earth_field_accel, rx, ry, rz, ux, uy, uz, tdat[c:],
+                               params[o:])
         px, py, pz = px + ex, py + ey, pz + ez
-    if layout[SLOT_EARTH_FIELD_INDIRECT, 0]:
-        o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
-        gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+    if tab[SLOT_EARTH_FIELD_INDIRECT, 0]:
+        o, c = tab[SLOT_EARTH_FIELD_INDIRECT, 1], tab[SLOT_EARTH_FIELD_INDIRECT, 2]
+        gx, gy, gz = call_term(layout, SLOT_EARTH_FIELD_INDIRECT, earth_field_indirect_accel, rx, ry, rz, ux, uy, uz,
+                                 tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, dynamic(-1))
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
@@ -342,31 +379,38 @@ def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon
     (:func:`~tqdyn.forces.moon.moon_field_accel`); >= 0: its degrees 2 .. moon_degree on the point
     alone (:func:`~tqdyn.forces.moon.moon_field_direct`; the Earth's term drops out of a
     difference).  float64; returns (x, y, z)."""
-    if layout[SLOT_MOON_FIELD, 0]:
-        o, c = layout[SLOT_MOON_FIELD, 1], layout[SLOT_MOON_FIELD, 2]
+    tab = slot_table(layout)
+    if tab[SLOT_MOON_FIELD, 0]:
+        o, c = tab[SLOT_MOON_FIELD, 1], tab[SLOT_MOON_FIELD, 2]
         if moon_degree < 0:
-            gx, gy, gz = moon_field_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+            gx, gy, gz = call_term(layout, SLOT_MOON_FIELD, moon_field_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
+                                   params[o:])
         else:
-            gx, gy, gz = moon_field_direct(rx, ry, rz, tdat[c:], params[o:], moon_degree)
+            gx, gy, gz = call_term(layout, SLOT_MOON_FIELD, moon_field_direct, rx, ry, rz, tdat[c:], params[o:],
+                                   moon_degree)
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_SUN_J2, 0]:
-        o, c = layout[SLOT_SUN_J2, 1], layout[SLOT_SUN_J2, 2]
-        gx, gy, gz = sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_SUN_J2, 0]:
+        o, c = tab[SLOT_SUN_J2, 1], tab[SLOT_SUN_J2, 2]
+        gx, gy, gz = call_term(layout, SLOT_SUN_J2, sun_j2_accel, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_RELATIVITY, 0]:
-        o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
-        gx, gy, gz = relativity_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_RELATIVITY, 0]:
+        o, c = tab[SLOT_RELATIVITY, 1], tab[SLOT_RELATIVITY, 2]
+        gx, gy, gz = call_term(layout, SLOT_RELATIVITY, relativity_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
+                               params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_CENTRAL_J2, 0]:
-        o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = central_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_CENTRAL_J2, 0]:
+        o, c = tab[SLOT_CENTRAL_J2, 1], tab[SLOT_CENTRAL_J2, 2]
+        gx, gy, gz = call_term(layout, SLOT_CENTRAL_J2, central_j2_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
+                               params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EIH, 0]:
-        o, c = layout[SLOT_EIH, 1], layout[SLOT_EIH, 2]
-        gx, gy, gz = heliocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_EIH, 0]:
+        o, c = tab[SLOT_EIH, 1], tab[SLOT_EIH, 2]
+        gx, gy, gz = call_term(layout, SLOT_EIH, heliocentric_eih_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
+                               params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EIH_GCRS, 0]:
-        o, c = layout[SLOT_EIH_GCRS, 1], layout[SLOT_EIH_GCRS, 2]
-        gx, gy, gz = geocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_EIH_GCRS, 0]:
+        o, c = tab[SLOT_EIH_GCRS, 1], tab[SLOT_EIH_GCRS, 2]
+        gx, gy, gz = call_term(layout, SLOT_EIH_GCRS, geocentric_eih_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
+                               params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     return px, py, pz

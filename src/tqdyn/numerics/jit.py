@@ -39,7 +39,7 @@ from numba.core.registry import CPUDispatcher
 from numba.core.typed_passes import NativeLowering
 from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
@@ -138,6 +138,10 @@ def dynamic(typingctx, x):
 
     return _types.unliteral(x)(x), codegen
 
+
+#: ``jit_options`` of tqdyn's numba overloads (called by compiled code only): no C wrapper (numba gives
+#: overloads no CPython wrapper already), which every caller would link in and optimise again.
+OVERLOAD_OPTIONS = {"no_cfunc_wrapper": True}
 
 #: Suffix of the qualified name of an inner kernel's Python entry (:class:`_InnerDispatcher`): its own
 #: cache files, apart from the inner kernel's (numba keys a cached kernel by name and argument types only).
