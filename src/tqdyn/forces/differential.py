@@ -67,8 +67,8 @@ from numba import njit
 from ..numerics.jit import dynamic
 
 from .earth import PARAM_HEADER as _EF_HEADER
-from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
-from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, call_term, float64_terms, slot_table
+from .earth import degree2_matrix, gcrs_from_itrs, itrs_from_gcrs
+from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, earth_field_term, float64_terms, slot_table
 from .third_body import pm_difference
 from ..numerics.jit import inner_kernel
 
@@ -153,8 +153,7 @@ def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey,
     wx, wy, wz = vx + ux, vy + uy, vz + uz
     if tab[SLOT_EARTH_FIELD, 0]:
         o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
-        fx, fy, fz = call_term(layout, SLOT_EARTH_FIELD, earth_field_accel, hx, hy, hz, wx, wy, wz, tdat[c:],
-                               params[o:])
+        fx, fy, fz = earth_field_term(layout, hx, hy, hz, wx, wy, wz, tdat[c:], params[o:])
         gx, gy, gz = gx + (fx - ex), gy + (fy - ey), gz + (fz - ez)
         ld = int(params[o + 2]) + 1
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 is not in the float64 field: midpoint Jacobian

@@ -22,7 +22,9 @@ kind, each switched on by the ``layout`` table built here.  Adding a term
 means adding its module, a slot constant and one branch in
 :func:`gravity_split` or, for a float64 term evaluated at the point alone,
 in :func:`float64_terms` (the one list of those, which the test masses'
-differential gravity differences too).
+differential gravity differences too); a float64 kernel is called through
+:func:`term_gate`, so that a propagation (which passes
+:attr:`ForceModel.kernel_layout`) compiles it only if its model enables it.
 """
 
 from __future__ import annotations
@@ -48,8 +50,8 @@ from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
 
-__all__ = ["ForceModel", "build_force_model", "call_term", "describe_terms", "float64_terms", "gravity",
-           "gravity_split", "slot_table", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity",
+           "gravity_split", "slot_table", "SLOTS", "term_gate"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -88,7 +90,7 @@ class ForceModel:
     kernel_layout: the ``layout`` the propagation passes to the compiled
         functions: (layout, on), on[s] True for an enabled slot s and None
         for one that is off, so that only the enabled terms are compiled
-        (:func:`call_term`); the table alone compiles every term.
+        (:func:`term_gate`); the table alone compiles every term.
     n_tdat: total number of time-only input columns.
     eop: the :class:`~tqdyn.astro.eop.EOP` table the Earth's orientation
         uses (None: no EOP); eop_source: its name ("auto", "c04-14", ...,
@@ -278,20 +280,36 @@ def _ov_slot_table(layout):
     return lambda layout: layout[0]
 
 
-def call_term(layout, slot, fn, *args):
-    """``fn(*args)``: the float64 acceleration (ax, ay, az) [m/s^2] of the
-    term in slot ``slot`` (a constant) -- compiled only if the term can be
-    on: with the :attr:`ForceModel.kernel_layout` of a model without it,
-    ``fn`` is not compiled and the call gives (0.0, 0.0, 0.0) (the caller
-    checks the table at run time, as for ``layout`` alone).  Compiled code only."""
+def term_gate(slot: int, kernel):
+    """``gate(layout, *args)``: ``kernel(*args)``, the float64 acceleration
+    (ax, ay, az) [m/s^2] of the term in slot ``slot``, compiled only if the
+    term can be on: given the :attr:`ForceModel.kernel_layout` of a model
+    without it, ``kernel`` is not compiled and the gate gives (0.0, 0.0, 0.0)
+    (the caller checks the table at run time, as for a layout table alone,
+    with which ``kernel`` is compiled).  Compiled code only."""
+    def gate(layout, *args):
+        raise TypeError("a force-term gate is called from compiled code only")
+
+    @overload(gate, jit_options=OVERLOAD_OPTIONS)
+    def _gate(layout, *args):
+        if isinstance(layout, types.BaseTuple) and isinstance(layout.types[1].types[slot], types.NoneType):
+            return lambda layout, *args: (0.0, 0.0, 0.0)
+        return lambda layout, *args: kernel(*args)
+
+    gate.__name__ = gate.__qualname__ = f"{kernel.__name__}_gate"
+    gate.__doc__ = f":func:`term_gate` of ``{kernel.__name__}`` (slot {slot})."
+    return gate
 
 
-@overload(call_term, jit_options=OVERLOAD_OPTIONS, prefer_literal=True)
-def _ov_call_term(layout, slot, fn, *args):
-    if (isinstance(layout, types.BaseTuple) and isinstance(slot, types.IntegerLiteral)
-            and isinstance(layout.types[1].types[slot.literal_value], types.NoneType)):
-        return lambda layout, slot, fn, *args: (0.0, 0.0, 0.0)
-    return lambda layout, slot, fn, *args: fn(*args)
+earth_field_term = term_gate(SLOT_EARTH_FIELD, earth_field_accel)
+_indirect_term = term_gate(SLOT_EARTH_FIELD_INDIRECT, earth_field_indirect_accel)
+_moon_term = term_gate(SLOT_MOON_FIELD, moon_field_accel)
+_moon_direct_term = term_gate(SLOT_MOON_FIELD, moon_field_direct)
+_sun_j2_term = term_gate(SLOT_SUN_J2, sun_j2_accel)
+_relativity_term = term_gate(SLOT_RELATIVITY, relativity_accel)
+_central_j2_term = term_gate(SLOT_CENTRAL_J2, central_j2_accel)
+_eih_term = term_gate(SLOT_EIH, heliocentric_eih_accel)
+_eih_gcrs_term = term_gate(SLOT_EIH_GCRS, geocentric_eih_accel)
 
 
 @njit(cache=True, inline="always")
@@ -354,13 +372,11 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EARTH_FIELD, 0]:
         o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
-        ex, ey, ez = call_term(layout, SLOT_EARTH_FIELD, earth_field_accel, rx, ry, rz, ux, uy, uz, tdat[c:],
-                               params[o:])
+        ex, ey, ez = earth_field_term(layout, rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + ex, py + ey, pz + ez
     if tab[SLOT_EARTH_FIELD_INDIRECT, 0]:
         o, c = tab[SLOT_EARTH_FIELD_INDIRECT, 1], tab[SLOT_EARTH_FIELD_INDIRECT, 2]
-        gx, gy, gz = call_term(layout, SLOT_EARTH_FIELD_INDIRECT, earth_field_indirect_accel, rx, ry, rz, ux, uy, uz,
-                                 tdat[c:], params[o:])
+        gx, gy, gz = _indirect_term(layout, rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, dynamic(-1))
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
@@ -383,34 +399,28 @@ def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon
     if tab[SLOT_MOON_FIELD, 0]:
         o, c = tab[SLOT_MOON_FIELD, 1], tab[SLOT_MOON_FIELD, 2]
         if moon_degree < 0:
-            gx, gy, gz = call_term(layout, SLOT_MOON_FIELD, moon_field_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
-                                   params[o:])
+            gx, gy, gz = _moon_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         else:
-            gx, gy, gz = call_term(layout, SLOT_MOON_FIELD, moon_field_direct, rx, ry, rz, tdat[c:], params[o:],
-                                   moon_degree)
+            gx, gy, gz = _moon_direct_term(layout, rx, ry, rz, tdat[c:], params[o:], moon_degree)
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_SUN_J2, 0]:
         o, c = tab[SLOT_SUN_J2, 1], tab[SLOT_SUN_J2, 2]
-        gx, gy, gz = call_term(layout, SLOT_SUN_J2, sun_j2_accel, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _sun_j2_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_RELATIVITY, 0]:
         o, c = tab[SLOT_RELATIVITY, 1], tab[SLOT_RELATIVITY, 2]
-        gx, gy, gz = call_term(layout, SLOT_RELATIVITY, relativity_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
-                               params[o:])
+        gx, gy, gz = _relativity_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_CENTRAL_J2, 0]:
         o, c = tab[SLOT_CENTRAL_J2, 1], tab[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = call_term(layout, SLOT_CENTRAL_J2, central_j2_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
-                               params[o:])
+        gx, gy, gz = _central_j2_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EIH, 0]:
         o, c = tab[SLOT_EIH, 1], tab[SLOT_EIH, 2]
-        gx, gy, gz = call_term(layout, SLOT_EIH, heliocentric_eih_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
-                               params[o:])
+        gx, gy, gz = _eih_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EIH_GCRS, 0]:
         o, c = tab[SLOT_EIH_GCRS, 1], tab[SLOT_EIH_GCRS, 2]
-        gx, gy, gz = call_term(layout, SLOT_EIH_GCRS, geocentric_eih_accel, rx, ry, rz, vx, vy, vz, tdat[c:],
-                               params[o:])
+        gx, gy, gz = _eih_gcrs_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
     return px, py, pz
