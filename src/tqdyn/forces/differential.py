@@ -153,7 +153,7 @@ def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey,
     wx, wy, wz = vx + ux, vy + uy, vz + uz
     if tab[SLOT_EARTH_FIELD, 0]:
         o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
-        fx, fy, fz = earth_field_term(layout, hx, hy, hz, wx, wy, wz, tdat[c:], params[o:])
+        fx, fy, fz = earth_field_term(layout, (hx, hy, hz, wx, wy, wz, tdat[c:], params[o:]))
         gx, gy, gz = gx + (fx - ex), gy + (fy - ey), gz + (fz - ez)
         ld = int(params[o + 2]) + 1
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 is not in the float64 field: midpoint Jacobian

@@ -281,20 +281,21 @@ def _ov_slot_table(layout):
 
 
 def term_gate(slot: int, kernel):
-    """``gate(layout, *args)``: ``kernel(*args)``, the float64 acceleration
-    (ax, ay, az) [m/s^2] of the term in slot ``slot``, compiled only if the
-    term can be on: given the :attr:`ForceModel.kernel_layout` of a model
-    without it, ``kernel`` is not compiled and the gate gives (0.0, 0.0, 0.0)
-    (the caller checks the table at run time, as for a layout table alone,
-    with which ``kernel`` is compiled).  Compiled code only."""
-    def gate(layout, *args):
+    """``gate(layout, args)``: ``kernel(*args)`` (args a tuple), the float64
+    acceleration (ax, ay, az) [m/s^2] of the term in slot ``slot``, compiled
+    only if the term can be on: given the :attr:`ForceModel.kernel_layout`
+    of a model without it, ``kernel`` is not compiled and the gate gives
+    (0.0, 0.0, 0.0) (the caller checks the table at run time, as for a
+    layout table alone, with which ``kernel`` is compiled).  Compiled code
+    only; inlined into the caller (no function of its own to compile)."""
+    def gate(layout, args):
         raise TypeError("a force-term gate is called from compiled code only")
 
-    @overload(gate, jit_options=OVERLOAD_OPTIONS)
-    def _gate(layout, *args):
+    @overload(gate, jit_options=OVERLOAD_OPTIONS, inline="always")
+    def _gate(layout, args):
         if isinstance(layout, types.BaseTuple) and isinstance(layout.types[1].types[slot], types.NoneType):
-            return lambda layout, *args: (0.0, 0.0, 0.0)
-        return lambda layout, *args: kernel(*args)
+            return lambda layout, args: (0.0, 0.0, 0.0)
+        return lambda layout, args: kernel(*args)
 
     gate.__name__ = gate.__qualname__ = f"{kernel.__name__}_gate"
     gate.__doc__ = f":func:`term_gate` of ``{kernel.__name__}`` (slot {slot})."
@@ -372,11 +373,11 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EARTH_FIELD, 0]:
         o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
-        ex, ey, ez = earth_field_term(layout, rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        ex, ey, ez = earth_field_term(layout, (rx, ry, rz, ux, uy, uz, tdat[c:], params[o:]))
         px, py, pz = px + ex, py + ey, pz + ez
     if tab[SLOT_EARTH_FIELD_INDIRECT, 0]:
         o, c = tab[SLOT_EARTH_FIELD_INDIRECT, 1], tab[SLOT_EARTH_FIELD_INDIRECT, 2]
-        gx, gy, gz = _indirect_term(layout, rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+        gx, gy, gz = _indirect_term(layout, (rx, ry, rz, ux, uy, uz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, dynamic(-1))
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
@@ -399,28 +400,28 @@ def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon
     if tab[SLOT_MOON_FIELD, 0]:
         o, c = tab[SLOT_MOON_FIELD, 1], tab[SLOT_MOON_FIELD, 2]
         if moon_degree < 0:
-            gx, gy, gz = _moon_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+            gx, gy, gz = _moon_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         else:
-            gx, gy, gz = _moon_direct_term(layout, rx, ry, rz, tdat[c:], params[o:], moon_degree)
+            gx, gy, gz = _moon_direct_term(layout, (rx, ry, rz, tdat[c:], params[o:], moon_degree))
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_SUN_J2, 0]:
         o, c = tab[SLOT_SUN_J2, 1], tab[SLOT_SUN_J2, 2]
-        gx, gy, gz = _sun_j2_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _sun_j2_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_RELATIVITY, 0]:
         o, c = tab[SLOT_RELATIVITY, 1], tab[SLOT_RELATIVITY, 2]
-        gx, gy, gz = _relativity_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _relativity_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_CENTRAL_J2, 0]:
         o, c = tab[SLOT_CENTRAL_J2, 1], tab[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = _central_j2_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _central_j2_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EIH, 0]:
         o, c = tab[SLOT_EIH, 1], tab[SLOT_EIH, 2]
-        gx, gy, gz = _eih_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _eih_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     if tab[SLOT_EIH_GCRS, 0]:
         o, c = tab[SLOT_EIH_GCRS, 1], tab[SLOT_EIH_GCRS, 2]
-        gx, gy, gz = _eih_gcrs_term(layout, rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+        gx, gy, gz = _eih_gcrs_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     return px, py, pz
