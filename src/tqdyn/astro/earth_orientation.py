@@ -66,7 +66,6 @@ from ..readers.iers_tables import load_tidal_eop_terms
 from .eop import EOP, tidal_arguments, tidal_eop_corrections
 from .eop_sources import DEFAULT_EOP_SOURCE, eop_table
 from .timescales import Epoch, tt_jd
-from ..numerics.jit import inner_kernel
 
 __all__ = ["GRID_POINTS", "GRID_STEP_S", "EarthOrientation", "earth_orientation", "gcrs_to_itrs", "itrs_to_gcrs"]
 
@@ -170,7 +169,7 @@ _DJ00 = 2451545.0
 _DAS2R = math.pi / 648000.0
 
 
-@inner_kernel
+@njit(cache=True)
 def _anp(a):
     w = np.fmod(a, _D2PI)
     if w < 0.0:

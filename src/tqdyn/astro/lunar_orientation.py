@@ -57,7 +57,6 @@ from .._choices import unknown
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.pck import IauMoonElements, LunarPaKernel, load_lunar_pa_kernel, read_iau_moon_elements
 from .constants import ARCSEC_RAD, J2000_JD
-from ..numerics.jit import inner_kernel
 
 __all__ = [
     "ARCSEC_RAD",
@@ -102,7 +101,7 @@ def _r3(a):
 T_PA_ME_DE421 = _r3(67.92 * ARCSEC_RAD) @ _r2(78.56 * ARCSEC_RAD) @ _r1(0.30 * ARCSEC_RAD)
 
 
-@inner_kernel
+@njit(cache=True)
 def _euler313_into(phi, theta, psi, pre, rot, i):
     """rot[i, :] = (pre @ R3(psi) R1(theta) R3(phi)) row-major, angles [rad],
     pre (3, 3) a constant left factor (the identity for none)."""

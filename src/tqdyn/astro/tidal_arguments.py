@@ -53,7 +53,6 @@ from numba import njit
 from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..readers.doodson import delaunay_multipliers, doodson_multipliers
 from .constants import J2000_JD
-from ..numerics.jit import inner_kernel
 
 __all__ = [
     "DAYS_PER_JULIAN_CENTURY",
@@ -149,7 +148,7 @@ def tidal_phase(beta, multipliers) -> np.ndarray:
     return beta @ mult.T
 
 
-@inner_kernel
+@njit(cache=True)
 def _exp_powers(beta_row, pmax, pr, pi_):
     """pr[k, pmax + p] + i pi_[k, pmax + p] = exp(i p beta_row[k]) for
     p = -pmax..pmax (by repeated multiplication; negative p by conjugation)."""
@@ -166,7 +165,7 @@ def _exp_powers(beta_row, pmax, pr, pi_):
             pi_[k, pmax - p] = -pi_[k, pmax + p]
 
 
-@inner_kernel
+@njit(cache=True)
 def _phase(pr, pi_, pmax, mult, f):
     """(cos, sin) of theta_f = sum_k mult[f, k] beta_k from the powers of
     exp(i beta_k) tabulated by :func:`_exp_powers`."""
