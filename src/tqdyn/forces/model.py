@@ -287,7 +287,7 @@ def term_gate(slot: int, kernel):
     of a model without it, ``kernel`` is not compiled and the gate gives
     (0.0, 0.0, 0.0) (the caller checks the table at run time, as for a
     layout table alone, with which ``kernel`` is compiled).  Compiled code
-    only; inlined into the caller (no function of its own to compile)."""
+    only; inlined into the caller (numba still compiles each gate once, to type it)."""
     def gate(layout, args):
         raise TypeError("a force-term gate is called from compiled code only")
 
