@@ -103,7 +103,7 @@ def _warm(scen):
     import dataclasses
 
     n = scen.integrator.order + 2 if scen.integrator.method == "multistep" else 1
-    dynamics.warm_up(scen.run.precision, scen.integrator.method)
+    dynamics.warm_up(scen.run.precision, scen.integrator.method, model=dynamics.check_inputs(scen))
     dynamics.propagate(dataclasses.replace(scen, run=dataclasses.replace(scen.run, duration_s=scen.integrator.step_s * n)))
 
 

@@ -124,6 +124,31 @@ def test_composition_sums_terms():
         assert abs(float(diff) - tb[q]) < 1e-30  # the float64 term is added to the dd sum (dd rounding ~1e-33)
 
 
+def test_kernel_layout_compiles_the_enabled_terms_alone():
+    """A model without the Sun's J2 and relativity, given as its kernel_layout, compiles neither kernel
+    into the force sum (the LLVM code of the same function given the layout table alone, which compiles
+    every term, is the reference: it calls both), gives the table's acceleration to the bit, and stays
+    cacheable (no dynamic globals: a term's kernel is no run-time value)."""
+    from numba import njit
+
+    from tqdyn.forces.model import float64_terms
+
+    model = _model()
+
+    @njit
+    def terms(r, tdat, params, layout):
+        return float64_terms(0.0, 0.0, 0.0, r[0], r[1], r[2], 0.0, 0.0, 0.0, tdat, params, layout, -1)
+
+    r = np.array((7.0e7, 2.0e7, -6.0e7))
+    tdat = model.precompute(None, np.array(1234.0), np.array(0.0))
+    assert terms(r, tdat, model.params, model.kernel_layout) == terms(r, tdat, model.params, model.layout)
+    by_layout = {type(sig[-1]).__name__: terms.inspect_llvm(sig) for sig in terms.signatures}
+    code_table, code_gated = by_layout["Array"], by_layout["Tuple"]
+    for kernel in ("sun_j2_accel", "relativity_accel"):
+        assert kernel in code_table and kernel not in code_gated
+    assert all(not cres.library._dynamic_globals for cres in terms.overloads.values())
+
+
 def _final(scen, model, **kw):
     res = dynamics.propagate(scen, model=model, **kw)
     return mp_from_dd(res.y_final[:, 0:3, :]), res

@@ -111,3 +111,52 @@ def test_compile_clock_counts_compilations_not_calls():
         assert outer(2.0) == 5.0
     assert first["n"] == 1 and 0.0 < first["cpu_s"] and 0.0 < first["wall_s"] < 60.0
     assert jit == first
+
+
+def _has_cpython_wrapper(dispatcher, sig) -> bool:
+    cres = dispatcher.overloads[sig]
+    return cres.library.get_pointer_to_function(cres.fndesc.llvm_cpython_wrapper_name) != 0
+
+
+def test_inner_kernels_have_no_wrappers_and_serve_python_through_a_twin():
+    """An ``inner_kernel`` compiled for a compiled caller has no CPython wrapper (numba's own ``njit``
+    version of the same function has one: the reference); calling it from Python afterwards with the
+    same argument types (its compiled version cannot be entered from Python) runs the twin compiled
+    with the wrapper, and both give what the plain ``njit`` function gives."""
+    import numpy as np
+    from numba import njit
+
+    def f(x, a):
+        return x * a[0] + a[1]
+
+    inner, plain = _jit.inner_kernel(cache=False)(f), njit(f)
+
+    @njit
+    def caller(x, a):
+        return inner(x, a) - 1.0
+
+    a = np.array([3.0, 0.5])
+    assert caller(2.0, a) == plain(2.0, a) - 1.0 == 5.5
+    sig = inner.signatures[0]
+    assert not _has_cpython_wrapper(inner, sig) and _has_cpython_wrapper(plain, sig)
+    assert inner(2.0, a) == plain(2.0, a) == 6.5
+    entry = inner.python_entry()
+    assert entry.signatures == [sig] and _has_cpython_wrapper(entry, sig)
+    assert inner.signatures == [sig]  # the Python call compiled nothing more into the inner kernel
+
+
+def test_entry_kernels_keep_the_python_wrapper():
+    """``kernel`` (numba's njit without the C wrapper) is called from Python and from compiled code."""
+    from numba import njit
+
+    def g(x):
+        return 3.0 * x
+
+    k = _jit.kernel(cache=False)(g)
+
+    @njit
+    def caller(x):
+        return k(x) + 1.0
+
+    assert caller(2.0) == 7.0 and k(2.0) == 6.0 and len(k.signatures) == 1
+    assert _has_cpython_wrapper(k, k.signatures[0])

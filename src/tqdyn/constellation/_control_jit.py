@@ -17,15 +17,15 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
 from ..numerics.vec3 import cross
 from .indices import MOSA_SIGN
+from ..numerics.jit import inner_kernel
 
 __all__ = ["housing_geometry", "satellite_control"]
 
 
-@njit(cache=True)
+@inner_kernel
 def housing_geometry(i, theta, theta_dot, r0_nom, piv, theta_nom, w, r0, rho, vel):
     """EH centers of satellite ``i`` and their velocity relative to the CoM, in S.
 
@@ -57,7 +57,7 @@ def housing_geometry(i, theta, theta_dot, r0_nom, piv, theta_nom, w, r0, rho, ve
         vel[i, l, 2] = cz
 
 
-@njit(cache=True)
+@inner_kernel
 def satellite_control(i, scheme, sens, dg_S, sg_S, w, wd, theta, theta_dot, theta_ddot, r0, rho, g, A, G_S,
                       alpha):
     """g_l, suspension A_c,l, drag-free G and TM angular acceleration of satellite ``i``.

@@ -121,6 +121,7 @@ from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache bef
 from ..numerics.vec3 import add as _add, axpy as _axpy, cross as _cross, dot as _dot
 from ..numerics.vec3 import row as _row, scale as _scale, sub as _sub
 from ..forces.central import monopole_jerk_snap as _monopole_jerk_snap
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "LAW_CODES",
@@ -158,7 +159,7 @@ def law_code(name: str) -> int:
 
 # ------------------------------------------------------------------ jets
 
-@njit(cache=True)
+@inner_kernel
 def _unit_jet(w0, w1, w2):
     """Unit vector u = w/|w| and L = |w| with first and second derivatives.
 
@@ -173,7 +174,7 @@ def _unit_jet(w0, w1, w2):
     return u, u1, u2, L, L1, L2
 
 
-@njit(cache=True)
+@inner_kernel
 def _cross_jet(a0, a1, a2, b0, b1, b2):
     c0 = _cross(a0, b0)
     c1 = _add(_cross(a1, b0), _cross(a0, b1))
@@ -183,7 +184,7 @@ def _cross_jet(a0, a1, a2, b0, b1, b2):
 
 # ------------------------------------------------------------------ beams
 
-@njit(cache=True)
+@inner_kernel
 def _arm(r_hi, r_lo, i, m):
     """r_m - r_i from the dd positions, float64 (hi and lo differences summed)."""
     return ((r_hi[m, 0] - r_hi[i, 0]) + (r_lo[m, 0] - r_lo[i, 0]),
@@ -191,7 +192,7 @@ def _arm(r_hi, r_lo, i, m):
             (r_hi[m, 2] - r_hi[i, 2]) + (r_lo[m, 2] - r_lo[i, 2]))
 
 
-@njit(cache=True)
+@inner_kernel
 def _beam_taylor(law, d0, d1, d2, vm, am, jm, sm, c):
     """Beam jet for the global (0), taylor1 (1) and taylor2 (2) laws.
 
@@ -214,7 +215,7 @@ def _beam_taylor(law, d0, d1, d2, vm, am, jm, sm, c):
     return b0, b1, b2
 
 
-@njit(cache=True)
+@inner_kernel
 def _emission_offsets(s, vm, am, jm, sm):
     """Taylor model of the remote orbit at t - s: (P(t-s) - r_m, P'(t-s), P''(t-s))."""
     off = (s * (-vm[0] + s * (0.5 * am[0] + s * (-jm[0] / 6.0 + s * (sm[0] / 24.0)))),
@@ -229,7 +230,7 @@ def _emission_offsets(s, vm, am, jm, sm):
     return off, ve, ae
 
 
-@njit(cache=True)
+@inner_kernel
 def _beam_iterative(d0, vi, ai, vm, am, jm, sm, c):
     """Beam jet of the iterative law and the light time with its derivatives.
 
@@ -266,7 +267,7 @@ def _beam_iterative(d0, vi, ai, vm, am, jm, sm, c):
     return (b0, b1, b2), (s, tau1, tau2)
 
 
-@njit(cache=True)
+@inner_kernel
 def _beam_jet(law, jerk_pert, i, m, r_hi, r_lo, v, a, jm, sm, c):
     """Beam jet (b, b', b'') of satellite i towards remote satellite m
     (jerk_pert None: the global law, as in :func:`nominal_kinematics`)."""
@@ -340,7 +341,7 @@ def sat_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out
     nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out)
 
 
-@njit(cache=True)
+@inner_kernel
 def nominal_kinematics(law, r_hi, r_lo, v, a, jerk_pert, gm, c, T_out, w_out, wd_out, th_out):
     """:func:`sat_kinematics` without its checks of the law code and the
     shapes, for callers whose arrays and law are fixed by construction (the

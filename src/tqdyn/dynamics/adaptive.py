@@ -121,8 +121,8 @@ def propagate_adaptive(scenario, precision, model, epoch, tab, y0_dd, sink, prog
         tdat = _node_tdat(model, epoch, [t + ci * h_exact for ci in c_nodes])
         y_try, comp_try = y.copy(), comp.copy()
         kernel(y_try, comp_try, K, ystage, err, ha, unit.nz, unit.nnz, hb, unit.nzb, unit.nnzb, he,
-               np.ascontiguousarray(tdat)[None], model.params, model.layout, cpar, aux, gw, fw, 1, out_y1, out_a1,
-               no_aux)
+               np.ascontiguousarray(tdat)[None], model.params, model.kernel_layout, cpar, aux, gw, fw, 1, out_y1,
+               out_a1, no_aux)
         n_rhs += 13
         norm = dp87.error_norm(y_try, err, rtol)
         if not (np.isfinite(norm) and np.isfinite(y_try).all()):  # no step size makes it finite: stop here

@@ -25,12 +25,13 @@ from numba import njit
 from ..forces.model import ForceModel
 from ..numerics import dp87
 from ..numerics.dd import add, copy_columns, ld, mul, st
+from ..numerics.jit import kernel
 from . import layout as _lay
 from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_kernel", "chunk_plan", "deliver_rows",
-           "input_pipeline", "propagate_fixed", "warm_up", "warm_up_systems"]
+           "input_pipeline", "propagate_fixed", "warm_up", "warm_up_layout", "warm_up_systems"]
 
 DEFAULT_CHUNK = 4096  # steps per chunk: rows to the sink, progress and checkpoints
 INPUT_BLOCK = 512  # steps per compiled call and per evaluation of the time-only inputs
@@ -82,7 +83,7 @@ def _steps(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, p
 # picks the run's).
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                  cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
     """n_steps fixed DP87 steps of the coupled constellation.  Before step n
@@ -93,7 +94,7 @@ def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, 
            cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _fixed_chunk_points(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
                         cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
     """:func:`_fixed_chunk` for independent point masses (fw None)."""
@@ -130,17 +131,20 @@ def _scale_tableau(a, b, h, ha, hb):
             st(ha, mul(ld(a, i, j), h), i, j)
 
 
-def warm_up(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+def warm_up(precision: str = "dd", cpar: np.ndarray | None = None, model: ForceModel | None = None) -> None:
     """Compile the fixed-step kernel for ``precision`` (numba JIT, a few
     seconds on first use in a process, then cached on disk) so that later
     timings measure the propagation alone.  ``cpar``: the run's system
     (the ``cpar`` of its :class:`tqdyn.dynamics.system.System`), whose kernel is compiled
     (each system has its own: independent point masses, the coupled
     constellation with the global or with a local pointing law); None: the
-    point masses' and the coupled constellation's with the global law."""
+    point masses' and the coupled constellation's with the global law.
+    ``model``: the run's force model, whose terms alone are compiled (the
+    propagation passes its :attr:`~tqdyn.forces.model.ForceModel.kernel_layout`);
+    None: the kernels for a layout table alone, with every term."""
     _lay.check_precision(precision)
     for c in warm_up_systems(cpar):
-        _compile_chunk(precision, c)
+        _compile_chunk(precision, c, model)
     _grid_times(0, 1, np.array((1.0, 0.0)), np.zeros(13), np.empty((1, 2)), np.empty((0, 13, 2)))
 
 
@@ -151,16 +155,25 @@ def warm_up_systems(cpar: np.ndarray | None) -> tuple:
     return _lay.make_cpar(_lay.MODE_POINT_MASS), _lay.make_cpar(_lay.MODE_COUPLED)
 
 
-def _compile_chunk(precision: str, cpar: np.ndarray) -> None:
-    """Compile the kernel of the system ``cpar`` for the argument types of a run (zero steps run)."""
+def warm_up_layout(model: ForceModel | None):
+    """The ``params`` and ``layout`` a warm-up compiles for (:func:`warm_up`): ``model``'s
+    parameters and kernel layout, or, without a model, an empty parameter vector and a layout table."""
+    if model is None:
+        return np.zeros(0), ForceModel([]).layout
+    return model.params, model.kernel_layout
+
+
+def _compile_chunk(precision: str, cpar: np.ndarray, model: ForceModel | None = None) -> None:
+    """Compile the kernel of the system ``cpar`` (and force ``model``, :func:`warm_up`) for the argument
+    types of a run (zero steps run)."""
     tail = (2,) if precision == "dd" else ()
     y = np.zeros((3, 6) + tail)
     coef = dp87.step_coefficients(dp87.load_tableau(), 1, precision)
-    model = ForceModel([])
+    params, layout = warm_up_layout(model)
     gw, fw, aux = _lay.workspace(y, cpar)
     chunk_kernel(fw)(y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros((3, 6)),
                      coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he, np.zeros((0, 13, 0)),
-                     model.params, model.layout, cpar, aux, gw, fw, 0, np.empty((0,) + y.shape),
+                     params, layout, cpar, aux, gw, fw, 0, np.empty((0,) + y.shape),
                      np.empty((0, 3, 3) + tail), np.empty((0, _lay.AUX_LEN)))
 
 
@@ -315,7 +328,7 @@ def propagate_fixed(scenario, precision, model, epoch, tab, y0_dd, sink, progres
         for o, e, tdat in parts:
             t_cpu = _time.thread_time()
             kernel(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb,
-                   coef.he, tdat, model.params, model.layout, cpar, aux, gw, fw, e - o, out_y[o:e],
+                   coef.he, tdat, model.params, model.kernel_layout, cpar, aux, gw, fw, e - o, out_y[o:e],
                    out_a[o:e], out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat

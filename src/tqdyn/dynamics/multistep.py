@@ -37,9 +37,10 @@ from numba import njit
 from ..numerics import dp87
 from ..numerics import multistep as _ms
 from ..numerics.dd import copy_columns
+from ..numerics.jit import kernel
 from . import layout as _lay
 from .fixed import (CheckpointClock, _as_precision, _grid_times, _workspace, chunk_kernel, chunk_plan, deliver_rows,
-                    input_pipeline, warm_up_systems)
+                    input_pipeline, warm_up_layout, warm_up_systems)
 from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
 from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
 
@@ -88,7 +89,7 @@ def _steps(rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_
     head[0] = h
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
                      layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
     """n_steps steps P(EC)^n_corr [E] of the coupled constellation: predict,
@@ -104,7 +105,7 @@ def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stat
            params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def _multistep_chunk_points(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
                             params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
     """:func:`_multistep_chunk` for independent point masses (fw None)."""
@@ -151,24 +152,22 @@ class _State:
         self.head[0] = self.F.shape[0] - 1
 
 
-def warm_up_multistep(precision: str = "dd", cpar: np.ndarray | None = None) -> None:
+def warm_up_multistep(precision: str = "dd", cpar: np.ndarray | None = None, model=None) -> None:
     """Compile the multistep kernel for ``precision`` (numba JIT, cached on
-    disk); ``cpar`` as for :func:`tqdyn.dynamics.fixed.warm_up`."""
-    from ..forces.model import ForceModel
-
+    disk); ``cpar`` and ``model`` as for :func:`tqdyn.dynamics.fixed.warm_up`."""
     _lay.check_precision(precision)
     tail = (2,) if precision == "dd" else ()
     y = np.zeros((3, 6) + tail)
     order = _ms.ORDERS[0]
     mc = _ms.step_coefficients(order, 1, precision)
-    model = ForceModel([])
+    params, layout = warm_up_layout(model)
     st = _State(y, order)
     _ms.start(st.y, st.F, 0, mc.coef, mc.hh, st.S, st.cS, st.s, st.cs)
     for c in warm_up_systems(cpar):
         gw, fw, _ = _lay.workspace(y, c)
         _kernel(fw)(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, np.zeros_like(y),
-                    np.zeros_like(y), st.aux, np.zeros(2), 1, True, np.zeros((0, 0)), model.params, model.layout,
-                    c, gw, fw, 0, np.empty((0,) + y.shape), np.empty((0, 3, 3) + tail),
+                    np.zeros_like(y), st.aux, np.zeros(2), 1, True, np.zeros((0, 0)), params, layout, c,
+                    gw, fw, 0, np.empty((0,) + y.shape), np.empty((0, 3, 3) + tail),
                     np.empty((0, _lay.AUX_LEN)))
 
 
@@ -197,7 +196,7 @@ def _start_up(st, mc, scenario, precision, model, epoch, tab, y0_dd, sink, syste
     out_a = np.empty((n_s, y.shape[0], 3) + y.shape[2:])
     out_aux = np.empty((n_s if system.coupled else 0, _lay.AUX_LEN))
     chunk_kernel(fw)(y, comp, K, ystage, err, coef.ha, coef.nz, coef.nnz, coef.hb, coef.nzb, coef.nnzb, coef.he,
-                     tdat, model.params, model.layout, cpar, aux, gw, fw, n_s, out_y, out_a, out_aux)
+                     tdat, model.params, model.kernel_layout, cpar, aux, gw, fw, n_s, out_y, out_a, out_aux)
     k_end, aux_end = evaluate_rhs(y, tdat_end, model, cpar, with_aux=True)
     cpu["loop"] += _time.thread_time() - t_cpu
     check_finite_states(0, t_out[:n_s], out_y)
@@ -295,8 +294,8 @@ def propagate_multistep(scenario, precision, model, epoch, tab, y0_dd, sink, pro
         for o, e, tdat in parts:
             t_cpu = _time.thread_time()
             kernel(st.y, st.F, st.head, st.S, st.cS, st.s, st.cs, mc.coef, mc.hh, ypred, kbuf, st.aux, stats,
-                   n_corr, evaluated, tdat, model.params, model.layout, cpar, gw, fw, e - o, out_y[o:e], out_a[o:e],
-                   out_aux[o:e])
+                   n_corr, evaluated, tdat, model.params, model.kernel_layout, cpar, gw, fw, e - o, out_y[o:e],
+                   out_a[o:e], out_aux[o:e])
             cpu["loop"] += _time.thread_time() - t_cpu
             del tdat
         deliver_rows(sink, extremes, n_aux, system, precision, every, n0, t_out, out_y, out_a, out_aux)

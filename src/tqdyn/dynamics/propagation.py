@@ -33,7 +33,8 @@ __all__ = ["propagate", "check_inputs", "two_body_energy", "warm_up", "PRECISION
            "NonFiniteStateError", "Rows", "RunResult"]
 
 
-def warm_up(precision: str = "dd", method: str = "dp87", cpar: np.ndarray | None = None) -> None:
+def warm_up(precision: str = "dd", method: str = "dp87", cpar: np.ndarray | None = None,
+            model: ForceModel | None = None) -> None:
     """Compile the kernels of ``method`` ("dp87" | "multistep") for
     ``precision`` (numba JIT, a few seconds on first use, then cached on
     disk) so that later timings measure the propagation alone.  The DP87
@@ -41,10 +42,13 @@ def warm_up(precision: str = "dd", method: str = "dp87", cpar: np.ndarray | None
     ``cpar``: the run's system (the ``cpar`` of its
     :class:`tqdyn.dynamics.system.System`, ``build_system(scenario).cpar``), whose kernels alone are
     compiled; None: those of independent point masses and of the coupled
-    constellation with the global pointing law."""
-    _warm_up_fixed(precision, cpar)
+    constellation with the global pointing law.  ``model``: the run's
+    force model, whose terms alone are compiled; None: the kernels for a
+    layout table alone, with every term (which runs do not use: they pass
+    their model's :attr:`~tqdyn.forces.model.ForceModel.kernel_layout`)."""
+    _warm_up_fixed(precision, cpar, model)
     if method == "multistep":
-        warm_up_multistep(precision, cpar)
+        warm_up_multistep(precision, cpar, model)
 
 
 def two_body_energy(y_dd: np.ndarray, gm) -> list:

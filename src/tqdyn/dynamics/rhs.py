@@ -80,6 +80,7 @@ from .layout import (AX_AGRAV, AX_ALPHA, AX_G, AX_SAT, AX_T, AX_THETA, AX_TM, AX
                      CP_C, CP_GM, CP_GMREL, CP_J2K, CP_JGM, CP_LAW, CP_MODE, CP_NJB, CP_PIV, CP_R0, CP_SCHEME, CP_SENS,
                      CP_SG_OA, CP_SG_S, CP_SGC, CP_LEN, CP_TD, CP_THNOM, CP_TMG, MODE_FREE_TM, MODE_POINT_MASS, TM_A, TM_ALPHA, TM_OFF, TM_RHI, TM_RLO,
                      TM_SUSP, TM_VHI, TM_VLO, TMG_DIRECT, make_cpar, workspace)
+from ..numerics.jit import inner_kernel, kernel
 
 __all__ = ["system_rhs", "coupled_rhs", "point_mass_rhs", "point_masses", "point_mass_system", "evaluate_rhs",
            "toward_centre"]
@@ -99,7 +100,7 @@ def point_masses(y, tdat, params, layout, k):
         st(k, az, b, 5)
 
 
-@njit(cache=True)
+@kernel
 def point_mass_system(y, tdat, params, layout, cpar, k):
     """dy/dt of the point-mass system (MODE_POINT_MASS): :func:`point_masses`, then, when
     cpar says so, the self-gravity toward the constellation centre (:func:`toward_centre`)
@@ -121,7 +122,7 @@ def _gravity_into(gw, row, x, y, z, vx, vy, vz, tdat, params, layout):
     st(gw, az, row, 2)
 
 
-@njit(cache=True)
+@inner_kernel
 def _breathing_angle(r_hi, r_lo, i):
     """Angle at satellite i between its two arms (instantaneous positions) [rad]."""
     j, kk = (i + 1) % 3, (i + 2) % 3
@@ -135,7 +136,7 @@ def _breathing_angle(r_hi, r_lo, i):
     return np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), a0 * b0 + a1 * b1 + a2 * b2)
 
 
-@njit(cache=True)
+@inner_kernel
 def _jerk_perturbation(cpar, tdat, fw, jp):
     """Jerk of each satellite beyond the central monopole [m/s^3] into jp
     (fw[19]; None for the global law, which needs none: then nothing is
@@ -191,7 +192,7 @@ def _jerk_perturbation(cpar, tdat, fw, jp):
         jp[i, 0], jp[i, 1], jp[i, 2] = jx, jy, jz
 
 
-@njit(cache=True)
+@inner_kernel
 def _control_pass(cpar, fw):
     """Kinematics and EH geometry of the three satellites from the work
     arrays (positions, velocities, accelerations)."""
@@ -204,7 +205,7 @@ def _control_pass(cpar, fw):
         housing_geometry(i, th[i, 0], th[i, 1], r0_nom, piv, cpar[CP_THNOM], om, r0, rho, vel)
 
 
-@njit(cache=True)
+@inner_kernel
 def _control_laws(cpar, tdat, fw):
     """g, A, G (S and GCRS), alpha of the three satellites from the work arrays
     (and, when cpar[CP_SGC] >= 0, the self-gravity ramp from tdat: a common
@@ -232,7 +233,7 @@ def _control_laws(cpar, tdat, fw):
             GI[i, q] = T[i, 0, q] * GS[i, 0] + T[i, 1, q] * GS[i, 1] + T[i, 2, q] * GS[i, 2]
 
 
-@njit(cache=True)
+@inner_kernel
 def _oa_to_inertial(T, i, theta, l, x, y, z):
     """OA_l vector of satellite i -> GCRS (T_I_S T_S_OA); T: (3, 3, 3)."""
     s = MOSA_SIGN[l]
@@ -243,7 +244,7 @@ def _oa_to_inertial(T, i, theta, l, x, y, z):
             T[i, 0, 2] * ux + T[i, 1, 2] * uy + T[i, 2, 2] * uz)
 
 
-@njit(cache=True)
+@kernel
 def coupled_rhs(y, tdat, params, layout, cpar, k, aux, gw, fw):
     """dy/dt of the coupled constellation (MODE_COUPLED, MODE_FREE_TM); arguments as
     :func:`system_rhs`."""
@@ -444,5 +445,5 @@ def evaluate_rhs(y: np.ndarray, tdat_row: np.ndarray, model: ForceModel, cpar: n
     k = np.zeros_like(y)
     cpar = make_cpar(MODE_POINT_MASS) if cpar is None else cpar
     gw, fw, aux = workspace(y, cpar)
-    system_rhs(y, tdat_row, model.params, model.layout, cpar, k, aux, gw, fw)
+    system_rhs(y, tdat_row, model.params, model.kernel_layout, cpar, k, aux, gw, fw)
     return (k, aux) if with_aux else k

@@ -27,15 +27,15 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from ..numerics.dd import add, dd_from_mp, div, mul, neg, sqrt
 from ..numerics.vec3 import axpy, dot, scale
+from ..numerics.jit import inner_kernel
 
 __all__ = ["monopole", "monopole_jerk_snap", "central_jerk_snap", "EarthMonopole"]
 
 
-@njit(cache=True)
+@inner_kernel
 def monopole(x, y, z, gm):
     """Acceleration -gm r / |r|^3 [m/s^2] at r = (x, y, z) [m] relative to the
     body's center, in the frame of r.  Generic: dd tuples or float64 scalars.
@@ -45,7 +45,7 @@ def monopole(x, y, z, gm):
     return neg(mul(f, x)), neg(mul(f, y)), neg(mul(f, z))
 
 
-@njit(cache=True)
+@inner_kernel
 def monopole_jerk_snap(r, v, a, gm):
     """Jerk [m/s^3] and snap [m/s^4] of -gm r/|r|^3 (snap with the given a).
 

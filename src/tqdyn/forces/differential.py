@@ -67,9 +67,10 @@ from numba import njit
 from ..numerics.jit import dynamic
 
 from .earth import PARAM_HEADER as _EF_HEADER
-from .earth import degree2_matrix, earth_field_accel, gcrs_from_itrs, itrs_from_gcrs
-from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, float64_terms
+from .earth import degree2_matrix, gcrs_from_itrs, itrs_from_gcrs
+from .model import SLOT_CENTRAL_MONOPOLE, SLOT_EARTH_FIELD, SLOT_THIRD_BODY, earth_field_term, float64_terms, slot_table
 from .third_body import pm_difference
+from ..numerics.jit import inner_kernel
 
 __all__ = ["pm_difference", "quadrupole_jacobian_product", "direct_terms", "differential_gravity",
            "MOON_DEGREE_DG"]
@@ -110,7 +111,7 @@ def quadrupole_jacobian_product(k, mxx, myy, mzz, mxy, mxz, myz, x, y, z, dx, dy
             s1 * md_z - s2 * mz - s3 * z - s4 * dz + s5 * z)
 
 
-@njit(cache=True)
+@inner_kernel
 def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     """Sum [m/s^2] of the terms whose differences :func:`differential_gravity`
     takes directly in float64, apart from the Earth field: the list of
@@ -121,7 +122,7 @@ def direct_terms(rx, ry, rz, vx, vy, vz, tdat, params, layout):
     return float64_terms(0.0, 0.0, 0.0, rx, ry, rz, vx, vy, vz, tdat, params, layout, dynamic(MOON_DEGREE_DG))
 
 
-@njit(cache=True)
+@inner_kernel
 def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey, ez, sx, sy, sz,
                          tdat, params, layout):
     """a(r + d, v + u) - a(r, v) [m/s^2] of the force model (see the module
@@ -135,13 +136,14 @@ def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey,
     (r, v); tdat, params, layout: the force model's.  float64; returns
     (x, y, z).
     """
+    tab = slot_table(layout)
     gx, gy, gz = 0.0, 0.0, 0.0
-    if layout[SLOT_CENTRAL_MONOPOLE, 0]:
-        o = layout[SLOT_CENTRAL_MONOPOLE, 1]
+    if tab[SLOT_CENTRAL_MONOPOLE, 0]:
+        o = tab[SLOT_CENTRAL_MONOPOLE, 1]
         px, py, pz = pm_difference(params[o] + params[o + 1], rx, ry, rz, dx, dy, dz)
         gx, gy, gz = gx - px, gy - py, gz - pz
-    if layout[SLOT_THIRD_BODY, 0]:
-        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+    if tab[SLOT_THIRD_BODY, 0]:
+        o, c = tab[SLOT_THIRD_BODY, 1], tab[SLOT_THIRD_BODY, 2]
         n = int(params[o])
         for b in range(n):
             px, py, pz = pm_difference(params[o + 1 + b], tdat[c + 3 * b] - rx, tdat[c + 3 * b + 1] - ry,
@@ -149,9 +151,9 @@ def differential_gravity(rx, ry, rz, vx, vy, vz, dx, dy, dz, ux, uy, uz, ex, ey,
             gx, gy, gz = gx + px, gy + py, gz + pz
     hx, hy, hz = rx + dx, ry + dy, rz + dz
     wx, wy, wz = vx + ux, vy + uy, vz + uz
-    if layout[SLOT_EARTH_FIELD, 0]:
-        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
-        fx, fy, fz = earth_field_accel(hx, hy, hz, wx, wy, wz, tdat[c:], params[o:])
+    if tab[SLOT_EARTH_FIELD, 0]:
+        o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
+        fx, fy, fz = earth_field_term(layout, (hx, hy, hz, wx, wy, wz, tdat[c:], params[o:]))
         gx, gy, gz = gx + (fx - ex), gy + (fy - ey), gz + (fz - ez)
         ld = int(params[o + 2]) + 1
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 is not in the float64 field: midpoint Jacobian

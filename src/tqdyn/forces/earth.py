@@ -48,6 +48,7 @@ from ..numerics.jit import dynamic  # (importing numerics.jit registers the pack
 from ..numerics.dd import add, const, div, mul, sqrt, sub
 from ..readers.gravity_fields import GravityModel, egm2008
 from .spherical_harmonics import NMAX_SH, sh_accel_flat
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "EarthField",
@@ -264,7 +265,7 @@ class EarthField:
         return out
 
 
-@njit(cache=True)
+@inner_kernel
 def _earth_field(rx, ry, rz, tdat, params, static, tides):
     gm, radius = params[0], params[1]
     n = int(params[2])
@@ -306,7 +307,7 @@ def gcrs_from_itrs(tdat, x, y, z):
             tdat[2] * x + tdat[5] * y + tdat[8] * z)
 
 
-@njit(cache=True)
+@inner_kernel
 def degree2_matrix(tdat, params, one):
     """(GM R^2, M_xx, M_yy, M_zz, M_xy, M_xz, M_yz) of the degree-2 field
     (static + tidal corrections; see :func:`degree2_accel_ext`), ITRS, in
@@ -342,7 +343,7 @@ def degree2_matrix(tdat, params, one):
     return gmr2, m_xx, m_yy, m_zz, m_xy, m_xz, m_yz
 
 
-@njit(cache=True)
+@inner_kernel
 def degree2_accel_ext(rx, ry, rz, tdat, params):
     """Degree-2 part of the Earth field (static + tidal corrections) in the
     number type of r (generic: dd tuples or float64), GCRS [m/s^2].
@@ -414,7 +415,7 @@ def j2_jerk_gcrs_z(k, rx, ry, rz, vx, vy, vz):
             fd * (3.0 - 5.0 * q) * rz + f * (-5.0 * qd * rz + (3.0 - 5.0 * q) * vz))
 
 
-@njit(cache=True)
+@inner_kernel
 def earth_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Acceleration [m/s^2, GCRS] of the Earth's field, degrees 2..N of the
     static model plus the tidal corrections, at the geocentric GCRS position

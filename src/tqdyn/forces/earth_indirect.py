@@ -23,15 +23,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from ..astro.timescales import tdb_jd
 from .earth import EarthField, earth_field_accel_batch
+from ..numerics.jit import inner_kernel
 
 __all__ = ["EarthFieldIndirect", "earth_field_indirect_accel"]
 
 
-@njit(cache=True)
+@inner_kernel
 def earth_field_indirect_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """The geocentre's acceleration reversed [m/s^2, GCRS]: tdat[0:3]
     (precomputed; independent of the satellite's state)."""

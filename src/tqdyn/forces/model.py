@@ -22,18 +22,21 @@ kind, each switched on by the ``layout`` table built here.  Adding a term
 means adding its module, a slot constant and one branch in
 :func:`gravity_split` or, for a float64 term evaluated at the point alone,
 in :func:`float64_terms` (the one list of those, which the test masses'
-differential gravity differences too).
+differential gravity differences too); a float64 kernel is called through
+:func:`term_gate`, so that a propagation (which passes
+:attr:`ForceModel.kernel_layout`) compiles it only if its model enables it.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
-from ..numerics.jit import dynamic
+from ..numerics.jit import OVERLOAD_OPTIONS, dynamic, inner_kernel
 from .body_gms import body_gms
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
@@ -47,7 +50,8 @@ from .relativity import Relativity, relativity_accel
 from .sun import SunJ2, sun_j2_accel
 from .third_body import ThirdBodies, third_bodies_accel, third_body_accel_ext
 
-__all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity", "gravity_split", "SLOTS"]
+__all__ = ["ForceModel", "build_force_model", "describe_terms", "float64_terms", "gravity",
+           "gravity_split", "slot_table", "SLOTS", "term_gate"]
 
 #: Slot of each term kind in the compiled dispatcher (row of ``layout``).
 SLOT_EARTH_MONOPOLE = 0
@@ -83,6 +87,10 @@ class ForceModel:
     params: (n_params,) float64, the terms' parameters concatenated.
     layout: (n_slots, 3) int64; row s = (enabled, parameter offset, tdat
         column offset) of slot s.
+    kernel_layout: the ``layout`` the propagation passes to the compiled
+        functions: (layout, on), on[s] True for an enabled slot s and None
+        for one that is off, so that only the enabled terms are compiled
+        (:func:`term_gate`); the table alone compiles every term.
     n_tdat: total number of time-only input columns.
     eop: the :class:`~tqdyn.astro.eop.EOP` table the Earth's orientation
         uses (None: no EOP); eop_source: its name ("auto", "c04-14", ...,
@@ -108,6 +116,7 @@ class ForceModel:
             t_off += term.n_tdat
         self.params = np.concatenate(params) if params else np.zeros(0)
         self.n_tdat = t_off
+        self.kernel_layout = (self.layout, tuple(True if row[0] else None for row in self.layout))
 
     @property
     def time_dependent(self) -> bool:
@@ -259,6 +268,51 @@ def _heliocentric_model(forces, reference: ReferenceSystem) -> ForceModel:
     return ForceModel(terms, reference)
 
 
+def slot_table(layout):
+    """The (n_slots, 3) int64 table of ``layout``: :attr:`ForceModel.layout`
+    itself or the table of :attr:`ForceModel.kernel_layout` (compiled code only)."""
+
+
+@overload(slot_table, jit_options=OVERLOAD_OPTIONS)
+def _ov_slot_table(layout):
+    if isinstance(layout, types.Array):
+        return lambda layout: layout
+    return lambda layout: layout[0]
+
+
+def term_gate(slot: int, kernel):
+    """``gate(layout, args)``: ``kernel(*args)`` (args a tuple), the float64
+    acceleration (ax, ay, az) [m/s^2] of the term in slot ``slot``, compiled
+    only if the term can be on: given the :attr:`ForceModel.kernel_layout`
+    of a model without it, ``kernel`` is not compiled and the gate gives
+    (0.0, 0.0, 0.0) (the caller checks the table at run time, as for a
+    layout table alone, with which ``kernel`` is compiled).  Compiled code
+    only; inlined into the caller (numba still compiles each gate once, to type it)."""
+    def gate(layout, args):
+        raise TypeError("a force-term gate is called from compiled code only")
+
+    @overload(gate, jit_options=OVERLOAD_OPTIONS, inline="always")
+    def _gate(layout, args):
+        if isinstance(layout, types.BaseTuple) and isinstance(layout.types[1].types[slot], types.NoneType):
+            return lambda layout, args: (0.0, 0.0, 0.0)
+        return lambda layout, args: kernel(*args)
+
+    gate.__name__ = gate.__qualname__ = f"{kernel.__name__}_gate"
+    gate.__doc__ = f":func:`term_gate` of ``{kernel.__name__}`` (slot {slot})."
+    return gate
+
+
+earth_field_term = term_gate(SLOT_EARTH_FIELD, earth_field_accel)
+_indirect_term = term_gate(SLOT_EARTH_FIELD_INDIRECT, earth_field_indirect_accel)
+_moon_term = term_gate(SLOT_MOON_FIELD, moon_field_accel)
+_moon_direct_term = term_gate(SLOT_MOON_FIELD, moon_field_direct)
+_sun_j2_term = term_gate(SLOT_SUN_J2, sun_j2_accel)
+_relativity_term = term_gate(SLOT_RELATIVITY, relativity_accel)
+_central_j2_term = term_gate(SLOT_CENTRAL_J2, central_j2_accel)
+_eih_term = term_gate(SLOT_EIH, heliocentric_eih_accel)
+_eih_gcrs_term = term_gate(SLOT_EIH_GCRS, geocentric_eih_accel)
+
+
 @njit(cache=True, inline="always")
 def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
@@ -270,7 +324,7 @@ def gravity(x, y, z, vx, vy, vz, tdat, params, layout):
     return ax, ay, az
 
 
-@njit(cache=True)
+@inner_kernel
 def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     """Total gravitational acceleration [m/s^2] at the position (x, y, z) [m]
     and velocity (vx, vy, vz) [m/s] relative to the central body, in the
@@ -283,14 +337,15 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     field's float64 kernel (zero without that term), which the differential
     gravity of the test masses reuses (:mod:`tqdyn.forces.differential`).
     """
+    tab = slot_table(layout)
     zero = mul(x, 0.0)
     ax, ay, az = zero, zero, zero
-    if layout[SLOT_EARTH_MONOPOLE, 0]:
-        o = layout[SLOT_EARTH_MONOPOLE, 1]
+    if tab[SLOT_EARTH_MONOPOLE, 0]:
+        o = tab[SLOT_EARTH_MONOPOLE, 1]
         gx, gy, gz = monopole(x, y, z, const(params[o], params[o + 1], x))
         ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    if layout[SLOT_THIRD_BODY, 0]:
-        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+    if tab[SLOT_THIRD_BODY, 0]:
+        o, c = tab[SLOT_THIRD_BODY, 1], tab[SLOT_THIRD_BODY, 2]
         n = int(params[o])
         for k in range(n):
             if params[o + 1 + n + k] != 0.0:  # this body in extended precision
@@ -298,8 +353,8 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
                                                   tdat[c + 3 * k + 2], params[o + 1 + k], tdat[c + 3 * (n + k)],
                                                   tdat[c + 3 * (n + k) + 1], tdat[c + 3 * (n + k) + 2])
                 ax, ay, az = add(ax, gx), add(ay, gy), add(az, gz)
-    if layout[SLOT_EARTH_FIELD, 0]:
-        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
+    if tab[SLOT_EARTH_FIELD, 0]:
+        o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
         ld = int(params[o + 2]) + 1
         if params[o + _EF_HEADER + 2 * ld * ld] != 0.0:  # degree 2 in extended precision
             gx, gy, gz = degree2_accel_ext(x, y, z, tdat[c:], params[o:])
@@ -312,23 +367,23 @@ def gravity_split(x, y, z, vx, vy, vz, tdat, params, layout):
     ux, uy, uz = to_f64(vx), to_f64(vy), to_f64(vz)
     px, py, pz = 0.0, 0.0, 0.0
     ex, ey, ez = 0.0, 0.0, 0.0
-    if layout[SLOT_THIRD_BODY, 0]:
-        o, c = layout[SLOT_THIRD_BODY, 1], layout[SLOT_THIRD_BODY, 2]
+    if tab[SLOT_THIRD_BODY, 0]:
+        o, c = tab[SLOT_THIRD_BODY, 1], tab[SLOT_THIRD_BODY, 2]
         gx, gy, gz = third_bodies_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EARTH_FIELD, 0]:
-        o, c = layout[SLOT_EARTH_FIELD, 1], layout[SLOT_EARTH_FIELD, 2]
-        ex, ey, ez = earth_field_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+    if tab[SLOT_EARTH_FIELD, 0]:
+        o, c = tab[SLOT_EARTH_FIELD, 1], tab[SLOT_EARTH_FIELD, 2]
+        ex, ey, ez = earth_field_term(layout, (rx, ry, rz, ux, uy, uz, tdat[c:], params[o:]))
         px, py, pz = px + ex, py + ey, pz + ez
-    if layout[SLOT_EARTH_FIELD_INDIRECT, 0]:
-        o, c = layout[SLOT_EARTH_FIELD_INDIRECT, 1], layout[SLOT_EARTH_FIELD_INDIRECT, 2]
-        gx, gy, gz = earth_field_indirect_accel(rx, ry, rz, ux, uy, uz, tdat[c:], params[o:])
+    if tab[SLOT_EARTH_FIELD_INDIRECT, 0]:
+        o, c = tab[SLOT_EARTH_FIELD_INDIRECT, 1], tab[SLOT_EARTH_FIELD_INDIRECT, 2]
+        gx, gy, gz = _indirect_term(layout, (rx, ry, rz, ux, uy, uz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     px, py, pz = float64_terms(px, py, pz, rx, ry, rz, ux, uy, uz, tdat, params, layout, dynamic(-1))
     return add(ax, px), add(ay, py), add(az, pz), ex, ey, ez
 
 
-@njit(cache=True)
+@inner_kernel
 def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon_degree):
     """(px, py, pz) plus the force terms evaluated in float64 at the point itself [m/s^2], in this
     order: the Moon's field, the Sun's J2, relativity (IERS 2010 eq. 10.12), the central body's J2,
@@ -341,31 +396,32 @@ def float64_terms(px, py, pz, rx, ry, rz, vx, vy, vz, tdat, params, layout, moon
     (:func:`~tqdyn.forces.moon.moon_field_accel`); >= 0: its degrees 2 .. moon_degree on the point
     alone (:func:`~tqdyn.forces.moon.moon_field_direct`; the Earth's term drops out of a
     difference).  float64; returns (x, y, z)."""
-    if layout[SLOT_MOON_FIELD, 0]:
-        o, c = layout[SLOT_MOON_FIELD, 1], layout[SLOT_MOON_FIELD, 2]
+    tab = slot_table(layout)
+    if tab[SLOT_MOON_FIELD, 0]:
+        o, c = tab[SLOT_MOON_FIELD, 1], tab[SLOT_MOON_FIELD, 2]
         if moon_degree < 0:
-            gx, gy, gz = moon_field_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+            gx, gy, gz = _moon_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         else:
-            gx, gy, gz = moon_field_direct(rx, ry, rz, tdat[c:], params[o:], moon_degree)
+            gx, gy, gz = _moon_direct_term(layout, (rx, ry, rz, tdat[c:], params[o:], moon_degree))
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_SUN_J2, 0]:
-        o, c = layout[SLOT_SUN_J2, 1], layout[SLOT_SUN_J2, 2]
-        gx, gy, gz = sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_SUN_J2, 0]:
+        o, c = tab[SLOT_SUN_J2, 1], tab[SLOT_SUN_J2, 2]
+        gx, gy, gz = _sun_j2_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_RELATIVITY, 0]:
-        o, c = layout[SLOT_RELATIVITY, 1], layout[SLOT_RELATIVITY, 2]
-        gx, gy, gz = relativity_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_RELATIVITY, 0]:
+        o, c = tab[SLOT_RELATIVITY, 1], tab[SLOT_RELATIVITY, 2]
+        gx, gy, gz = _relativity_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_CENTRAL_J2, 0]:
-        o, c = layout[SLOT_CENTRAL_J2, 1], layout[SLOT_CENTRAL_J2, 2]
-        gx, gy, gz = central_j2_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_CENTRAL_J2, 0]:
+        o, c = tab[SLOT_CENTRAL_J2, 1], tab[SLOT_CENTRAL_J2, 2]
+        gx, gy, gz = _central_j2_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EIH, 0]:
-        o, c = layout[SLOT_EIH, 1], layout[SLOT_EIH, 2]
-        gx, gy, gz = heliocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_EIH, 0]:
+        o, c = tab[SLOT_EIH, 1], tab[SLOT_EIH, 2]
+        gx, gy, gz = _eih_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
-    if layout[SLOT_EIH_GCRS, 0]:
-        o, c = layout[SLOT_EIH_GCRS, 1], layout[SLOT_EIH_GCRS, 2]
-        gx, gy, gz = geocentric_eih_accel(rx, ry, rz, vx, vy, vz, tdat[c:], params[o:])
+    if tab[SLOT_EIH_GCRS, 0]:
+        o, c = tab[SLOT_EIH_GCRS, 1], tab[SLOT_EIH_GCRS, 2]
+        gx, gy, gz = _eih_gcrs_term(layout, (rx, ry, rz, vx, vy, vz, tdat[c:], params[o:]))
         px, py, pz = px + gx, py + gy, pz + gz
     return px, py, pz

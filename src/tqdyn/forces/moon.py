@@ -44,6 +44,7 @@ from ..numerics.jit import dynamic  # (importing numerics.jit registers the pack
 from ..astro.lunar_orientation import LIBRATIONS, lunar_pa_rotation
 from ..astro.timescales import tdb_jd
 from .spherical_harmonics import sh_accel
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "MoonField",
@@ -56,7 +57,7 @@ __all__ = [
 # the force term
 
 
-@njit(cache=True)
+@inner_kernel
 def _field_gcrs(px, py, pz, tdat, params, ntrunc=-1):
     """Field acceleration [m/s^2, GCRS] at the Moon-centred GCRS position
     (px, py, pz) [m]: rotate into PA with tdat[3:12], sh_accel, rotate back;
@@ -79,7 +80,7 @@ def _field_gcrs(px, py, pz, tdat, params, ntrunc=-1):
             t02 * fx + t12 * fy + t22 * fz)
 
 
-@njit(cache=True)
+@inner_kernel
 def moon_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Geocentric acceleration [m/s^2, GCRS] of a satellite at (rx, ry, rz)
     [m, GCRS] from the Moon's degree >= 2 field: field on the satellite minus
@@ -95,7 +96,7 @@ def moon_field_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     return ax - tdat[12], ay - tdat[13], az - tdat[14]
 
 
-@njit(cache=True)
+@inner_kernel
 def moon_field_direct(rx, ry, rz, tdat, params, nmax):
     """The Moon's field on a satellite at (rx, ry, rz) [m, GCRS] alone (no
     term on the Earth), degrees 2 .. min(nmax, N) [m/s^2, GCRS]; tdat and

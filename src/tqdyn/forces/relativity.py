@@ -60,13 +60,13 @@ from dataclasses import dataclass, field
 
 import erfa
 import numpy as np
-from numba import njit
 
 from .._choices import unknown
 from ..astro.constants import C_LIGHT, DAY_S, GM_EARTH_EGM2008, J_EARTH_IERS2010
 from ..astro.ephemeris import Ephemeris, default_ephemeris, planetary_gm
 from ..astro.timescales import tdb_jd, tt_jd
 from ..numerics.lagrange import MARGIN, grid_interp
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "Relativity",
@@ -85,7 +85,7 @@ _J_AXES = ("cip", "gcrs_z")
 _CIP_NODE_SPACING = 0.5 * DAY_S  # s between ERFA evaluations of the CIP
 
 
-@njit(cache=True)
+@inner_kernel
 def schwarzschild_accel(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
     """Schwarzschild term of IERS 2010 eq. (10.12) [m/s^2], GCRS:
     GM/(c^2 r^3) {[2(beta+gamma) GM/r - gamma v.v] r + 2(1+gamma)(r.v) v}.
@@ -101,7 +101,7 @@ def schwarzschild_accel(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
     return f * rx + g * vx, f * ry + g * vy, f * rz + g * vz
 
 
-@njit(cache=True)
+@inner_kernel
 def schwarzschild_jerk(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
     """Time derivative [m/s^3] of :func:`schwarzschild_accel` along the
     Kepler motion (r' = v, v' = -gm r/r^3; the post-Newtonian part of v'
@@ -126,7 +126,7 @@ def schwarzschild_jerk(rx, ry, rz, vx, vy, vz, gm, c, beta, gamma):
             kd * (p * rz + q * vz) + k * (pd * rz + (p + qd) * vz + q * m * rz))
 
 
-@njit(cache=True)
+@inner_kernel
 def lense_thirring_accel(rx, ry, rz, vx, vy, vz, jx, jy, jz, gm, c, gamma):
     """Lense-Thirring term of IERS 2010 eq. (10.12) [m/s^2], GCRS:
     (1+gamma) GM/(c^2 r^3) [(3/r^2)(r x v)(r.J) + v x J].
@@ -141,7 +141,7 @@ def lense_thirring_accel(rx, ry, rz, vx, vy, vz, jx, jy, jz, gm, c, gamma):
     return k * (q * hx + wx), k * (q * hy + wy), k * (q * hz + wz)
 
 
-@njit(cache=True)
+@inner_kernel
 def de_sitter_accel(vx, vy, vz, sx, sy, sz, svx, svy, svz, gm_sun, c, gamma):
     """De Sitter (geodesic precession) term of IERS 2010 eq. (10.12) [m/s^2],
     GCRS: (1+2 gamma) [Rdot x (-GM_S R/(c^2 R^3))] x v, with R = -s, Rdot = -sv
@@ -160,7 +160,7 @@ def de_sitter_accel(vx, vy, vz, sx, sy, sz, svx, svy, svz, gm_sun, c, gamma):
     return oy * vz - oz * vy, oz * vx - ox * vz, ox * vy - oy * vx
 
 
-@njit(cache=True)
+@inner_kernel
 def relativity_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Sum of the enabled terms of IERS 2010 eq. (10.12) [m/s^2], GCRS (the
     perturbation-kernel signature of :mod:`tqdyn.forces.model`).

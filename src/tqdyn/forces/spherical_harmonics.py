@@ -73,6 +73,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics.jit import dynamic  # (importing numerics.jit registers the package-wide kernel cache)
+from ..numerics.jit import inner_kernel
 
 __all__ = [
     "NMAX_SH",
@@ -153,7 +154,7 @@ for _t in (_A, _B, _FZ, _FM, _FP, _CK):
     _t.setflags(write=False)
 del _t
 
-@njit(cache=True)
+@inner_kernel
 def _factors(j, k):
     """(a, b, f_z, f_-, f_+) of harmonic (j, k), j >= 1, as in _factor_tables
     (same products, same order); for the degrees above the tables."""
@@ -207,7 +208,7 @@ def _accumulate(ax, ay, az, fz, fm, fp, v, w, cm, sm, c0, s0, cp, sp):
     return ax, ay, az
 
 
-@njit(cache=True)
+@inner_kernel
 def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, nmin):
     """Acceleration [m/s^2] of a fully-normalised spherical-harmonic field,
     degrees nmin .. max(nmax, nt), at body-fixed position (x, y, z) [m]; the
@@ -386,7 +387,7 @@ def sh_accel_flat(x, y, z, gm, radius, C, S, ldc, nmax, mmax, dC, dS, ldt, nt, n
     return scale * ax, scale * ay, scale * az
 
 
-@njit(cache=True)
+@inner_kernel
 def sh_accel(x, y, z, gm, radius, C, S, nmax, nmin=2, mmax=-1):
     """Acceleration [m/s^2] of a fully-normalised spherical-harmonic field,
     degrees nmin .. nmax, orders 0 .. mmax, at body-fixed position (x, y, z)

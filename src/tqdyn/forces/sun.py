@@ -46,11 +46,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
-from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..astro.constants import J2000_JD
 from ..astro.timescales import tdb_jd
+from ..numerics.jit import inner_kernel
 from ..readers.pck import IauSunElements, read_iau_sun_elements
 
 __all__ = [
@@ -111,7 +110,7 @@ def solar_iau_rotation(jd1, jd2, elements: IauSunElements | None = None) -> np.n
     return np.stack(rows, axis=-1).reshape(np.shape(d) + (3, 3))
 
 
-@njit(cache=True)
+@inner_kernel
 def zonal_j2_accel(dx, dy, dz, gm, j2r2, px, py, pz):
     """Acceleration [m/s^2] of the zonal J2 term of a body at the body-centred
     position d = (dx, dy, dz) [m] (any inertial axes), pole unit vector
@@ -124,7 +123,7 @@ def zonal_j2_accel(dx, dy, dz, gm, j2r2, px, py, pz):
     return k * (u * dx + 2.0 * z * px), k * (u * dy + 2.0 * z * py), k * (u * dz + 2.0 * z * pz)
 
 
-@njit(cache=True)
+@inner_kernel
 def sun_j2_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Geocentric acceleration [m/s^2, GCRS] of a satellite at (rx, ry, rz)
     [m, GCRS] from the Sun's J2: field on the satellite minus field on the

@@ -52,6 +52,7 @@ from numba import njit
 
 from .._choices import unknown as unknown_name
 from ..numerics.dd import add, const, div, mul, neg, sqrt, sub
+from ..numerics.jit import inner_kernel
 
 __all__ = ["ThirdBodies", "pm_difference", "third_body_accel", "third_bodies_accel", "third_body_accel_ext",
            "third_body_jerk", "third_body_position_jacobian_times"]
@@ -73,7 +74,7 @@ def pm_difference(gm, Dx, Dy, Dz, ex, ey, ez):
     return gm * (ex / p3 + Dx * w), gm * (ey / p3 + Dy * w), gm * (ez / p3 + Dz * w)
 
 
-@njit(cache=True)
+@inner_kernel
 def third_body_accel(rx, ry, rz, sx, sy, sz, gm):
     """Geocentric acceleration [m/s^2] of a satellite at r [m] due to a point
     mass gm [m^3/s^2] at s [m] (direct minus indirect term, Battin's
@@ -106,7 +107,7 @@ def third_body_position_jacobian_times(rx, ry, rz, sx, sy, sz, gm, ex, ey, ez):
             gm * ((ez - pd * dz) * id3 - (ez - ps * sz) * is3))
 
 
-@njit(cache=True)
+@inner_kernel
 def third_body_accel_ext(rx, ry, rz, sx, sy, sz, gm, lx=0.0, ly=0.0, lz=0.0):
     """:func:`third_body_accel` in the number type of r (generic: dd tuples
     or float64): for extended-precision evaluation of the large third-body
@@ -148,7 +149,7 @@ def third_body_jerk(gm, rx, ry, rz, vx, vy, vz, sx, sy, sz, ux, uy, uz):
             gm * ((ez - q * dz) * id3 - (uz - p * sz) * is3))
 
 
-@njit(cache=True)
+@inner_kernel
 def third_bodies_accel(rx, ry, rz, vx, vy, vz, tdat, params):
     """Sum of the point-mass terms of all bodies (the perturbation-kernel
     signature of :mod:`tqdyn.forces.model`): tdat = body positions (3 n,) [m]

@@ -227,7 +227,7 @@ def lo_part(a):
     """Low part of a dd number (0.0 for float64): a = to_f64(a) + lo_part(a)."""
 
 
-@overload(add)
+@overload(add, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_add(a, b):
     if _is_dd(a) and _is_dd(b):
         return lambda a, b: _dd_add(a[0], a[1], b[0], b[1])
@@ -239,14 +239,14 @@ def _ov_add(a, b):
         return lambda a, b: a + b
 
 
-@overload(add_acc)
+@overload(add_acc, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_add_acc(a, b):
     if _is_dd(a) and _is_dd(b):
         return lambda a, b: _dd_add_sloppy(a[0], a[1], b[0], b[1])
     return _ov_add(a, b)
 
 
-@overload(sub)
+@overload(sub, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_sub(a, b):
     if _is_dd(a) and _is_dd(b):
         return lambda a, b: _dd_add(a[0], a[1], -b[0], -b[1])
@@ -258,7 +258,7 @@ def _ov_sub(a, b):
         return lambda a, b: a - b
 
 
-@overload(mul)
+@overload(mul, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_mul(a, b):
     if _is_dd(a) and _is_dd(b):
         return lambda a, b: _dd_mul(a[0], a[1], b[0], b[1])
@@ -270,7 +270,7 @@ def _ov_mul(a, b):
         return lambda a, b: a * b
 
 
-@overload(div)
+@overload(div, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_div(a, b):
     if _is_dd(a) and _is_dd(b):
         return lambda a, b: _dd_div(a[0], a[1], b[0], b[1])
@@ -282,7 +282,7 @@ def _ov_div(a, b):
         return lambda a, b: a / b
 
 
-@overload(sqrt)
+@overload(sqrt, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_sqrt(a):
     if _is_dd(a):
         return lambda a: _dd_sqrt(a[0], a[1])
@@ -290,7 +290,7 @@ def _ov_sqrt(a):
         return lambda a: math.sqrt(a)
 
 
-@overload(neg)
+@overload(neg, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_neg(a):
     if _is_dd(a):
         return lambda a: (-a[0], -a[1])
@@ -298,7 +298,7 @@ def _ov_neg(a):
         return lambda a: -a
 
 
-@overload(to_f64)
+@overload(to_f64, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_to_f64(a):
     if _is_dd(a):
         return lambda a: a[0]
@@ -306,7 +306,7 @@ def _ov_to_f64(a):
         return lambda a: float(a)
 
 
-@overload(lo_part)
+@overload(lo_part, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_lo_part(a):
     if _is_dd(a):
         return lambda a: a[1]
@@ -314,7 +314,7 @@ def _ov_lo_part(a):
         return lambda a: 0.0
 
 
-@overload(const)
+@overload(const, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_const(hi, lo, like):
     if _is_dd(like):
         return lambda hi, lo, like: (float(hi), float(lo))
@@ -335,7 +335,7 @@ def st(arr, value, *idx):
     """Store a generic number into ``arr[idx]`` (both parts for dd arrays)."""
 
 
-@overload(ld)
+@overload(ld, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_ld(arr, *idx):
     nidx = len(idx)
     if arr.ndim == nidx + 1:
@@ -348,7 +348,7 @@ def _ov_ld(arr, *idx):
         return impl
 
 
-@overload(st)
+@overload(st, jit_options=_jit.OVERLOAD_OPTIONS)
 def _ov_st(arr, value, *idx):
     nidx = len(idx)
     if arr.ndim == nidx + 1 and _is_dd(value):

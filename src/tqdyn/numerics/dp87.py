@@ -36,6 +36,7 @@ from numba import njit
 from .._choices import unknown
 from .dd import add, add_acc, dd_from_mp, ld, mp_exact, mul, st, sub, to_f64
 from . import _dp87_tableau as _tab
+from .jit import inner_kernel
 
 __all__ = [
     "CORRECTED_TABLEAU_PROVENANCE", "TABLEAUX", "Tableau", "load_tableau", "StepCoefficients",
@@ -151,7 +152,7 @@ def step_coefficients(tab: Tableau, h, precision: str) -> StepCoefficients:
 # compiled building blocks (generic over dd / float64)
 
 
-@njit(cache=True)
+@inner_kernel
 def stage_state(y, K, ha, nz, nnz, i, out):
     """out = y + sum_j ha[i, j] K[j] over the nonzero a[i][j] (j < i).
 
@@ -167,7 +168,7 @@ def stage_state(y, K, ha, nz, nnz, i, out):
             st(out, acc, b, q)
 
 
-@njit(cache=True)
+@inner_kernel
 def combine(y, comp, K, hb, nzb, nnzb, he, err):
     """Advance y in place by the 8th-order increment sum_j hb[j] K[j], with a
     compensated (Kahan) update: ``comp`` carries the rounding error of the

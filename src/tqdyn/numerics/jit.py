@@ -28,12 +28,18 @@ import os
 import pathlib
 import shutil
 import time
+import types
 
 import numba
 from numba.core import types as _types
+from numba.core.caching import NullCache
+from numba.core.compiler import CompilerBase, DefaultPassBuilder
+from numba.core.compiler_machinery import LoweringPass, register_pass
+from numba.core.registry import CPUDispatcher
+from numba.core.typed_passes import NativeLowering
 from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "install_cache_locator", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
@@ -131,6 +137,121 @@ def dynamic(typingctx, x):
         return context.cast(builder, args[0], signature.args[0], signature.return_type)
 
     return _types.unliteral(x)(x), codegen
+
+
+#: ``jit_options`` of tqdyn's numba overloads (called by compiled code only): no C wrapper (numba gives
+#: overloads no CPython wrapper already), which every caller would link in and optimise again.
+OVERLOAD_OPTIONS = {"no_cfunc_wrapper": True}
+
+#: Suffix of the qualified name of an inner kernel's Python entry (:class:`_InnerDispatcher`): its own
+#: cache files, apart from the inner kernel's (numba keys a cached kernel by name and argument types only).
+_PYTHON_ENTRY = "__python_entry"
+
+
+@register_pass(mutates_CFG=False, analysis_only=False)
+class _DropWrappers(LoweringPass):
+    """Compiler pass before the lowering: no CPython and no C wrapper for
+    this function (set here, after typing, so that the functions it calls
+    are typed and compiled with the same flags as under ``njit`` and their
+    compiled versions are shared)."""
+    _name = "tqdyn_drop_wrappers"
+    keep_python = False
+
+    def __init__(self):
+        LoweringPass.__init__(self)
+
+    def run_pass(self, state):
+        state.flags = state.flags.copy()
+        state.flags.no_cfunc_wrapper = True
+        if not self.keep_python:
+            state.flags.no_cpython_wrapper = True
+        return True
+
+
+@register_pass(mutates_CFG=False, analysis_only=False)
+class _DropCWrapper(_DropWrappers):
+    """:class:`_DropWrappers` that keeps the CPython wrapper (the C wrapper
+    serves only numba's first-class function objects, which tqdyn does not use)."""
+    _name = "tqdyn_drop_c_wrapper"
+    keep_python = True
+
+
+class _InnerCompiler(CompilerBase):
+    """numba's nopython pipeline with :class:`_DropWrappers` before the lowering."""
+    drop = _DropWrappers
+
+    def define_pipelines(self):
+        pm = DefaultPassBuilder.define_nopython_pipeline(self.state)
+        at = next(i for i, (p, _) in enumerate(pm.passes) if p is NativeLowering)
+        pm.passes.insert(at, (self.drop, self.drop.__doc__.split("\n")[0]))
+        pm.finalize()
+        return [pm]
+
+
+class _EntryCompiler(_InnerCompiler):
+    """numba's nopython pipeline with :class:`_DropCWrapper` before the lowering."""
+    drop = _DropCWrapper
+
+
+class _InnerDispatcher(CPUDispatcher):
+    """A numba dispatcher whose compiled versions have no CPython and no C
+    wrapper: the versions compiled for other compiled functions, which call
+    the native function directly.  Every compiled function otherwise gets
+    both wrappers, and each caller links them in and optimises them again
+    with its own code (a fifth of the first run's compile time).  Called
+    from Python, it runs a twin compiled with the wrappers (same source and
+    options; its own cache files), so Python callers see an ordinary kernel."""
+
+    def __init__(self, py_func, locals=None, targetoptions=None, pipeline_class=_InnerCompiler):
+        super().__init__(py_func, locals=locals, targetoptions=targetoptions, pipeline_class=pipeline_class)
+        self._python_entry = None
+
+    def python_entry(self) -> CPUDispatcher:
+        """The twin with the wrappers, which calls from Python run (compiled and cached on first use)."""
+        if self._python_entry is None:
+            f = self.py_func
+            twin = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__, f.__closure__)
+            twin.__qualname__ = f.__qualname__ + _PYTHON_ENTRY
+            twin.__doc__ = f.__doc__
+            entry = CPUDispatcher(twin, locals=self.locals, targetoptions=self.targetoptions)
+            if not isinstance(self._cache, NullCache):
+                entry.enable_caching()
+            self._python_entry = entry
+        return self._python_entry
+
+    def __call__(self, *args, **kwargs):
+        return self.python_entry()(*args, **kwargs)
+
+
+def inner_kernel(func=None, *, cache: bool = True, **options):
+    """``numba.njit(cache=cache, **options)`` for a function called mostly
+    from other compiled functions: its compiled versions carry neither the
+    CPython nor the C wrapper (:class:`_InnerDispatcher`), which saves their
+    compilation in every caller; the compiled code is the same.  Calls from
+    Python work as for any kernel (through a twin compiled with the
+    wrappers).  Entry points that Python and compiled code both call stay
+    ``njit``, so that one compiled version serves both.  Usage:
+    ``@inner_kernel`` or ``@inner_kernel(...)``."""
+    def decorate(f):
+        dispatcher = _InnerDispatcher(f, targetoptions={"nopython": True, **options})
+        if cache:
+            dispatcher.enable_caching()
+        return dispatcher
+
+    return decorate if func is None else decorate(func)
+
+
+def kernel(func=None, *, cache: bool = True, **options):
+    """``numba.njit(cache=cache, **options)`` without numba's C wrapper (a
+    second entry besides the CPython one, which every caller compiled
+    later links in): for the kernels that Python calls and compiled code
+    calls too (e.g. the right-hand sides, called by the propagation loops
+    and by :func:`tqdyn.dynamics.rhs.evaluate_rhs`).  Usage: ``@kernel`` or
+    ``@kernel(...)``."""
+    def decorate(f):
+        return numba.njit(cache=cache, pipeline_class=_EntryCompiler, **options)(f)
+
+    return decorate if func is None else decorate(func)
 
 
 def _touch(path: pathlib.Path) -> None:

@@ -47,6 +47,7 @@ from numba import njit
 from . import _multistep_coefficients as _tab
 from .dd import add, dd_from_mp, div, ld, mp_exact, mul, st, sub, to_f64
 from .jit import dynamic
+from .jit import inner_kernel, kernel
 
 __all__ = ["ORDERS", "CORRECTORS", "DEFAULT_ORDER", "DEFAULT_CORRECTOR", "Coefficients", "load_coefficients",
            "StepCoefficients", "step_coefficients", "predict", "correct", "commit", "start", "max_change", "ROW_NAMES"]
@@ -124,7 +125,7 @@ def step_coefficients(order: int, h, precision: str) -> StepCoefficients:
 # compiled building blocks (generic over dd / float64)
 
 
-@njit(cache=True)
+@inner_kernel
 def _weighted(F, head, row, coef, b, q, acc, first, k, shift):
     """acc + sum_j coef[row, j] f_{m-j}[b, q] over the table (j = 0 .. K).
 
@@ -141,7 +142,7 @@ def _weighted(F, head, row, coef, b, q, acc, first, k, shift):
     return acc
 
 
-@njit(cache=True)
+@inner_kernel
 def predict(S, cS, s, cs, F, head, coef, hh, out):
     """out = the predicted state at t_{n+1}: r = h^2 (S_n + sum_j PP_j f_{n-j}),
     r' = h (s_n + sum_j PV_j f_{n-j}) (the sums' compensations included)."""
@@ -154,7 +155,7 @@ def predict(S, cS, s, cs, F, head, coef, hh, out):
             st(out, mul(add(ld(s, b, q), accv), h), b, q + 3)
 
 
-@njit(cache=True)
+@inner_kernel
 def correct(S, cS, s, cs, F, head, k, coef, hh, out):
     """out = the corrected state at t_{n+1} from the derivative k (n_body,
     6[, 2]) evaluated at the previous iterate: r = h^2 (S_n + sum_j CP_j
@@ -168,7 +169,7 @@ def correct(S, cS, s, cs, F, head, k, coef, hh, out):
             st(out, mul(add(ld(s, b, q), accv), h), b, q + 3)
 
 
-@njit(cache=True)
+@inner_kernel
 def commit(S, cS, s, cs, F, head, k):
     """Enter f_{n+1} = k[:, 3:6] (the evaluation at the returned state):
     s_{n+1} = s_n + f_{n+1}, S_{n+1} = S_n + s_{n+1}, each a compensated
@@ -193,7 +194,7 @@ def commit(S, cS, s, cs, F, head, k):
     return new
 
 
-@njit(cache=True)
+@kernel
 def start(y, F, head, coef, hh, S, cS, s, cs):
     """Sums at t_N from the state y_N (n_body, 6[, 2]) and the table
     f_{N-K} .. f_N (newest at ``head``), by the corrector at N:
@@ -218,7 +219,7 @@ def start(y, F, head, coef, hh, S, cS, s, cs):
             st(cS, zero, b, q)
 
 
-@njit(cache=True)
+@inner_kernel
 def max_change(a, b, out):
     """out[0] = max(out[0], max |r_a - r_b|) [m], out[1] likewise for the
     velocities [m/s] (largest component, float64); a, b: (n_body, 6[, 2])."""

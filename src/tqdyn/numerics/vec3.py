@@ -10,50 +10,48 @@ IEEE order of operations, no fastmath: ``cross(a, b)`` is always
 
 from __future__ import annotations
 
-from numba import njit
-
-from . import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
+from .jit import inner_kernel
 
 __all__ = ["add", "axpy", "cross", "dot", "row", "scale", "sub"]
 
 
-@njit(cache=True)
+@inner_kernel
 def add(a, b):
     """a + b."""
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@njit(cache=True)
+@inner_kernel
 def sub(a, b):
     """a - b."""
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-@njit(cache=True)
+@inner_kernel
 def scale(s, a):
     """s * a (s a scalar)."""
     return (s * a[0], s * a[1], s * a[2])
 
 
-@njit(cache=True)
+@inner_kernel
 def axpy(s, a, b):
     """s * a + b (s a scalar)."""
     return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
 
 
-@njit(cache=True)
+@inner_kernel
 def dot(a, b):
     """a . b."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@inner_kernel
 def cross(a, b):
     """a x b."""
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=True)
+@inner_kernel
 def row(x, m):
     """Row m of a (n, 3) array as a tuple."""
     return (x[m, 0], x[m, 1], x[m, 2])

@@ -97,8 +97,9 @@ def kepler_benchmark(duration: str = "90d", step: str = "50", heyoka: bool = Tru
     half = load_scenario("tianqin-kepler", [f"run.duration={duration}",
                                             f"integrator.step={scen.integrator.step_s / 2}", *DP87])
     for name, precision, sc in (("dd", "dd", scen), ("float64", "float64", scen), ("dd h/2", "dd", half)):
+        model = dynamics.check_inputs(sc)
         t0 = time.perf_counter()
-        dynamics.warm_up(precision, cpar=dynamics.build_system(sc).cpar)
+        dynamics.warm_up(precision, cpar=dynamics.build_system(sc, model).cpar, model=model)
         compile_s = time.perf_counter() - t0
         rows = []
         res = dynamics.propagate(sc, precision=precision, sink=rows.append)

@@ -311,7 +311,8 @@ def run_to_file(scen, *, model=None, progress: Callable[[int], None] | None = No
         writer_factory = None
     t0 = time.perf_counter()
     try:
-        dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
+        dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar,
+                         model=model)
     except OSError as exc:  # numba could not write its cache (disk full, file-size limit)
         raise io.OutputIOError(f"JIT compilation could not write numba's cache: {exc.strerror or exc}; free "
                                f"space, or set NUMBA_CACHE_DIR to a writable directory") from None

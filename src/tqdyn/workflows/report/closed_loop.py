@@ -88,7 +88,7 @@ def _coupled_run(name: str, overrides):
 
     scen = load_scenario(name, list(overrides))
     model = dynamics.check_inputs(scen)
-    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
+    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar, model=model)
     blocks: list = []
     dynamics.propagate(scen, sink=blocks.append, model=model)
     return Trajectory.from_rows(dynamics.Rows.concatenate(blocks), output_attrs(scen, model),
