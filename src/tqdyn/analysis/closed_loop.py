@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from ..closedloop import frequency
+from ..closedloop import frequency, modal
 from ..closedloop.budget import grid_margins, loop_gains, noise_budget
 from ..closedloop.loop import OUTPUTS, SOURCES, output_names
 from ..closedloop.missions import requirement
@@ -43,13 +43,18 @@ _GROUP = 8
 
 
 def _margins(model: ClosedLoopModel, idx, fm) -> dict:
-    """:func:`tqdyn.closedloop.budget.grid_margins` of the loops ``idx`` (satellite-major indices)."""
+    """:func:`tqdyn.closedloop.budget.grid_margins` of the loops ``idx`` (satellite-major indices): the loop gains
+    modal where that leaves the margins unchanged, else exact (:func:`tqdyn.closedloop.modal.loop_gains`; exact:
+    the stacked 20 x 20 solves, or each loop's state space)."""
+    n_seg = len(model.loops[0])
+    cls = [model.loops[j // n_seg][j % n_seg][1] for j in idx]
     if model.stack is not None:
-        L = frequency.loop_gains(model.stack, idx, fm)
+        def exact(pos, f):
+            return frequency.loop_gains(model.stack, idx[pos], f)
     else:
-        n_seg = len(model.loops[0])
-        L = np.array([loop_gains(model.loops[j // n_seg][j % n_seg][1], fm)[1] for j in idx])
-    return grid_margins(L, fm)
+        def exact(pos, f):
+            return np.array([loop_gains(cls[p], f)[1] for p in pos])
+    return grid_margins(modal.loop_gains([c.system for c in cls], cls[0].channel_names, fm, exact), fm)
 
 
 def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, progress=None,
