@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["COND_MAX", "KAPPA", "loop_gains"]
+__all__ = ["COND_MAX", "KAPPA", "loop_gains", "transfer"]
 
 #: Safety factor of the modal evaluation's error bound (module docstring).
 KAPPA = 10.0
@@ -70,24 +70,22 @@ def _uncertain(L, rel) -> np.ndarray:
     return np.any(bad, axis=1)
 
 
-def loop_gains(systems, channels, f, exact) -> np.ndarray:
-    """Loop-at-a-time gains L (n, nc, F) of the closed loops ``systems`` (python-control state spaces with inputs
-    ``d_<channel>`` and outputs ``c_<channel>``, :class:`~tqdyn.closedloop.loop.ClosedLoop`) for the ``channels``
-    at ``f`` (F,) [Hz] (module docstring): modal where its error bound leaves the margins unchanged, else
-    ``exact(positions, f_sub)`` (the gains (len(positions), nc, len(f_sub)) of the loops ``systems[positions]``)."""
-    f = np.asarray(f, dtype=np.float64)
-    s = 2j * math.pi * f
+def transfer(systems, channels, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The modal T_kk (n, nc, F) of the closed loops ``systems`` (python-control state spaces with inputs
+    ``d_<channel>`` and outputs ``c_<channel>``) for the ``channels`` at ``f`` (F,) [Hz], the bound of its
+    absolute error (n, nc, F) (module docstring) and whether each loop's eigenvectors allow it (n,) bool (where
+    not, T and the bound are meaningless)."""
+    s = 2j * math.pi * np.asarray(f, dtype=np.float64)
     sys0 = systems[0]
     ii = [sys0.input_labels.index(f"d_{ch}") for ch in channels]
     oi = [sys0.output_labels.index(f"c_{ch}") for ch in channels]
     keep = _kept_states(sys0, oi)
-    n, nc = len(systems), len(channels)
+    if any(_kept_states(x, oi) != keep for x in systems[1:]):
+        raise ValueError("closed loops: the loops of one evaluation differ in the states they couple")
     A = np.array([np.asarray(x.A)[np.ix_(keep, keep)] for x in systems])
     Bd = np.array([np.asarray(x.B)[np.ix_(keep, ii)] for x in systems]).astype(complex)
     Cc = np.array([np.asarray(x.C)[np.ix_(oi, keep)] for x in systems])
     Dd = np.array([np.asarray(x.D)[oi, ii] for x in systems])                        # (n, nc): D_kk
-    if any(_kept_states(x, oi) != keep for x in systems[1:]):
-        raise ValueError("closed loops: the loops of one evaluation differ in the states they couple")
     lam, V = np.linalg.eig(A)
     cond = np.linalg.cond(V)
     ok = np.isfinite(cond) & (cond <= COND_MAX)
@@ -95,10 +93,21 @@ def loop_gains(systems, channels, f, exact) -> np.ndarray:
     g = 1.0 / (s[None, None, :] - lam[:, :, None])                                  # (n, n_state, F)
     T = np.matmul(r, g) + Dd[:, :, None]
     bound = KAPPA * np.finfo(np.float64).eps * np.where(ok, cond, 0.0)[:, None, None] * np.matmul(np.abs(r), np.abs(g))
+    return T, bound, ok
+
+
+def loop_gains(systems, channels, f, exact) -> np.ndarray:
+    """Loop-at-a-time gains L (n, nc, F) of the closed loops ``systems`` (python-control state spaces with inputs
+    ``d_<channel>`` and outputs ``c_<channel>``, :class:`~tqdyn.closedloop.loop.ClosedLoop`) for the ``channels``
+    at ``f`` (F,) [Hz] (module docstring): modal (:func:`transfer`) where its error bound leaves the margins
+    unchanged, else ``exact(positions, f_sub)`` (the gains (len(positions), nc, len(f_sub)) of the loops
+    ``systems[positions]``)."""
+    f = np.asarray(f, dtype=np.float64)
+    T, bound, ok = transfer(systems, channels, f)
     with np.errstate(divide="ignore", invalid="ignore"):
         L = -T / (1.0 + T)
         rel = bound / (np.abs(T) * np.abs(1.0 + T))
-    done = np.zeros((n, len(f)), dtype=bool)
+    done = np.zeros((len(systems), len(f)), dtype=bool)
     need = _uncertain(L, rel)
     need[~ok] = True
     for _ in range(_ROUNDS):
