@@ -41,7 +41,7 @@ from .loop import SOURCES, ClosedLoop, channel_names, controller_realisations, l
     source_inputs
 
 __all__ = ["LoopStack", "NOISE_INPUTS", "STACKED_SCHEMES", "closed_loop_matrices", "closed_loops",
-           "controller_response", "loop_gains", "noise_asd", "stack_loops", "unstable_loops"]
+           "controller_response", "loop_gains", "noise_asd", "rows_product", "stack_loops", "unstable_loops"]
 
 #: The noise inputs w of a closed loop, in order (sources of :data:`SOURCES`, their components).
 NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
@@ -264,6 +264,17 @@ def _columns_product(A, B) -> np.ndarray:
     return out
 
 
+def rows_product(A, B) -> np.ndarray:
+    """A B for stacked A (..., r, c) and B (..., c, n) (numpy's broadcasting), in blocks of A's rows small enough
+    (<= :data:`_BLAS_SINGLE` multiply-adds) that BLAS runs each on one thread (:func:`_columns_product`)."""
+    r, c = A.shape[-2:]
+    m = max(1, _BLAS_SINGLE // max(1, c * B.shape[-1]))
+    out = np.empty(np.broadcast_shapes(A.shape[:-2], B.shape[:-2]) + (r, B.shape[-1]), dtype=np.result_type(A, B))
+    for a in range(0, r, m):
+        np.matmul(A[..., a:a + m, :], B, out=out[..., a:a + m, :])
+    return out
+
+
 def _kmul(P, S, Ks, out) -> np.ndarray:
     """``out`` (k, F, a, b) complex plus P diag(K(s)) S for real P (k, a, 17), S (k, 17, b) and K(s) ``Ks``
     (17, F), in place and returned: the real products P_ic S_cj (one matrix per loop), then over their nonzero
@@ -329,7 +340,7 @@ def _response(st: LoopStack, idx, f) -> np.ndarray:
     for L, power in sens:
         if np.any(L):
             _kmul(ZuAc, L, Ks * s[None, :] ** power, W)
-    z = _kmul(ZuAc, st.Sw[idx], Ks, np.matmul(W, q))
+    z = _kmul(ZuAc, st.Sw[idx], Ks, rows_product(W, q))
     ZuAw = np.matmul(Zu, st.Aw[idx])
     r, c = np.nonzero(np.any(ZuAw != 0, axis=0))
     z[:, :, r, c] += ZuAw[:, None, r, c]
