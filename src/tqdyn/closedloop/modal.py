@@ -73,8 +73,8 @@ def _uncertain(L, rel) -> np.ndarray:
 
 
 def transfer(systems, channels, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The modal T_kk (n, nc, F) of the closed loops ``systems`` (python-control state spaces with inputs
-    ``d_<channel>`` and outputs ``c_<channel>``) for the ``channels`` at ``f`` (F,) [Hz], the bound of its
+    """The modal T_kk (n, nc, F) of the closed loops ``systems`` (python-control state spaces with the same states,
+    inputs ``d_<channel>`` and outputs ``c_<channel>``) for the ``channels`` at ``f`` (F,) [Hz], the bound of its
     absolute error (n, nc, F) (module docstring) and whether each loop's eigenvectors allow it (n,) bool (where
     not, T and the bound are meaningless)."""
     s = 2j * math.pi * np.asarray(f, dtype=np.float64)
@@ -82,8 +82,8 @@ def transfer(systems, channels, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ii = [sys0.input_labels.index(f"d_{ch}") for ch in channels]
     oi = [sys0.output_labels.index(f"c_{ch}") for ch in channels]
     keep = _kept_states(sys0, oi)
-    if any(_kept_states(x, oi) != keep for x in systems[1:]):
-        raise ValueError("closed loops: the loops of one evaluation differ in the states they couple")
+    if any(tuple(x.state_labels) != tuple(sys0.state_labels) or _kept_states(x, oi) != keep for x in systems[1:]):
+        raise ValueError("closed loops: the loops of one evaluation differ in their states")
     A = np.array([np.asarray(x.A)[np.ix_(keep, keep)] for x in systems])
     Bd = np.array([np.asarray(x.B)[np.ix_(keep, ii)] for x in systems]).astype(complex)
     Cc = np.array([np.asarray(x.C)[np.ix_(oi, keep)] for x in systems])
@@ -107,10 +107,19 @@ def transfer(systems, channels, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def loop_gains(systems, channels, f, exact) -> np.ndarray:
     """Loop-at-a-time gains L (n, nc, F) of the closed loops ``systems`` (python-control state spaces with inputs
     ``d_<channel>`` and outputs ``c_<channel>``, :class:`~tqdyn.closedloop.loop.ClosedLoop`) for the ``channels``
-    at ``f`` (F,) [Hz] (module docstring): modal (:func:`transfer`) where its error bound leaves the margins
-    unchanged, else ``exact(positions, f_sub)`` (the gains (len(positions), nc, len(f_sub)) of the loops
+    at ``f`` (F,) [Hz] (module docstring; loops with other states, e.g. controllers of other orders, apart): modal
+    (:func:`transfer`) where its error bound leaves the margins unchanged, else ``exact(positions, f_sub)`` (the gains (len(positions), nc, len(f_sub)) of the loops
     ``systems[positions]``)."""
     f = np.asarray(f, dtype=np.float64)
+    kinds = {}
+    for i, x in enumerate(systems):
+        kinds.setdefault(tuple(x.state_labels), []).append(i)
+    if len(kinds) > 1:                                   # e.g. controllers of other orders: each kind apart
+        L = np.empty((len(systems), len(channels), len(f)), dtype=complex)
+        for pos in kinds.values():
+            pos = np.array(pos)
+            L[pos] = loop_gains([systems[i] for i in pos], channels, f, lambda q, ff, pos=pos: exact(pos[q], ff))
+        return L
     T, bound, ok = transfer(systems, channels, f)
     with np.errstate(divide="ignore", invalid="ignore"):
         L = -T / (1.0 + T)
