@@ -18,10 +18,11 @@ time axis (``traj.reference.time_scale`` since the epoch).  Frames: :data:`tqdyn
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
-from ..closedloop import frequency
+from ..closedloop import frequency, modal
 from ..closedloop.budget import grid_margins, loop_gains, noise_budget
 from ..closedloop.loop import OUTPUTS, SOURCES, output_names
 from ..closedloop.missions import requirement
@@ -42,18 +43,52 @@ MARGIN_GRID = (1e-6, 10.0, 1500)
 _GROUP = 8
 
 
+def _cores() -> int:
+    """The CPU cores this process may use."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def _ordered_map(fn, items, threads: int | None):
+    """fn over ``items``, results in order, on ``threads`` threads (default :func:`_cores`) with at most two
+    items per thread ahead of the one consumed (bounds the memory of the results held)."""
+    threads = _cores() if threads is None else max(1, int(threads))
+    if threads == 1 or len(items) < 2:
+        yield from map(fn, items)
+        return
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads) as pool:
+        it = iter(items)
+        pending = deque(pool.submit(fn, x) for _, x in zip(range(2 * threads), it))
+        while pending:
+            out = pending.popleft().result()
+            for x in it:
+                pending.append(pool.submit(fn, x))
+                break
+            yield out
+
+
 def _margins(model: ClosedLoopModel, idx, fm) -> dict:
-    """:func:`tqdyn.closedloop.budget.grid_margins` of the loops ``idx`` (satellite-major indices)."""
+    """:func:`tqdyn.closedloop.budget.grid_margins` of the loops ``idx`` (satellite-major indices): the loop gains
+    modal where that leaves the margins unchanged, else exact (:func:`tqdyn.closedloop.modal.loop_gains`; exact:
+    the stacked 20 x 20 solves, or each loop's state space)."""
+    n_seg = len(model.loops[0])
+    cls = [model.loops[j // n_seg][j % n_seg][1] for j in idx]
     if model.stack is not None:
-        L = frequency.loop_gains(model.stack, idx, fm)
+        def exact(pos, f):
+            return frequency.loop_gains(model.stack, idx[pos], f)
     else:
-        n_seg = len(model.loops[0])
-        L = np.array([loop_gains(model.loops[j // n_seg][j % n_seg][1], fm)[1] for j in idx])
-    return grid_margins(L, fm)
+        def exact(pos, f):
+            return np.array([loop_gains(cls[p], f)[1] for p in pos])
+    return grid_margins(modal.loop_gains([c.system for c in cls], cls[0].channel_names, fm, exact), fm)
 
 
 def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, progress=None,
-                       per_source: bool = True):
+                       per_source: bool = True, threads: int | None = None):
     """The noise budget as an ``xarray.Dataset``: ``asd`` (segment, sat, output, source, frequency) one-sided
     [output unit/Hz^1/2] (only with ``per_source``); ``total`` (segment, sat, output, frequency) the sources
     summed in power; ``requirement`` (frequency) the mission's TM acceleration requirement [m/s^2/Hz^1/2];
@@ -66,7 +101,9 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, 
     :func:`tqdyn.closedloop.budget.noise_budget`).  ``dt`` [s]: the zero-order-hold discretised loops' budget
     (a sampled loop on held noise; the time series realise the continuous budget:
     :mod:`tqdyn.closedloop.synthesis`; one state space at a time).  ``progress``: called with 1 after each
-    (segment, satellite) loop.  Coordinates carry units and frames (attrs)."""
+    (segment, satellite) loop.  ``threads``: groups of loops evaluated at once by the stacked path (default: the
+    CPU cores this process may use; numpy's solves and products run outside the interpreter's lock); the result
+    does not depend on it.  Coordinates carry units and frames (attrs)."""
     import xarray as xr
 
     s = model.settings
@@ -82,22 +119,27 @@ def closed_loop_budget(model: ClosedLoopModel, f=None, dt: float | None = None, 
     fm = np.logspace(math.log10(MARGIN_GRID[0]), math.log10(MARGIN_GRID[1]), MARGIN_GRID[2])
     margins = {}
     order = np.arange(n_sat * n_seg)
-    for a in range(0, len(order), _GROUP):
-        idx = order[a:a + _GROUP]
+    groups = [order[a:a + _GROUP] for a in range(0, len(order), _GROUP)]
+
+    def evaluate(idx):
         if fast:
             b, _src = frequency.noise_asd(model.stack, idx, model.noise, f)
         else:
             b = np.array([noise_budget(model.loops[j // n_seg][j % n_seg][1], model.noise, f, dt=dt)[0] for j in idx])
-        sat, seg = idx // n_seg, idx % n_seg
         b2 = b ** 2
-        total[seg, sat] = np.sqrt(np.sum(b2, axis=2))
+        power = np.zeros(b.shape[:3] + (len(BANDS),))
         for m, mask in enumerate(bands):
             if np.any(mask):
-                band_power[seg, sat, :, :, m] = np.mean(b2[..., mask], axis=-1)
+                power[..., m] = np.mean(b2[..., mask], axis=-1)
+        return np.sqrt(np.sum(b2, axis=2)), power, (b if per_source else None), _margins(model, idx, fm)
+
+    for idx, (tot, power, b, marg) in zip(groups, _ordered_map(evaluate, groups, threads if fast else 1)):
+        sat, seg = idx // n_seg, idx % n_seg
+        total[seg, sat] = tot
+        band_power[seg, sat] = power
         if per_source:
             asd[seg, sat] = b
-        del b, b2
-        for key, v in _margins(model, idx, fm).items():
+        for key, v in marg.items():
             margins.setdefault(key, np.empty((n_seg, n_sat) + v.shape[1:]))[seg, sat] = v
         if progress is not None:
             for _ in idx:

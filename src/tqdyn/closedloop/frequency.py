@@ -21,7 +21,9 @@ static observables z = Oy y + Ou u (w the noise inputs, d the loop breaks, z the
   plant's own coordinates.  The plant outputs that are second derivatives of a coordinate (the TMs'
   relative accelerations x_l'', rows of the plant's C, D equal to rows of its A, B) are taken as s^2 q:
   no cancellation of large terms at low frequencies.  The controllers' terms P diag(K(s)) S are one matrix
-  product over all frequencies, in blocks small enough that BLAS keeps them on one thread.
+  product over all frequencies, in blocks small enough that BLAS keeps them on one thread.  The outputs are
+  z = W(s) q + (direct terms), W (46 x 20) built per loop and frequency: one stacked matrix product, a few
+  dozen frequencies of one loop at a time (arrays of a few MB).
 
 Units SI; frequencies in Hz, s in rad/s; ASDs one-sided in (output unit)/Hz^1/2.
 """
@@ -39,7 +41,7 @@ from .loop import SOURCES, ClosedLoop, channel_names, controller_realisations, l
     source_inputs
 
 __all__ = ["LoopStack", "NOISE_INPUTS", "STACKED_SCHEMES", "closed_loop_matrices", "closed_loops",
-           "controller_response", "loop_gains", "noise_asd", "stack_loops", "unstable_loops"]
+           "controller_response", "loop_gains", "noise_asd", "rows_product", "stack_loops", "unstable_loops"]
 
 #: The noise inputs w of a closed loop, in order (sources of :data:`SOURCES`, their components).
 NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
@@ -50,6 +52,9 @@ NOISE_INPUTS = tuple(s for src in SOURCES for s in source_inputs(src))
 STACKED_SCHEMES = ("constellation", "collinear")
 #: Complex numbers held at once per evaluation chunk (bounds the memory: 16 bytes each).
 _CHUNK_ELEMENTS = 1_500_000
+#: Complex numbers of one loop's transfer functions evaluated at once by :func:`noise_asd` (a few MB, so that its
+#: arrays stay in the processor's caches).
+_BLOCK_ELEMENTS = 250_000
 #: Complex multiply-adds of one matrix product that OpenBLAS runs on one thread (measured: its zgemm threads at
 #: 5e4 multiply-adds, not at 2e4).
 _BLAS_SINGLE = 20_000
@@ -247,19 +252,6 @@ def _chunks(n_loops: int, per_loop: int):
         yield range(a, min(n_loops, a + size))
 
 
-def _lmul(L, X) -> np.ndarray:
-    """L X for real L (k, a, b) and complex X (k, F, b, m): (k, F, a, m).  The blocks' matrices are sparse (a
-    few entries per row): the product runs over the nonzero pattern shared by the k loops, each row summed in
-    the order of its columns (a BLAS product sums in another order: at low frequencies, where some outputs are
-    differences of large terms, that moves them by up to 1e-8 relative)."""
-    r, c = np.nonzero(np.any(L != 0, axis=0))                     # row-major: sorted by row
-    out = np.zeros(X.shape[:2] + (L.shape[1], X.shape[3]), dtype=complex)
-    if len(r):
-        starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-        out[:, :, r[starts], :] = np.add.reduceat(X[:, :, c, :] * L[:, r, c][:, None, :, None], starts, axis=2)
-    return out
-
-
 def _columns_product(A, B) -> np.ndarray:
     """A B for A (k, r, c) and B (c, n), in blocks of B's columns small enough (<= :data:`_BLAS_SINGLE` multiply-adds)
     that BLAS runs each on one thread: on a machine shared with other jobs a threaded product of these sizes waits
@@ -269,6 +261,17 @@ def _columns_product(A, B) -> np.ndarray:
     out = np.empty((k, r, B.shape[1]), dtype=np.result_type(A, B))
     for a in range(0, B.shape[1], n):
         out[:, :, a:a + n] = np.matmul(A, B[:, a:a + n])
+    return out
+
+
+def rows_product(A, B) -> np.ndarray:
+    """A B for stacked A (..., r, c) and B (..., c, n) (numpy's broadcasting), in blocks of A's rows small enough
+    (<= :data:`_BLAS_SINGLE` multiply-adds) that BLAS runs each on one thread (:func:`_columns_product`)."""
+    r, c = A.shape[-2:]
+    m = max(1, _BLAS_SINGLE // max(1, c * B.shape[-1]))
+    out = np.empty(np.broadcast_shapes(A.shape[:-2], B.shape[:-2]) + (r, B.shape[-1]), dtype=np.result_type(A, B))
+    for a in range(0, r, m):
+        np.matmul(A[..., a:a + m, :], B, out=out[..., a:a + m, :])
     return out
 
 
@@ -287,17 +290,13 @@ def _kmul(P, S, Ks, out) -> np.ndarray:
     return out
 
 
-def _polys(terms, s, X) -> np.ndarray:
-    """sum_p s^p L_p X over the (L_p, p) of ``terms`` (real L_p (k, a, b), zero ones left out) for X (k, F, b, m)."""
-    out = None
+def _powers(terms, s, shape) -> np.ndarray:
+    """sum_p s^p L_p (k, F, a, b) complex over the (L_p, p) of ``terms`` (real L_p (k, a, b), zero ones left out)
+    at ``s`` (F,)."""
+    out = np.zeros(shape, dtype=complex)
     for L, power in terms:
-        if not np.any(L):
-            continue
-        y = _lmul(L, X)
-        y = y if power == 0 else y * (s ** power)[None, :, None, None]
-        out = y if out is None else out + y
-    if out is None:
-        out = np.zeros(X.shape[:2] + (terms[0][0].shape[1], X.shape[3]), dtype=complex)
+        if np.any(L):
+            out += L[:, None] if power == 0 else L[:, None] * (s ** power)[None, :, None, None]
     return out
 
 
@@ -325,16 +324,27 @@ def _solve(st: LoopStack, idx, s, Ks, breaks: bool):
 
 
 def _response(st: LoopStack, idx, f) -> np.ndarray:
-    """:func:`noise_response` with the frequency second: (k, F, 46, 58)."""
+    """:func:`noise_response` with the frequency second: (k, F, 46, 58).  Eliminating c and u, the outputs are
+    z = W(s) q + Zu (Ac K(s) Sw + Aw) w with Zu = Oy Dp + Ou and W(s) = Oy (Cq + s Cv + s^2 C2)
+    + Zu Ac K(s) Sy (Cq + s Cv + s^2 C2): W is built per loop and frequency (46 x 20) and multiplied with the
+    solves q (20 x 58) in one stacked matrix product; the direct terms are added on their nonzero pattern."""
     idx = np.atleast_1d(np.asarray(idx))
     s = 2j * math.pi * np.asarray(f, dtype=np.float64)
     Ks = controller_response(st, s)
     q, sens, (_Kq, _Gq, _Bq, Cq, Cv, C2, Dp) = _solve(st, idx, s, Ks, False)
-    c = Ks.T[None, :, :, None] * (_polys(sens, s, q) + st.Sw[idx][:, None])          # (k, F, 17, 58)
-    u = _lmul(st.Ac[idx], c) + st.Aw[idx][:, None]                                   # (k, F, 32, 58)
     Oy = st.Oy[idx]
-    return _polys([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, q) \
-        + _lmul(np.matmul(Oy, Dp) + st.Ou[idx], u)
+    Zu = np.matmul(Oy, Dp) + st.Ou[idx]
+    ZuAc = np.matmul(Zu, st.Ac[idx])
+    k, F, nq, m = q.shape
+    W = _powers([(np.matmul(Oy, Cq), 0), (np.matmul(Oy, Cv), 1), (np.matmul(Oy, C2), 2)], s, (k, F, Oy.shape[1], nq))
+    for L, power in sens:
+        if np.any(L):
+            _kmul(ZuAc, L, Ks * s[None, :] ** power, W)
+    z = _kmul(ZuAc, st.Sw[idx], Ks, rows_product(W, q))
+    ZuAw = np.matmul(Zu, st.Aw[idx])
+    r, c = np.nonzero(np.any(ZuAw != 0, axis=0))
+    z[:, :, r, c] += ZuAw[:, None, r, c]
+    return z
 
 
 def noise_response(st: LoopStack, idx, f) -> np.ndarray:
@@ -349,18 +359,17 @@ def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
     f = np.asarray(f, dtype=np.float64)
     sources = [s for s in SOURCES if s in noise]
     idx = np.atleast_1d(np.asarray(idx))
+    starts = np.cumsum([0] + [SOURCES[src][0] for src in SOURCES])[:-1]
+    pick = [list(SOURCES).index(src) for src in sources]
+    asd = np.array([noise[src].asd(f) for src in sources]).reshape(len(sources), len(f))
     out = np.empty((len(idx), len(output_names()), len(sources), len(f)))
-    for part in _chunks(len(idx), len(f) * len(NOISE_INPUTS) * 52):
-        z = _response(st, idx[list(part)], f)                                       # (k, F, 46, 58)
-        p2 = z.real ** 2 + z.imag ** 2
-        k = 0
-        for src in SOURCES:
-            n = SOURCES[src][0]
-            if src in noise:
-                ps = np.sum(p2[:, :, :, k:k + n], axis=3)                                # (k, F, 46)
-                out[part.start:part.stop, :, sources.index(src), :] = np.moveaxis(np.sqrt(ps), 1, 2) \
-                    * noise[src].asd(f)[None, None]
-            k += n
+    nf = max(1, _BLOCK_ELEMENTS // (len(output_names()) * len(NOISE_INPUTS)))
+    for j in range(len(idx)):
+        for a in range(0, len(f), nf):
+            z = _response(st, idx[j:j + 1], f[a:a + nf])[0].view(np.float64)        # (F, 46, 2 x 58): re, im
+            z *= z
+            ps = np.add.reduceat(z, 2 * starts, axis=2)[..., pick]                  # (F, 46, n_source)
+            out[j, :, :, a:a + nf] = np.sqrt(np.moveaxis(ps, 0, 2)) * asd[:, a:a + nf]
     return out, sources
 
 

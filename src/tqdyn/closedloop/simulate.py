@@ -220,6 +220,8 @@ def simulate(loops: list, noise: dict, fs: float, n_samples: int, seed: int = 0,
                 vals[j0:j1, s, :] = y.T
                 j0 = j1
             gens[s].trim()
+            if k + m >= n_samples:                        # its last block: the satellite's filters are done
+                cache.pop((s, seg), None)
         sink.write(Block(t=t, values=vals, outputs=tuple(outputs)))
         k += m
     sink.close()

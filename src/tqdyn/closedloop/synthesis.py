@@ -430,13 +430,15 @@ class HighBand:
         self.nc = max([h.shape[-1] for _c, h in parts], default=FIR_MIN)
         self.m = sfft.next_fast_len(2 * self.nc, real=True)
         self.delta = FIR_MAX // 2 - self.nc // 2
-        hp = np.zeros((self.n_out, len(self.cols), self.nc))
-        i = 0
-        for cols, h in parts:
-            a = (self.nc - h.shape[-1]) // 2
-            hp[:, i:i + len(cols), a:a + h.shape[-1]] = h
-            i += len(cols)
-        self.Hf = np.ascontiguousarray(np.moveaxis(sfft.rfft(hp, self.m, axis=-1), -1, 0))   # (F, n_out, n_col)
+        self.Hf = np.empty((self.m // 2 + 1, self.n_out, len(self.cols)), dtype=complex)    # (F, n_out, n_col)
+        for o in range(self.n_out):                      # one output at a time: no second copy of all filters
+            hp = np.zeros((len(self.cols), self.nc))
+            i = 0
+            for cols, h in parts:
+                a = (self.nc - h.shape[-1]) // 2
+                hp[i:i + len(cols), a:a + h.shape[-1]] = h[o]
+                i += len(cols)
+            self.Hf[:, o, :] = sfft.rfft(hp, self.m, axis=-1).T
 
     def apply(self, buf: np.ndarray, buf0: int, k0: int, k1: int) -> np.ndarray:
         """Outputs (n_out, k1 - k0) at samples k0..k1-1 from the pre-filtered white inputs ``buf`` (n_in, L)
