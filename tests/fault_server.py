@@ -2,9 +2,10 @@
 imports of each one.
 
 Started once (``python fault_server.py``, this tree's sources on PYTHONPATH), it imports the command
-line and the libraries every command loads, then reads one JSON request per line on stdin and, for
-each, forks a child that runs ``tqdyn ARGV`` as the console script does (``sys.exit(main(argv))``;
-a library crashing at exit shows as a killed child, :func:`_child`).  It answers
+line and the libraries every command loads (and runs the Monte Carlo's cached H-infinity synthesis),
+then reads one JSON request per line on stdin and, for each, forks a child that runs ``tqdyn ARGV``
+as the console script does (``sys.exit(main(argv))``; a library crashing at exit shows as a killed
+child, :func:`_child`).  It answers
 ``{"pid": PID}`` when the child starts and ``{"status": S}`` when it ends (S: the exit status, or
 -signal for a child killed by a signal), one child at a time.
 
@@ -41,9 +42,17 @@ def _warm() -> None:
     for name in ("tqdyn.workflows.run", "tqdyn.workflows.export", "tqdyn.workflows.export_oem",
                  "tqdyn.workflows.export_ttl", "tqdyn.workflows.export_injection", "tqdyn.workflows.closed_loop",
                  "tqdyn.workflows.od", "tqdyn.workflows.od_files", "tqdyn.workflows.report", "tqdyn.workflows.sweep", "tqdyn.workflows.bench",
+                 "tqdyn.workflows.od_campaign", "tqdyn.workflows.closed_loop_mc", "distributed",
                  "tqdyn.analysis.closed_loop", "tqdyn.analysis.figures", "tqdyn.analysis.figures_od",
                  "tqdyn.analysis.budget", "tqdyn.od.problem", "xarray", "h5netcdf", "control", "tqdm"):
         importlib.import_module(name)
+    import warnings
+
+    from tqdyn.workflows.closed_loop_mc import _designs
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _designs("tianqin", ())  # the H-infinity synthesis of `closed-loop --monte-carlo` (cached; 6 s)
 
 
 def _resolve(target: str):

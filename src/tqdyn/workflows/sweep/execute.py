@@ -127,7 +127,11 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int, *, dashboard: st
     new LocalCluster (processes, 1 thread each, at most ``n_workers``
     (default: the usable cores) and at most ``n_tasks`` workers; scheduler on
     127.0.0.1; dashboard at ``dashboard``, default ``127.0.0.1:0`` (loopback,
-    any port), None: no dashboard).  Also used by :mod:`tqdyn.workflows.studies`."""
+    any port), None: no dashboard).  The local cluster's own log lines are silenced up to CRITICAL:
+    a worker still sending its heartbeat while an interrupted command closes the cluster logs an
+    ERROR with a traceback, which would follow the command's one error line on stderr; what fails is
+    reported by the command itself (a failed member's line, a lost worker's note).  Also used by
+    :mod:`tqdyn.workflows.studies`."""
     from distributed import Client, LocalCluster
 
     if isinstance(scheduler, Client):
@@ -145,7 +149,7 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int, *, dashboard: st
     # no dashboard: the scheduler still serves its plain HTTP routes (health, metrics): on loopback, any port
     http = {"dashboard": dashboard is not None, "dashboard_address": dashboard or DEFAULT_DASHBOARD}
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      scheduler_kwargs=http, silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      scheduler_kwargs=http, silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:
         yield client
 
 
