@@ -6,7 +6,8 @@ line and the libraries every command loads (and runs the Monte Carlo's cached H-
 then reads one JSON request per line on stdin and, for each, forks a child that runs ``tqdyn ARGV``
 as the console script does (``sys.exit(main(argv))``; a library crashing at exit shows as a killed
 child, :func:`_child`).  It answers
-``{"pid": PID}`` when the child starts and ``{"status": S}`` when it ends (S: the exit status, or
+``{"pid": PID}`` when the child starts (the leader of a new process group) and ``{"status": S}``
+when it ends (S: the exit status, or
 -signal for a child killed by a signal), one child at a time.
 
 A request: ``argv`` (the arguments after ``tqdyn``), ``cwd``, ``stdout`` and ``stderr`` (files the
@@ -90,6 +91,7 @@ def _child(req: dict):
     process, and not where the faults are): the atexit functions, then the C library's ``exit``,
     which runs the C libraries' exit handlers -- HDF5 closes its open files there, where a file
     left after a failed write crashes it."""
+    os.setpgid(0, 0)  # a process group of its own (and its children's), as a terminal's foreground job
     os.chdir(req["cwd"])
     for fd, path, flags in ((0, os.devnull, os.O_RDONLY),
                             (1, req["stdout"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC),
@@ -131,6 +133,10 @@ def serve() -> None:
         pid = os.fork()
         if pid == 0:
             _child(req)
+        try:
+            os.setpgid(pid, pid)  # as the child does: before the client may signal the group
+        except OSError:
+            pass
         _reply({"pid": pid})
         _, wstatus = os.waitpid(pid, 0)
         _reply({"status": os.waitstatus_to_exitcode(wstatus)})

@@ -8,7 +8,8 @@ temporary file) and the inputs unchanged.  Each cell runs the command in a real 
 not the imports) under the fault:
 
 * bad input: one representative refusal of the command;
-* SIGINT / SIGTERM: sent while the command is at work -- the child waits inside the command (the rename
+* SIGINT / SIGTERM: sent while the command is at work (SIGINT to the child's process group, as Ctrl-C
+  in a terminal; SIGTERM to the child, as kill) -- the child waits inside the command (the rename
   of its output into place, with the temporary file written; the run's first block of rows; the
   closed loop's budget, its temporary file open; the report's first figure) until the signal is sent;
 * full disk: a file-size limit of 1 kB (RLIMIT_FSIZE, SIGXFSZ ignored: writes fail with EFBIG, as on a
@@ -98,7 +99,8 @@ class Server:
 
     def run(self, argv, cwd, *, limit=None, block=None, sig=None):
         """Run ``tqdyn ARGV`` in ``cwd``; with ``block`` (target, only under ``cwd``) send ``sig`` once
-        the child waits there.  Returns (status, stdout, stderr); stdout is not kept under a limit (the
+        the child waits there (SIGINT to its process group, as Ctrl-C; another signal to the child).
+        Returns (status, stdout, stderr); stdout is not kept under a limit (the
         limit is for the command's files).  ``self.children``: the child's own child processes (a local
         Dask cluster's workers) when the signal was sent."""
         side = Path(cwd).parent / Path(cwd).name
@@ -121,7 +123,9 @@ class Server:
                 assert time.monotonic() - t0 < 300, f"{argv}: never reached {block[0]}"
             else:
                 self.children = _descendants(pid)
-                os.kill(pid, sig)
+                # Ctrl-C in a terminal reaches the whole foreground process group (the child and its own
+                # children, e.g. Dask workers); SIGTERM (kill, a batch scheduler) the process
+                (os.killpg if sig == signal.SIGINT else os.kill)(pid, sig)
                 go.touch()
         status = (answer or self._line())["status"]
         return status, out.read_text() if out.exists() else "", err.read_text()
