@@ -2,10 +2,12 @@
 imports of each one.
 
 Started once (``python fault_server.py``, this tree's sources on PYTHONPATH), it imports the command
-line and the libraries every command loads, then reads one JSON request per line on stdin and, for
-each, forks a child that runs ``tqdyn ARGV`` as the console script does (``sys.exit(main(argv))``;
-a library crashing at exit shows as a killed child, :func:`_child`).  It answers
-``{"pid": PID}`` when the child starts and ``{"status": S}`` when it ends (S: the exit status, or
+line and the libraries every command loads (and runs the Monte Carlo's cached H-infinity synthesis),
+then reads one JSON request per line on stdin and, for each, forks a child that runs ``tqdyn ARGV``
+as the console script does (``sys.exit(main(argv))``; a library crashing at exit shows as a killed
+child, :func:`_child`).  It answers
+``{"pid": PID}`` when the child starts (the leader of a new process group) and ``{"status": S}``
+when it ends (S: the exit status, or
 -signal for a child killed by a signal), one child at a time.
 
 A request: ``argv`` (the arguments after ``tqdyn``), ``cwd``, ``stdout`` and ``stderr`` (files the
@@ -41,9 +43,17 @@ def _warm() -> None:
     for name in ("tqdyn.workflows.run", "tqdyn.workflows.export", "tqdyn.workflows.export_oem",
                  "tqdyn.workflows.export_ttl", "tqdyn.workflows.export_injection", "tqdyn.workflows.closed_loop",
                  "tqdyn.workflows.od", "tqdyn.workflows.od_files", "tqdyn.workflows.report", "tqdyn.workflows.sweep", "tqdyn.workflows.bench",
+                 "tqdyn.workflows.od_campaign", "tqdyn.workflows.closed_loop_mc", "distributed",
                  "tqdyn.analysis.closed_loop", "tqdyn.analysis.figures", "tqdyn.analysis.figures_od",
                  "tqdyn.analysis.budget", "tqdyn.od.problem", "xarray", "h5netcdf", "control", "tqdm"):
         importlib.import_module(name)
+    import warnings
+
+    from tqdyn.workflows.closed_loop_mc import _designs
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _designs("tianqin", ())  # the H-infinity synthesis of `closed-loop --monte-carlo` (cached; 6 s)
 
 
 def _resolve(target: str):
@@ -81,6 +91,7 @@ def _child(req: dict):
     process, and not where the faults are): the atexit functions, then the C library's ``exit``,
     which runs the C libraries' exit handlers -- HDF5 closes its open files there, where a file
     left after a failed write crashes it."""
+    os.setpgid(0, 0)  # a process group of its own (and its children's), as a terminal's foreground job
     os.chdir(req["cwd"])
     for fd, path, flags in ((0, os.devnull, os.O_RDONLY),
                             (1, req["stdout"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC),
@@ -122,6 +133,10 @@ def serve() -> None:
         pid = os.fork()
         if pid == 0:
             _child(req)
+        try:
+            os.setpgid(pid, pid)  # as the child does: before the client may signal the group
+        except OSError:
+            pass
         _reply({"pid": pid})
         _, wstatus = os.waitpid(pid, 0)
         _reply({"status": os.waitstatus_to_exitcode(wstatus)})

@@ -8,7 +8,8 @@ temporary file) and the inputs unchanged.  Each cell runs the command in a real 
 not the imports) under the fault:
 
 * bad input: one representative refusal of the command;
-* SIGINT / SIGTERM: sent while the command is at work -- the child waits inside the command (the rename
+* SIGINT / SIGTERM: sent while the command is at work (SIGINT to the child's process group, as Ctrl-C
+  in a terminal; SIGTERM to the child, as kill) -- the child waits inside the command (the rename
   of its output into place, with the temporary file written; the run's first block of rows; the
   closed loop's budget, its temporary file open; the report's first figure) until the signal is sent;
 * full disk: a file-size limit of 1 kB (RLIMIT_FSIZE, SIGXFSZ ignored: writes fail with EFBIG, as on a
@@ -16,8 +17,14 @@ not the imports) under the fault:
 * corrupted input: the input cut to half its length;
 * output = input: the output path is a hard link or a symbolic link to an input.
 
+The commands on a local Dask cluster (`od campaign`, `closed-loop --monte-carlo`, one worker) get their
+signals once their tasks are submitted; the worker processes alive then (psutil) must have ended with
+the command, and a stopped campaign keeps only the result files of its finished members.
+
 The inputs are built once per module: a 3 h tianqin-kepler run, a 2 h coupled tianqin run, its
-closed-loop file (60 s at 4 Hz), a TDM, a sweep with its member done.
+closed-loop file (60 s at 4 Hz), a TDM, a sweep with its member done; the campaign's member is run
+once in this process (the workers load its kernels from the cache) and the fork server runs the Monte
+Carlo's H-infinity synthesis once (its children inherit it).
 """
 
 from __future__ import annotations
@@ -41,6 +48,9 @@ SERVER = str(Path(__file__).resolve().parent / "fault_server.py")
 FAULTS = ("bad input", "SIGINT", "SIGTERM", "full disk", "corrupted input", "output = input")
 #: the file-size limit of the full-disk cells [bytes]
 LIMIT = 1024
+#: the campaign of the `od campaign` cells: one seed, on one worker (tqdyn.workflows.od_campaign.plan_campaign)
+CAMPAIGN = {"tracking": ["isr,slr"], "arc": ["3h"], "interval": "1800", "seeds": "1", "estimate": "state",
+            "a_priori": ["state=1000,0.1"]}
 
 
 def fault_table() -> dict:
@@ -69,6 +79,7 @@ class Server:
     """The client of tests/fault_server.py: one child at a time."""
 
     def __init__(self):
+        self.children = []
         env = dict(os.environ, PYTHONPATH=SRC, MPLBACKEND="Agg")
         self.p = subprocess.Popen([sys.executable, SERVER], stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env,
                                   bufsize=0)
@@ -88,8 +99,10 @@ class Server:
 
     def run(self, argv, cwd, *, limit=None, block=None, sig=None):
         """Run ``tqdyn ARGV`` in ``cwd``; with ``block`` (target, only under ``cwd``) send ``sig`` once
-        the child waits there.  Returns (status, stdout, stderr); stdout is not kept under a limit (the
-        limit is for the command's files)."""
+        the child waits there (SIGINT to its process group, as Ctrl-C; another signal to the child).
+        Returns (status, stdout, stderr); stdout is not kept under a limit (the
+        limit is for the command's files).  ``self.children``: the child's own child processes (a local
+        Dask cluster's workers) when the signal was sent."""
         side = Path(cwd).parent / Path(cwd).name
         out, err = Path(f"{side}.out"), Path(f"{side}.err")
         req = {"argv": [str(a) for a in argv], "cwd": str(cwd), "stderr": str(err), "limit": limit, "block": None,
@@ -109,7 +122,10 @@ class Server:
                     break
                 assert time.monotonic() - t0 < 300, f"{argv}: never reached {block[0]}"
             else:
-                os.kill(pid, sig)
+                self.children = _descendants(pid)
+                # Ctrl-C in a terminal reaches the whole foreground process group (the child and its own
+                # children, e.g. Dask workers); SIGTERM (kill, a batch scheduler) the process
+                (os.killpg if sig == signal.SIGINT else os.kill)(pid, sig)
                 go.touch()
         status = (answer or self._line())["status"]
         return status, out.read_text() if out.exists() else "", err.read_text()
@@ -131,6 +147,7 @@ def fx(tmp_path_factory):
     import tqdyn
     from tqdyn import cli
     from tqdyn.scenario import load_scenario
+    from tqdyn.workflows import od_campaign
     from tqdyn.workflows.run import run_scenario_text
     from tqdyn.workflows.sweep import plan_sweep
 
@@ -151,6 +168,11 @@ def fx(tmp_path_factory):
     tqdyn_cli("od", "simulate", d / "kep.h5", "--tracking", "isr,slr", "--arc", "3h", "--interval", "1800", "-o",
               d / "m.tdm", "-q")
     (d / "scen.toml").write_text(load_scenario("tianqin-kepler").to_toml(), encoding="utf-8")
+    # the campaign's member, run here once: its kernels are in the cache the cells' Dask workers load
+    spec = od_campaign.plan_campaign("recovery", "tianqin-kepler", output=tmp_path_factory.mktemp("warm") / "c.nc",
+                                     **CAMPAIGN)
+    spec.parts.mkdir()
+    assert od_campaign.run_member(json.dumps({"job": spec.members[0].job, "path": str(spec.members[0].path)}))["ok"]
     (d / "sw").mkdir()
     sweep = ('[sweep]\nname = "one"\nscenario = "tianqin-kepler"\noutput_dir = "sw"\n'
              'set = ["run.duration=1h", "integrator.step=600"]\n\n'
@@ -170,6 +192,34 @@ def fx(tmp_path_factory):
     yield fx
     server.close()
     assert _digests(d) == before, "an input changed"
+
+
+def _descendants(pid: int) -> list:
+    """The processes started by ``pid`` and by them (psutil)."""
+    import psutil
+
+    try:
+        return psutil.Process(pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        return []
+
+
+def _survivors(procs, wait: float = 5.0) -> list:
+    """Those of ``procs`` (psutil processes) still running (not zombies) ``wait`` seconds on."""
+    import psutil
+
+    t0 = time.monotonic()
+    while True:
+        alive = []
+        for p in procs:
+            try:
+                if p.is_running() and p.status() != psutil.STATUS_ZOMBIE:
+                    alive.append(p)
+            except psutil.NoSuchProcess:
+                pass
+        if not alive or time.monotonic() - t0 > wait:
+            return alive
+        time.sleep(0.1)
 
 
 def _digests(d: Path) -> dict:
@@ -276,10 +326,26 @@ def _case(command: str, fx, cell: Path) -> dict:
                 cell / "rec.json"]
         return {"good": good, "bad": good[:3] + ["--duration", "-1"] + good[5:],
                 "corrupt": good[:-1] + [fx["rec_cut_json"]], "same": None, "block": replace}
+    if command == "od campaign":
+        good = ["od", "campaign", "recovery", "tianqin-kepler", "--tracking", CAMPAIGN["tracking"][0], "--arc",
+                CAMPAIGN["arc"][0], "--interval", CAMPAIGN["interval"], "--seeds", CAMPAIGN["seeds"], "--estimate",
+                CAMPAIGN["estimate"], "--a-priori", CAMPAIGN["a_priori"][0], "--workers", "1", "-q", "-o",
+                cell / "c.nc"]
+        return {"good": good, "bad": good[:11] + ["0"] + good[12:],
+                "corrupt": good[:3] + [fx["scen_cut_toml"]] + good[4:],
+                "same": lambda: good[:3] + [scen] + good[4:-1] + [_link(scen, cell / "c.nc")],
+                "block": ("distributed:as_completed", False)}
+    if command == "closed-loop --monte-carlo":
+        good = ["closed-loop", "--mission", "tianqin", "--monte-carlo", "1", "--workers", "1", "-q", "-o",
+                cell / "mc.nc"]
+        return {"good": good, "bad": good[:4] + ["0"] + good[5:], "corrupt": None, "same": None,
+                "block": ("distributed:as_completed", False)}
     raise AssertionError(f"no case for {command!r}")
 
 
 CELLS = [(c, f) for c in TABLE for f in FAULTS]
+#: the rows whose command runs on a local Dask cluster: a signal must also end its worker processes
+DASK = ("od campaign", "closed-loop --monte-carlo")
 _SIGNALS = {"SIGINT": signal.SIGINT, "SIGTERM": signal.SIGTERM}
 
 
@@ -315,11 +381,27 @@ def test_fault_table_cell(fx, tmp_path, command, fault):
     assert len(errors) == 1 and lines[-1] == errors[0] and len(errors[0]) <= 400, err
     if fault in _SIGNALS:
         assert ("interrupted" if fault == "SIGINT" else "stopped by SIGTERM") in errors[0], errors[0]
+        if command in DASK:  # the signal found the local cluster's workers at work; none outlives the command
+            assert server.children, f"{command}: no worker process when the signal was sent"
+            assert not _survivors(server.children), _survivors(server.children)
     if fault == "full disk":
         assert re.search(r"File too large|needs at least", errors[0]), errors[0]
     if fault == "output = input":
         assert "is the input" in errors[0] or "would replace the input" in errors[0] or "which is the" in errors[0]
-    assert _listing(cell) == before, f"left behind: {set(_listing(cell)) - set(before)}"
+    after = _listing(cell)
+    if command == "od campaign" and fault in _SIGNALS:  # kept on purpose: the members that finished
+        after = {k: v for k, v in after.items() if k not in _finished_members(cell)}
+    assert after == before, f"left behind: {set(after) - set(before)}"
+
+
+def _finished_members(cell: Path, seeds: str = CAMPAIGN["seeds"]) -> set:
+    """What a stopped `od campaign` of the cell keeps on purpose (docs/reliability.md): the result files of
+    its finished members, each holding its member's job (CampaignSpec.done), and their directory."""
+    from tqdyn.workflows import od_campaign
+
+    spec = od_campaign.plan_campaign("recovery", "tianqin-kepler", output=cell / "c.nc", **dict(CAMPAIGN, seeds=seeds))
+    done = {str(m.path.relative_to(cell)) for m in spec.members if spec.done(m)}
+    return done | ({"c.nc.parts"} if done else set())
 
 
 def test_commands_md_gives_the_same_table():
@@ -340,7 +422,8 @@ def test_the_table_lists_every_writing_command():
     commands = set(cli.commands) - {"info", "export", "od", "forces", "bench"}
     rows = set(TABLE)
     assert {f"export --format {f}" for f in FORMATS} <= rows
-    assert {"od simulate", "od fit", "od covariance --json", "forces --plot", "bench --json"} <= rows
+    assert {"od simulate", "od fit", "od covariance --json", "od campaign", "forces --plot", "bench --json",
+            "closed-loop --monte-carlo"} <= rows
     assert commands <= rows, commands - rows
 
 
@@ -424,3 +507,45 @@ def test_injection_memory_and_closed_loop_disk_refused(fx, tmp_path, monkeypatch
     line = err.splitlines()[-1]
     assert status == 3 and "needs at least" in line and "--duration" in line and "--fs" in line, err
     assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- a stopped campaign resumes
+
+
+@pytest.mark.slow
+def test_campaign_resumes_after_sigterm(fx, tmp_path):
+    """`tqdyn od campaign` of two seeds on one worker gets SIGTERM once the first member's result is back
+    (the worker is then at the second): exit 143, one line, the result files of the finished members kept
+    in c.nc.parts -- the first, and the second if it finished while the cluster closed -- and nothing else
+    (no c.nc, no temporary file), no worker process left.  The same command
+    again runs the second member only and writes the dataset of the same campaign run uninterrupted (the
+    reference: that run in another directory): every variable but the members' wall times equal, bit for
+    bit, and the same attributes."""
+    from tqdyn.workflows.sweep import read_sweep_netcdf
+
+    server = fx["server"]
+    cells = {}
+    for name in ("stopped", "reference"):
+        cells[name] = tmp_path / name
+        cells[name].mkdir()
+    argv = {k: _case("od campaign", fx, c)["good"] for k, c in cells.items()}
+    for a in argv.values():
+        a[a.index("--seeds") + 1] = "2"
+    cell = cells["stopped"]
+    status, _, err = server.run(argv["stopped"], cell, block=("tqdyn.workflows.sweep.execute:_lost_counts", False),
+                                sig=signal.SIGTERM)
+    lines = err.splitlines()
+    assert status == 143 and lines[-1].startswith("tqdyn: error: stopped by SIGTERM"), err
+    assert sum(ln.startswith("tqdyn: error:") for ln in lines) == 1 and "Traceback" not in err, err
+    assert server.children and not _survivors(server.children)
+    kept = set(_listing(cell))
+    assert kept == _finished_members(cell, "2") and len(kept) >= 2, kept  # the first member at least
+    done = len(kept) - 1
+    status, out, err = server.run(argv["stopped"], cell)
+    assert status == 0 and f"2 members: {done} already done, {2 - done} ran, 0 failed" in out, err
+    status, _, err = server.run(argv["reference"], cells["reference"])
+    assert status == 0, err
+    resumed, ref = (read_sweep_netcdf(c / "c.nc") for c in (cell, cells["reference"]))
+    assert set(resumed.data_vars) == set(ref.data_vars) and resumed.attrs == ref.attrs
+    for var in set(ref.data_vars) - {"wall_s"}:
+        assert resumed[var].equals(ref[var]), var

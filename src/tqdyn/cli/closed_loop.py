@@ -125,7 +125,7 @@ def _monte_carlo(run_file, mission, output, n, seed, sets, scheduler, workers, q
     with guarded(bad_input=(ValueError, io.OutputError), cleanup=bar.close):
         ds = mc.monte_carlo(mission, n, seed or 0, sets, scheduler, workers, progress=bar.update)
         bar.close()
-        path = write_netcdf(ds, out)
+        path = write_netcdf(ds, out, what="the Monte Carlo file")
     for d, row in mc.summarise(ds).items():
         r = row["requirement_ratio"]
         ratio = "no stable draw" if r is None else f"{r['median']:.3g} [{r['p05']:.3g}, {r['p95']:.3g}]"

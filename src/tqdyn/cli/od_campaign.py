@@ -4,8 +4,10 @@ campaigns on Dask (:mod:`tqdyn.workflows.od_campaign`).
 Registered on the ``tqdyn od`` group (:mod:`.od`).  Bad input (no seeds, an unknown tracking kind,
 an arc outside the run, an output that is an input, an unreachable scheduler) exits with status 2
 and one line, nothing written; members that failed are reported on stderr and make the exit status 1
-after the others are gathered; Ctrl-C exits with 130 (the members that finished are kept and
-skipped when the campaign is run again).  Progress: a bar over the members on stderr.
+after the others are gathered; Ctrl-C exits with 130, SIGTERM with 143, a member or the gathered file
+that cannot be written (full disk) with 3 (:func:`._common.guarded`; the local cluster closed, the
+members that finished are kept and skipped when the campaign is run again, no output file).
+Progress: a bar over the members on stderr.
 """
 
 from __future__ import annotations

@@ -23,15 +23,15 @@ def netcdf_engine() -> str:
     raise ImportError("writing the sweep's netCDF file needs the h5netcdf package (pip install h5netcdf)")
 
 
-def write_netcdf(dataset, path: str | os.PathLike, encoding: dict | None = None) -> Path:
+def write_netcdf(dataset, path: str | os.PathLike, encoding: dict | None = None, what: str = "the sweep file") -> Path:
     """Write ``dataset`` atomically as netCDF-4 (engine :func:`netcdf_engine`)
     to ``path`` (temporary file in the same directory, then renamed), with
     xarray's per-variable ``encoding`` (e.g. checksums) if given.  The file is built in memory and
     written with ordinary file writes (:func:`tqdyn.formats.atomic.replacing`, as
     :func:`~tqdyn.formats.atomic.replacing_h5` does: HDF5 never sees a full disk, which becomes
-    :class:`~tqdyn.formats.trajectory.OutputIOError`).  Returns the absolute path."""
+    :class:`~tqdyn.formats.trajectory.OutputIOError`, naming the file as ``what``).  Returns the absolute path."""
     path = Path(os.path.abspath(os.fspath(path)))
     image = dataset.to_netcdf(engine=netcdf_engine(), encoding=encoding)
-    with replacing(path, "the sweep file") as tmp, open(tmp, "xb") as f:
+    with replacing(path, what) as tmp, open(tmp, "xb") as f:
         f.write(image)
     return path

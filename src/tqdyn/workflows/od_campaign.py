@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._choices import unknown
+from ..formats.stop import check_stop
 from . import od as _od
 
 __all__ = ["KINDS", "CampaignMember", "CampaignResult", "CampaignSpec", "gather_campaign", "parse_seeds",
@@ -232,8 +233,11 @@ def _result(job: dict) -> dict:
 
 def run_member(task: str) -> dict:
     """Dask task: run one member (``task``: JSON of its job and its result file) and write its result
-    file atomically; never raises: {"ok", "error", "wall_s"}."""
-    from ..formats.atomic import replacing
+    file atomically; never raises: {"ok", "error", "wall_s"}, and "no_space" (the one-line
+    :class:`~tqdyn.formats.trajectory.OutputIOError`) when its file could not be written for a full
+    disk or a file-size limit."""
+    from ..formats.atomic import NO_SPACE, replacing
+    from ..formats.trajectory import OutputIOError
     from .run import one_line
 
     t0 = time.perf_counter()
@@ -245,7 +249,9 @@ def run_member(task: str) -> dict:
             tmp.write_text(json.dumps({"job": item["job"], "result": res}), encoding="utf-8")
         return {"ok": True, "error": "", "wall_s": res["wall_s"]}
     except Exception as exc:  # noqa: BLE001 - a failed member is reported, the others go on
-        return {"ok": False, "error": one_line(exc), "wall_s": time.perf_counter() - t0}
+        full = isinstance(exc, OutputIOError) or (isinstance(exc, OSError) and exc.errno in NO_SPACE)
+        return {"ok": False, "error": one_line(exc), "wall_s": time.perf_counter() - t0,
+                **({"no_space": str(exc)} if full else {})}
 
 
 @dataclass
@@ -283,7 +289,15 @@ def run_campaign(spec: CampaignSpec, scheduler=None, n_workers: int | None = Non
                  started: Callable[[Any], None] | None = None, **client_options) -> CampaignResult:
     """Run the members not yet done on Dask (``scheduler``, ``n_workers``, ``client_options`` as
     :func:`tqdyn.workflows.sweep.run_sweep`'s), calling ``progress(member, result)`` as each finishes,
-    then gather every member into the dataset and write ``spec.output``."""
+    then gather every member into the dataset and write ``spec.output``.
+
+    A member whose result file could not be written for a full disk stops the campaign: the unfinished
+    members are cancelled and :class:`~tqdyn.formats.trajectory.OutputIOError` is raised.  On any
+    stop (that, Ctrl-C, a stop signal: :func:`tqdyn.formats.stop.check_stop`) the local cluster is
+    closed, the temporary files of unfinished members are removed and the result files of the
+    finished ones kept (a run again skips them); ``<output>.parts`` is removed if this run created it
+    and it holds none."""
+    from ..formats.trajectory import OutputIOError
     from .sweep.execute import dask_client, run_on_dask
 
     t0 = time.perf_counter()
@@ -291,33 +305,41 @@ def run_campaign(spec: CampaignSpec, scheduler=None, n_workers: int | None = Non
     status = ["done" if spec.done(m) else "" for m in spec.members]
     errors, lost = [""] * n, [0] * n
     pending = [m for m, s in zip(spec.members, status) if not s]
+    created = not spec.parts.exists()
     spec.parts.mkdir(parents=True, exist_ok=True)
 
     def done(m, res):
+        if res.get("no_space"):
+            raise OutputIOError(res["no_space"])
         status[m.index] = "ran" if res["ok"] else "failed"
         errors[m.index] = res.get("error", "")
         lost[m.index] = int(res.get("lost_workers", 0) or 0)
         if progress is not None:
             progress(m, res)
 
-    if pending:
-        token = secrets.token_hex(4)
-        with dask_client(scheduler, n_workers, len(pending), **client_options) as client:
-            if started is not None:
-                started(client)
-            run_on_dask(run_member, pending, lambda m: f"tqdyn-od-{m.digest}-{token}", client, None, done,
-                        argument=lambda m: json.dumps({"job": m.job, "path": str(m.path)}))
-        for m in pending:   # temporaries a killed worker left behind
+    try:
+        if pending:
+            token = secrets.token_hex(4)
+            with dask_client(scheduler, n_workers, len(pending), **client_options) as client:
+                if started is not None:
+                    started(client)
+                run_on_dask(run_member, pending, lambda m: f"tqdyn-od-{m.digest}-{token}", client, None, done,
+                            argument=lambda m: json.dumps({"job": m.job, "path": str(m.path)}))
+        elif started is not None:
+            started(None)
+        check_stop()
+    finally:
+        for m in pending:   # temporaries of members a stop or a killed worker interrupted
             for tmp in m.path.parent.glob(f".{m.path.name}.*.tmp"):
                 tmp.unlink(missing_ok=True)
-    elif started is not None:
-        started(None)
+        if created and not any(spec.parts.iterdir()):
+            spec.parts.rmdir()
     dataset = gather_campaign(spec, status, errors)
     output = None
     if dataset is not None:
         from .sweep import write_sweep_netcdf
 
-        output = write_sweep_netcdf(dataset, spec.output)
+        output = write_sweep_netcdf(dataset, spec.output, what="the campaign file")
     return CampaignResult(spec, status, errors, lost, dataset, output, time.perf_counter() - t0)
 
 

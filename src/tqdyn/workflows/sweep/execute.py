@@ -15,6 +15,8 @@ import contextlib
 import logging
 import os
 import secrets
+import signal
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -127,7 +129,12 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int, *, dashboard: st
     new LocalCluster (processes, 1 thread each, at most ``n_workers``
     (default: the usable cores) and at most ``n_tasks`` workers; scheduler on
     127.0.0.1; dashboard at ``dashboard``, default ``127.0.0.1:0`` (loopback,
-    any port), None: no dashboard).  Also used by :mod:`tqdyn.workflows.studies`."""
+    any port), None: no dashboard).  The worker processes it starts with ignore Ctrl-C (SIGINT:
+    this process takes it and closes the cluster), and its own log lines are silenced up to
+    CRITICAL: a worker still sending its heartbeat while an interrupted command closes the cluster
+    logs an ERROR with a traceback, which would follow the command's one error line on stderr; what
+    fails is reported by the command itself (a failed member's line, a lost worker's note).  Also
+    used by :mod:`tqdyn.workflows.studies`."""
     from distributed import Client, LocalCluster
 
     if isinstance(scheduler, Client):
@@ -144,8 +151,19 @@ def dask_client(scheduler, n_workers: int | None, n_tasks: int, *, dashboard: st
     dashboard = check_dashboard(dashboard)
     # no dashboard: the scheduler still serves its plain HTTP routes (health, metrics): on loopback, any port
     http = {"dashboard": dashboard is not None, "dashboard_address": dashboard or DEFAULT_DASHBOARD}
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      scheduler_kwargs=http, silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+    # Ctrl-C reaches every process of the terminal's group: the workers must leave it to this process, which
+    # closes the cluster (a worker taking it prints a traceback).  SIGINT is ignored while the cluster starts,
+    # so the worker processes spawned then inherit SIG_IGN (a signal mask is not inherited through
+    # multiprocessing's spawn); a Ctrl-C of that moment (the cluster's start, about a second) is lost.
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               scheduler_kwargs=http, silence_logs=logging.CRITICAL)
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
+    with cluster, Client(cluster) as client:
         yield client
 
 

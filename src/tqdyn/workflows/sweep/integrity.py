@@ -29,16 +29,17 @@ def checksum_encoding(dataset) -> dict:
     return enc
 
 
-def write_sweep_netcdf(dataset, path: str | os.PathLike) -> Path:
+def write_sweep_netcdf(dataset, path: str | os.PathLike, what: str = "the sweep file") -> Path:
     """Write ``dataset`` atomically as netCDF-4 (temporary file in the same
     directory, then renamed) with Fletcher-32 checksums (:func:`checksum_encoding`).
-    Returns the absolute path.  The file is built in memory (:func:`tqdyn.formats.netcdf.write_netcdf`)
-    with dask's synchronous scheduler: under a distributed client xarray would take a distributed
+    Returns the absolute path; a failed write names the file as ``what``.  The file is built in
+    memory (:func:`tqdyn.formats.netcdf.write_netcdf`) with dask's synchronous scheduler: under a
+    distributed client xarray would take a distributed
     lock named after the file, which an in-memory file cannot give."""
     import dask
 
     with dask.config.set(scheduler="synchronous"):
-        return write_netcdf(dataset, path, encoding=checksum_encoding(dataset))
+        return write_netcdf(dataset, path, encoding=checksum_encoding(dataset), what=what)
 
 
 def read_sweep_netcdf(path: str | os.PathLike):
