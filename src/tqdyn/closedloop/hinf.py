@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import control
@@ -148,7 +149,10 @@ def synthesise(p: PlantParameters, wp: WorkingPoint, attitude_z_sensor: str = "d
     G = design_plant(p, wp, attitude_z_sensor, scheme)
     Gs = control.ss(G.A + SHIFT_RAD_S * np.eye(G.nstates), G.B, G.C, G.D)
     W1, W2, w = weights(chans, peak_sensitivity, authority_ratio)
-    P = control.augw(Gs, W1, W2, None)
+    with warnings.catch_warnings():
+        # python-control 0.10's augw calls its own deprecated connect(): not the caller's to act on
+        warnings.filterwarnings("ignore", message=r"connect\(\) is deprecated", category=FutureWarning)
+        P = control.augw(Gs, W1, W2, None)
     n = len(chans)
     try:
         Ks, CL, gamma = _sb10ad(P, n, n)
