@@ -97,14 +97,14 @@ def _multistep_steps(rhs, y, ms, tdat, params, layout, cpar, gw, fw, n_steps, ou
     head[0] = h
 
 
-@kernel(nogil=True)
+@kernel(nogil=True, link_only=True)
 def _chunk(y, dp, ms, tdat_dp, tdat_ms, params, layout, cpar, gw, fw, n_dp, n_ms, out_y, out_a, out_aux):
     """n_dp DP87 steps, then n_ms multistep steps of the coupled constellation (the module's docstring)."""
     _dp87_steps(coupled_rhs, y, dp, tdat_dp, params, layout, cpar, gw, fw, n_dp, out_y, out_a, out_aux)
     _multistep_steps(coupled_rhs, y, ms, tdat_ms, params, layout, cpar, gw, fw, n_ms, out_y, out_a, out_aux)
 
 
-@kernel(nogil=True)
+@kernel(nogil=True, link_only=True)
 def _chunk_points(y, dp, ms, tdat_dp, tdat_ms, params, layout, cpar, gw, fw, n_dp, n_ms, out_y, out_a, out_aux):
     """:func:`_chunk` for independent point masses (fw None)."""
     _dp87_steps(point_mass_rhs, y, dp, tdat_dp, params, layout, cpar, gw, fw, n_dp, out_y, out_a, out_aux)
