@@ -39,7 +39,7 @@ from numba.core.registry import CPUDispatcher
 from numba.core.typed_passes import NativeLowering
 from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "INLINED_OVERLOAD_OPTIONS", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
@@ -240,6 +240,11 @@ class _LoopCompiler(_EntryCompiler):
         pm.passes.insert(at, (_LinkOnly, _LinkOnly.__doc__.split("\n")[0]))
         pm.finalize()
         return [pm]
+
+
+#: ``jit_options`` of an overload inlined into its callers (``inline="always"``): numba compiles it once to
+#: type it and never runs that code, so its callees are linked into it without being optimised again.
+INLINED_OVERLOAD_OPTIONS = {**OVERLOAD_OPTIONS, "pipeline_class": _LoopCompiler}
 
 
 class _InnerDispatcher(CPUDispatcher):
