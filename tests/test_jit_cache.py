@@ -8,8 +8,8 @@ import pathlib
 
 from numba.core import caching
 
+from tqdyn.dynamics.loops import _chunk as _fixed_chunk
 from tqdyn.numerics import jit as _jit
-from tqdyn.dynamics.fixed import _fixed_chunk
 
 
 def test_locator_registered_first_and_used_for_tqdyn_kernels():

@@ -24,11 +24,19 @@ from numba import njit
 
 from ..forces.model import ForceModel
 from ..numerics import dp87
-from ..numerics.dd import add, copy_columns, ld, mul, st
-from ..numerics.jit import kernel
+from ..numerics.dd import add, ld, mul, st
 from . import layout as _lay
-from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
+from .loops import dp87_chunk
+from .results import (
+    Checkpoint,
+    RunResult,
+    check_finite_states,
+    format_extremes,
+    select_rows,
+    to_dd,
+    update_extremes,
+)
+from .rhs import evaluate_rhs
 
 __all__ = ["DEFAULT_CHUNK", "INPUT_BLOCK", "CheckpointClock", "chunk_kernel", "chunk_plan", "deliver_rows",
            "input_pipeline", "propagate_fixed", "warm_up", "warm_up_layout", "warm_up_systems"]
@@ -51,61 +59,18 @@ def _workspace(y0_dd, precision):
     return y, np.zeros_like(y), np.zeros((13,) + y.shape), np.zeros_like(y), np.zeros(y.shape[:2])
 
 
-@njit(inline="always")
-def _one_step(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat_step, params, layout,
-              cpar, aux0, aux, gw, fw):
-    """One DP87 step in place: the 13 stages (K[0] = f(y) first, its
-    diagnostics into aux0), then the compensated update of y.  tdat_step:
-    (13, n_tdat) time-only inputs at the stage times; rhs: the system's
-    right-hand side (:func:`tqdyn.dynamics.rhs.coupled_rhs` or
-    :func:`~tqdyn.dynamics.rhs.point_mass_rhs`)."""
-    rhs(y, tdat_step[0], params, layout, cpar, K[0], aux0, gw, fw)
-    for i in range(1, 13):
-        dp87.stage_state(y, K, ha, nz, nnz, i, ystage)
-        rhs(ystage, tdat_step[i], params, layout, cpar, K[i], aux, gw, fw)
-    dp87.combine(y, comp, K, hb, nzb, nnzb, he, err)
-
-
-@njit(inline="always")
-def _steps(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
-    for n in range(n_steps):
-        copy_columns(y, out_y[n], 0, 6)
-        aux0 = out_aux[n] if out_aux.shape[0] > 0 else aux
-        _one_step(rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat[n], params, layout,
-                  cpar, aux0, aux, gw, fw)
-        copy_columns(K[0], out_a[n], 3, 3)
-
-
-# The kernels: one per system, each the loop of _steps compiled with that
-# system's right-hand side (numba inlines _steps and _one_step before typing,
-# so a kernel is one compiled function holding one system; :func:`chunk_kernel`
-# picks the run's).
-
-
-@kernel(nogil=True)
-def _fixed_chunk(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-                 cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
-    """n_steps fixed DP87 steps of the coupled constellation.  Before step n
-    it records the state y_n in out_y[n] (n_body, 6[, 2]); after it, f(y_n)'s
-    acceleration (stage 1) in out_a[n] (n_body, 3[, 2]) and its diagnostics
-    in out_aux[n] (AUX_LEN,) (if out_aux has rows).  tdat: (n_steps, 13, n_tdat)."""
-    _steps(coupled_rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
-
-
-@kernel(nogil=True)
-def _fixed_chunk_points(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-                        cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux):
-    """:func:`_fixed_chunk` for independent point masses (fw None)."""
-    _steps(point_mass_rhs, y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he, tdat, params, layout,
-           cpar, aux, gw, fw, n_steps, out_y, out_a, out_aux)
-
-
 def chunk_kernel(fw):
-    """The DP87 kernel of the system whose work arrays ``fw`` are
-    (:func:`tqdyn.dynamics.layout.workspace`: None for point masses)."""
-    return _fixed_chunk_points if fw is None else _fixed_chunk
+    """The DP87 loop of the system whose work arrays ``fw`` are
+    (:func:`tqdyn.dynamics.layout.workspace`: None for point masses): a
+    function of ``(y, comp, K, ystage, err, ha, nz, nnz, hb, nzb, nnzb, he,
+    tdat, params, layout, cpar, aux, gw, fw, n_steps, out_y, out_a,
+    out_aux)`` that runs n_steps DP87 steps in the compiled kernel it shares
+    with the multistep loop (:func:`tqdyn.dynamics.loops.dp87_chunk`).
+    Before step n it records the state y_n in out_y[n] (n_body, 6[, 2]);
+    after it, f(y_n)'s acceleration (stage 1) in out_a[n] (n_body, 3[, 2])
+    and its diagnostics in out_aux[n] (AUX_LEN,) (if out_aux has rows).
+    tdat: (n_steps, 13, n_tdat)."""
+    return dp87_chunk(fw)
 
 
 @njit(cache=True)

@@ -32,17 +32,33 @@ from __future__ import annotations
 import time as _time
 
 import numpy as np
-from numba import njit
 
 from ..numerics import dp87
 from ..numerics import multistep as _ms
-from ..numerics.dd import copy_columns
-from ..numerics.jit import kernel
 from . import layout as _lay
-from .fixed import (CheckpointClock, _as_precision, _grid_times, _workspace, chunk_kernel, chunk_plan, deliver_rows,
-                    input_pipeline, warm_up_layout, warm_up_systems)
-from .results import Checkpoint, RunResult, check_finite_states, format_extremes, select_rows, to_dd, update_extremes
-from .rhs import coupled_rhs, evaluate_rhs, point_mass_rhs
+from .fixed import (
+    CheckpointClock,
+    _as_precision,
+    _grid_times,
+    _workspace,
+    chunk_kernel,
+    chunk_plan,
+    deliver_rows,
+    input_pipeline,
+    warm_up_layout,
+    warm_up_systems,
+)
+from .loops import multistep_chunk
+from .results import (
+    Checkpoint,
+    RunResult,
+    check_finite_states,
+    format_extremes,
+    select_rows,
+    to_dd,
+    update_extremes,
+)
+from .rhs import evaluate_rhs
 
 __all__ = ["INPUT_BLOCK", "propagate_multistep", "warm_up_multistep", "corrector_stages"]
 
@@ -65,57 +81,19 @@ def corrector_stages(corrector: str) -> tuple[int, bool]:
     return c.count("c"), c.endswith("e")
 
 
-@njit(inline="always")
-def _steps(rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
-           layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
-    h = head[0]
-    for n in range(n_steps):
-        copy_columns(y, out_y[n], 0, 6)
-        copy_columns(F[h], out_a[n], 0, 3)
-        if out_aux.shape[0] > 0:
-            for j in range(aux_cur.shape[0]):
-                out_aux[n, j] = aux_cur[j]
-        _ms.predict(S, cS, s, cs, F, h, coef, hh, ypred)
-        rhs(ypred, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
-        for it in range(n_corr):
-            _ms.correct(S, cS, s, cs, F, h, k, coef, hh, y)
-            if it == 0:
-                _ms.max_change(y, ypred, stats)
-            if evaluated or it < n_corr - 1:
-                rhs(y, tdat[n], params, layout, cpar, k, aux_cur, gw, fw)
-        if n_corr == 0:
-            copy_columns(ypred, y, 0, 6)
-        h = _ms.commit(S, cS, s, cs, F, h, k)
-    head[0] = h
-
-
-@kernel(nogil=True)
-def _multistep_chunk(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat, params,
-                     layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
-    """n_steps steps P(EC)^n_corr [E] of the coupled constellation: predict,
-    evaluate, n_corr times correct and evaluate, the last evaluation only if
-    ``evaluated``.  Before step n it records the state y_n in out_y[n], the
-    table's newest acceleration f_n in out_a[n] and that evaluation's
-    diagnostics aux_cur in out_aux[n] (if out_aux has rows).  tdat:
-    (n_steps, n_tdat) inputs at the end times t_{n+1} of the steps.  head:
-    (1,) int64 ring index of f_n; stats: (2,) running maxima of the first
-    correction's change of positions [m] and velocities [m/s].  One kernel
-    per system, as in :mod:`.fixed`."""
-    _steps(coupled_rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
-           params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
-
-
-@kernel(nogil=True)
-def _multistep_chunk_points(y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
-                            params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux):
-    """:func:`_multistep_chunk` for independent point masses (fw None)."""
-    _steps(point_mass_rhs, y, F, head, S, cS, s, cs, coef, hh, ypred, k, aux_cur, stats, n_corr, evaluated, tdat,
-           params, layout, cpar, gw, fw, n_steps, out_y, out_a, out_aux)
-
-
 def _kernel(fw):
-    """The multistep kernel of the system whose work arrays ``fw`` are (None: point masses)."""
-    return _multistep_chunk_points if fw is None else _multistep_chunk
+    """The multistep loop of the system whose work arrays ``fw`` are (None:
+    point masses; :func:`tqdyn.dynamics.loops.multistep_chunk`, the kernel
+    it shares with the DP87 loop of the start-up): n_steps steps P(EC)^n_corr
+    [E] of the coupled constellation: predict, evaluate, n_corr times
+    correct and evaluate, the last evaluation only if ``evaluated``.  Before
+    step n it records the state y_n in out_y[n], the table's newest
+    acceleration f_n in out_a[n] and that evaluation's diagnostics aux_cur
+    in out_aux[n] (if out_aux has rows).  tdat: (n_steps, n_tdat) inputs at
+    the end times t_{n+1} of the steps.  head: (1,) int64 ring index of f_n;
+    stats: (2,) running maxima of the first correction's change of
+    positions [m] and velocities [m/s]."""
+    return multistep_chunk(fw)
 
 
 class _State:

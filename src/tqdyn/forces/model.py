@@ -36,7 +36,7 @@ from numba.extending import overload
 from ..astro.ephemeris import ephemeris_named
 from ..astro.reference import GEOCENTRIC, ReferenceSystem
 from ..numerics.dd import add, const, mul, to_f64
-from ..numerics.jit import OVERLOAD_OPTIONS, dynamic, inner_kernel
+from ..numerics.jit import INLINED_OVERLOAD_OPTIONS, OVERLOAD_OPTIONS, dynamic, inner_kernel
 from .body_gms import body_gms
 from .central import EarthMonopole, monopole
 from .earth import PARAM_HEADER as _EF_HEADER
@@ -287,11 +287,12 @@ def term_gate(slot: int, kernel):
     of a model without it, ``kernel`` is not compiled and the gate gives
     (0.0, 0.0, 0.0) (the caller checks the table at run time, as for a
     layout table alone, with which ``kernel`` is compiled).  Compiled code
-    only; inlined into the caller (numba still compiles each gate once, to type it)."""
+    only; inlined into the caller (numba still compiles each gate once, to type it, with
+    :data:`tqdyn.numerics.jit.INLINED_OVERLOAD_OPTIONS`: the term's kernel is not optimised again there)."""
     def gate(layout, args):
         raise TypeError("a force-term gate is called from compiled code only")
 
-    @overload(gate, jit_options=OVERLOAD_OPTIONS, inline="always")
+    @overload(gate, jit_options=INLINED_OVERLOAD_OPTIONS, inline="always")
     def _gate(layout, args):
         if isinstance(layout, types.BaseTuple) and isinstance(layout.types[1].types[slot], types.NoneType):
             return lambda layout, args: (0.0, 0.0, 0.0)

@@ -39,7 +39,7 @@ from numba.core.registry import CPUDispatcher
 from numba.core.typed_passes import NativeLowering
 from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "INLINED_OVERLOAD_OPTIONS", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
@@ -176,6 +176,43 @@ class _DropCWrapper(_DropWrappers):
     keep_python = True
 
 
+def _light_final_module(library) -> None:
+    """Let ``library`` (a numba code library) skip the full optimisation of
+    its final module, the module with its callees linked in: only numba's
+    "cheap" module passes run on it (each callee was fully optimised in its
+    own library already).  Left unchanged if numba's codegen internals are
+    not as expected (numba 0.68)."""
+    codegen = getattr(library, "_codegen", None)
+    if not hasattr(codegen, "_module_pass_manager") or not hasattr(library, "_optimize_final_module"):
+        return
+
+    def optimize_final_module():
+        mpm, mpb = codegen._module_pass_manager(loop_vectorize=codegen._loopvect, slp_vectorize=False,
+                                                opt=codegen._opt_level, cost="cheap")
+        with library._recorded_timings.record("Module passes (cheap optimization for refprune)", mpb):
+            mpm.run(library._final_module, mpb)
+
+    library._optimize_final_module = optimize_final_module
+
+
+@register_pass(mutates_CFG=False, analysis_only=False)
+class _LinkOnly(LoweringPass):
+    """Compiler pass before the lowering: the function's code library
+    optimises its own code fully but its linked callees only lightly
+    (:func:`_light_final_module`)."""
+    _name = "tqdyn_link_only"
+
+    def __init__(self):
+        LoweringPass.__init__(self)
+
+    def run_pass(self, state):
+        if state.library is None:  # as numba's NativeLowering creates it
+            state.library = state.targetctx.codegen().create_library(state.func_id.func_qualname)
+            state.library.enable_object_caching()
+        _light_final_module(state.library)
+        return True
+
+
 class _InnerCompiler(CompilerBase):
     """numba's nopython pipeline with :class:`_DropWrappers` before the lowering."""
     drop = _DropWrappers
@@ -191,6 +228,23 @@ class _InnerCompiler(CompilerBase):
 class _EntryCompiler(_InnerCompiler):
     """numba's nopython pipeline with :class:`_DropCWrapper` before the lowering."""
     drop = _DropCWrapper
+
+
+class _LoopCompiler(_EntryCompiler):
+    """:class:`_EntryCompiler` with :class:`_LinkOnly` before the lowering."""
+
+    def define_pipelines(self):
+        pm = DefaultPassBuilder.define_nopython_pipeline(self.state)
+        at = next(i for i, (p, _) in enumerate(pm.passes) if p is NativeLowering)
+        pm.passes.insert(at, (self.drop, self.drop.__doc__.split("\n")[0]))
+        pm.passes.insert(at, (_LinkOnly, _LinkOnly.__doc__.split("\n")[0]))
+        pm.finalize()
+        return [pm]
+
+
+#: ``jit_options`` of an overload inlined into its callers (``inline="always"``): numba compiles it once to
+#: type it and never runs that code, so its callees are linked into it without being optimised again.
+INLINED_OVERLOAD_OPTIONS = {**OVERLOAD_OPTIONS, "pipeline_class": _LoopCompiler}
 
 
 class _InnerDispatcher(CPUDispatcher):
@@ -241,15 +295,21 @@ def inner_kernel(func=None, *, cache: bool = True, **options):
     return decorate if func is None else decorate(func)
 
 
-def kernel(func=None, *, cache: bool = True, **options):
+def kernel(func=None, *, cache: bool = True, link_only: bool = False, **options):
     """``numba.njit(cache=cache, **options)`` without numba's C wrapper (a
     second entry besides the CPython one, which every caller compiled
     later links in): for the kernels that Python calls and compiled code
     calls too (e.g. the right-hand sides, called by the propagation loops
     and by :func:`tqdyn.dynamics.rhs.evaluate_rhs`).  Usage: ``@kernel`` or
-    ``@kernel(...)``."""
+    ``@kernel(...)``.  ``link_only``: the kernel's callees, fully optimised
+    in their own compilation, are not optimised again with the kernel's
+    code (for a kernel whose own code is a loop of calls, such as the
+    propagation loops: the callees' code is most of it, and optimising it
+    once more takes seconds; the arithmetic is the same, numba never
+    reorders floating-point operations without ``fastmath``)."""
     def decorate(f):
-        return numba.njit(cache=cache, pipeline_class=_EntryCompiler, **options)(f)
+        pipeline = _LoopCompiler if link_only else _EntryCompiler
+        return numba.njit(cache=cache, pipeline_class=pipeline, **options)(f)
 
     return decorate if func is None else decorate(func)
 
