@@ -186,10 +186,16 @@ def _light_final_module(library) -> None:
     if not hasattr(codegen, "_module_pass_manager") or not hasattr(library, "_optimize_final_module"):
         return
 
+    full = library._optimize_final_module
+
     def optimize_final_module():
-        mpm, mpb = codegen._module_pass_manager(loop_vectorize=codegen._loopvect, slp_vectorize=False,
-                                                opt=codegen._opt_level, cost="cheap")
-        with library._recorded_timings.record("Module passes (cheap optimization for refprune)", mpb):
+        try:
+            mpm, mpb = codegen._module_pass_manager(loop_vectorize=codegen._loopvect, slp_vectorize=False,
+                                                    opt=codegen._opt_level, cost="cheap")
+            timings = library._recorded_timings
+        except (AttributeError, TypeError):  # another numba's internals: its own full optimisation
+            return full()
+        with timings.record("Module passes (cheap optimization for refprune)", mpb):
             mpm.run(library._final_module, mpb)
 
     library._optimize_final_module = optimize_final_module
