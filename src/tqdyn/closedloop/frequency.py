@@ -323,14 +323,15 @@ def _solve(st: LoopStack, idx, s, Ks, breaks: bool):
     return np.linalg.solve(M, rhs), sens, pieces
 
 
-def _response(st: LoopStack, idx, f) -> np.ndarray:
+def _response(st: LoopStack, idx, f, Ks=None) -> np.ndarray:
     """:func:`noise_response` with the frequency second: (k, F, 46, 58).  Eliminating c and u, the outputs are
     z = W(s) q + Zu (Ac K(s) Sw + Aw) w with Zu = Oy Dp + Ou and W(s) = Oy (Cq + s Cv + s^2 C2)
     + Zu Ac K(s) Sy (Cq + s Cv + s^2 C2): W is built per loop and frequency (46 x 20) and multiplied with the
-    solves q (20 x 58) in one stacked matrix product; the direct terms are added on their nonzero pattern."""
+    solves q (20 x 58) in one stacked matrix product; the direct terms are added on their nonzero pattern.
+    ``Ks``: :func:`controller_response` at ``f`` if computed."""
     idx = np.atleast_1d(np.asarray(idx))
     s = 2j * math.pi * np.asarray(f, dtype=np.float64)
-    Ks = controller_response(st, s)
+    Ks = controller_response(st, s) if Ks is None else Ks
     q, sens, (_Kq, _Gq, _Bq, Cq, Cv, C2, Dp) = _solve(st, idx, s, Ks, False)
     Oy = st.Oy[idx]
     Zu = np.matmul(Oy, Dp) + st.Ou[idx]
@@ -364,9 +365,10 @@ def noise_asd(st: LoopStack, idx, noise: dict, f) -> tuple[np.ndarray, list]:
     asd = np.array([noise[src].asd(f) for src in sources]).reshape(len(sources), len(f))
     out = np.empty((len(idx), len(output_names()), len(sources), len(f)))
     nf = max(1, _BLOCK_ELEMENTS // (len(output_names()) * len(NOISE_INPUTS)))
+    Ks = controller_response(st, 2j * math.pi * f)                                 # the same for every loop
     for j in range(len(idx)):
         for a in range(0, len(f), nf):
-            z = _response(st, idx[j:j + 1], f[a:a + nf])[0].view(np.float64)        # (F, 46, 2 x 58): re, im
+            z = _response(st, idx[j:j + 1], f[a:a + nf], Ks[:, a:a + nf])[0].view(np.float64)  # (F, 46, 116): re, im
             z *= z
             ps = np.add.reduceat(z, 2 * starts, axis=2)[..., pick]                  # (F, 46, n_source)
             out[j, :, :, a:a + nf] = np.sqrt(np.moveaxis(ps, 0, 2)) * asd[:, a:a + nf]

@@ -222,6 +222,7 @@ def simulate(loops: list, noise: dict, fs: float, n_samples: int, seed: int = 0,
             gens[s].trim()
             if k + m >= n_samples:                        # its last block: the satellite's filters are done
                 cache.pop((s, seg), None)
+                sg = None                                 # released before the next satellite's are designed
         sink.write(Block(t=t, values=vals, outputs=tuple(outputs)))
         k += m
     sink.close()

@@ -367,8 +367,9 @@ def _design(tr: _Transfer, sources: list, fs: float) -> None:
     below fs/2, where the kink of |G| at fs/2 is smoothed) the DTFT is within FIR_TOL of the target for every
     output, relative to the source's whole contribution sum_j |G_oj ASD_j|^2 at that frequency plus
     FIR_DYNAMIC of its largest value at that output, or to G's rounding-error scale (``_Transfer`` bound x
-    1e-10).  The loop is evaluated once per grid point for all sources (the doubled grid's even points are
-    the old grid)."""
+    1e-10).  The loop is evaluated once per grid point and source, one source's columns at a time (the doubled
+    grid's even points are the old grid; the arrays held are those of one source's columns and the pending
+    sources' grids)."""
     fny = np.array([0.5 * fs])
     cols = [c for src in sources for c in src.cols]
     f = np.arange(FIR_MIN // 2 + 1) * fs / FIR_MIN
@@ -387,14 +388,13 @@ def _design(tr: _Transfer, sources: list, fs: float) -> None:
         taper = signal.windows.tukey(n, FIR_TAPER, sym=False)
         f = np.arange(n // 2 + 1) * fs / n
         f2 = np.arange(n + 1) * fs / (2 * n)
-        Go = tr(f2[1::2], [c for src in pending for c in src.cols])
-        k, left = 0, []
-        for src in pending:
+        left = []
+        for src in pending:                       # one source at a time: the arrays of one source's columns
             G2 = np.empty(src.G.shape[:2] + (n + 1,), dtype=complex)
-            G2[..., 0::2], G2[..., 1::2] = src.G, Go[:, k:k + len(src.cols)]
-            k += len(src.cols)
-            h = _double_zero(np.roll(sfft.irfft(src.target(f, src.G, fs), n, axis=-1), n // 2, axis=-1) * taper,
-                             taper)
+            G2[..., 0::2], G2[..., 1::2] = src.G, tr(f2[1::2], src.cols)
+            src.G = None
+            h = _double_zero(np.roll(sfft.irfft(src.target(f, G2[..., 0::2], fs), n, axis=-1), n // 2, axis=-1)
+                             * taper, taper)
             if src.accepts(h, f2, G2, fs):
                 src.h, src.G = h, None
             elif 2 * n > FIR_MAX:
