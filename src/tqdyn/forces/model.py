@@ -66,7 +66,8 @@ SLOT_EIH = 8
 SLOT_EIH_GCRS = 9
 #: The central body's monopole (the Earth's or, heliocentric, the Sun's) uses the first slot.
 SLOT_CENTRAL_MONOPOLE = SLOT_EARTH_MONOPOLE
-SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "central_j2": SLOT_CENTRAL_J2, "third_body": SLOT_THIRD_BODY, "relativity": SLOT_RELATIVITY,
+SLOTS = {"earth_monopole": SLOT_EARTH_MONOPOLE, "central_j2": SLOT_CENTRAL_J2, "third_body": SLOT_THIRD_BODY,
+         "relativity": SLOT_RELATIVITY,
          "moon_field": SLOT_MOON_FIELD, "sun_j2": SLOT_SUN_J2, "earth_field": SLOT_EARTH_FIELD,
          "earth_field_indirect": SLOT_EARTH_FIELD_INDIRECT, "relativity_eih": SLOT_EIH,
          "relativity_eih_gcrs": SLOT_EIH_GCRS}

@@ -39,7 +39,8 @@ from numba.core.registry import CPUDispatcher
 from numba.core.typed_passes import NativeLowering
 from numba.extending import intrinsic
 
-__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "INLINED_OVERLOAD_OPTIONS", "OVERLOAD_OPTIONS", "inner_kernel", "install_cache_locator", "kernel", "prune_stale_caches"]
+__all__ = ["STALE_AFTER_DAYS", "cache_dir", "dynamic", "INLINED_OVERLOAD_OPTIONS", "OVERLOAD_OPTIONS", "inner_kernel",
+           "install_cache_locator", "kernel", "prune_stale_caches"]
 
 _PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # the tqdyn package folder
 
