@@ -101,7 +101,8 @@ def propagate(scenario: str | Scenario | None = None, overrides: Mapping[str, ob
     scen = load_scenario(scenario, overrides)
     model = dynamics.check_inputs(scen)
     # compile (or load the cached kernels) outside the timed propagation
-    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar)
+    dynamics.warm_up(scen.run.precision, scen.integrator.method, dynamics.build_system(scen, model).cpar,
+                     model=model)
     blocks: list = []
     bar = None
     if progress:

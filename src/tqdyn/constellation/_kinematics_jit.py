@@ -117,7 +117,6 @@ from math import atan2, sqrt
 from numba import njit
 
 from .._choices import unknown
-from ..numerics import jit as _jit  # noqa: F401  (package-wide kernel cache before any @njit)
 from ..numerics.vec3 import add as _add, axpy as _axpy, cross as _cross, dot as _dot
 from ..numerics.vec3 import row as _row, scale as _scale, sub as _sub
 from ..forces.central import monopole_jerk_snap as _monopole_jerk_snap

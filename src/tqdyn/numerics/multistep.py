@@ -42,12 +42,10 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
-from numba import njit
 
 from . import _multistep_coefficients as _tab
 from .dd import add, dd_from_mp, div, ld, mp_exact, mul, st, sub, to_f64
-from .jit import dynamic
-from .jit import inner_kernel, kernel
+from .jit import dynamic, inner_kernel, kernel
 
 __all__ = ["ORDERS", "CORRECTORS", "DEFAULT_ORDER", "DEFAULT_CORRECTOR", "Coefficients", "load_coefficients",
            "StepCoefficients", "step_coefficients", "predict", "correct", "commit", "start", "max_change", "ROW_NAMES"]
